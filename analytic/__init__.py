@@ -1,0 +1,12 @@
+"""The analytic trilith-pendulum rocking model (Di Egidio et al.), re-derived.
+
+Public API::
+
+    from analytic import Scene, Pulse, simulate, SimulationSettings
+"""
+from .excitation import Pulse, SampledRecord
+from .parameters import Scene
+from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
+
+__all__ = ["Scene", "Pulse", "SampledRecord", "Trajectory", "Event", "Verdict",
+           "OverturnCriterion"]

@@ -1,0 +1,1 @@
+"""Comparison layer: metrics between backends, the validation campaign, reports, CLI."""
