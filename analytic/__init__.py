@@ -4,9 +4,9 @@ Public API::
 
     from analytic import Scene, Pulse, simulate, SimulationSettings
 """
-from .excitation import Pulse, SampledRecord
+from .excitation import Pulse, SampledRecord, Still
 from .parameters import Scene
 from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
 
-__all__ = ["Scene", "Pulse", "SampledRecord", "Trajectory", "Event", "Verdict",
+__all__ = ["Scene", "Pulse", "SampledRecord", "Still", "Trajectory", "Event", "Verdict",
            "OverturnCriterion"]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Pulse", "SampledRecord", "Excitation", "PULSE_KINDS"]
+__all__ = ["Pulse", "SampledRecord", "Still", "Excitation", "PULSE_KINDS"]
 
 PULSE_KINDS = ("sine", "cosine")
 
@@ -172,4 +172,31 @@ class SampledRecord:
                 "peak": float(np.max(np.abs(self.accelerations)))}
 
 
-Excitation = Pulse | SampledRecord
+@dataclass(frozen=True)
+class Still:
+    """No base motion: for free rocking released from a tilt (restitution runs)."""
+
+    @property
+    def end_time(self) -> float:
+        return 0.0
+
+    def acceleration(self, t: float) -> float:
+        return 0.0
+
+    def acceleration_array(self, t: np.ndarray) -> np.ndarray:
+        return np.zeros_like(np.asarray(t, dtype=float))
+
+    def velocity(self, t: float) -> float:
+        return 0.0
+
+    def displacement(self, t: float) -> float:
+        return 0.0
+
+    def mirrored(self) -> "Still":
+        return self
+
+    def describe(self) -> dict:
+        return {"type": "still"}
+
+
+Excitation = Pulse | SampledRecord | Still

@@ -1,0 +1,233 @@
+"""What every engine adapter shares: run monitoring, verdicts and impact measurement.
+
+An engine adapter steps its world and hands sampled column angles to a
+:class:`RunMonitor`, which decides when the run can stop (same overturning
+criterion and survival rules as the analytic model) and turns the samples into a
+:class:`~analytic.trajectory.Trajectory`.
+
+Impact velocities are *not* read from the samples around a zero crossing: an
+engine spreads an impact over several steps.  Instead the engine state at the
+last sample clearly before the impact (``|theta| >= window``) is propagated with
+the analytic rocking equations (the smooth dynamics between impacts, which the
+engine must reproduce anyway) forward to ``theta = 0``, and the first sample
+clearly after it backward to ``theta = 0``.  This is the "fit away from the
+impact" of ``DESIGN.md``; without a pendulum it equals the energy-equivalent
+speed at ``theta = 0``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from analytic import equations as eq
+from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
+
+__all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero", "free_pendulum_period"]
+
+
+@dataclass(frozen=True)
+class MonitorSettings:
+    """Thresholds of the run monitor (shared by every engine).
+
+    uplift_angle : |theta| [rad] above which the trilith counts as uplifted
+        (contact compliance tilts a resting engine trilith by ~1e-6 rad).
+    impact_window : |theta| [rad] outside which a sample counts as "clearly away
+        from an impact" for the velocity measurement (impacts in engines last a
+        few steps, i.e. |theta| below ~1e-4 rad at dt = 1e-4 s).
+    rest_angle, rest_rate : |theta| [rad] and |theta_dot| [rad/s] under which the
+        trilith counts as at rest.
+    rest_hold : s; how long it must stay at rest after the pulse (at least one free
+        pendulum period is added when there is a pendulum).
+    t_cap : s after the pulse end before an undecided run stops ('undecided').
+    """
+
+    uplift_angle: float = 1e-4
+    impact_window: float = 1e-3
+    rest_angle: float = 1e-4
+    rest_rate: float = 1e-3
+    rest_hold: float = 0.5
+    t_cap: float = 60.0
+
+
+def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:
+    """Period [s] of the free pendulum through state ``(psi, psi_dot)``: libration
+    ``4 sqrt(l/g) K(k^2)`` with ``k = sin(psi_max/2)``; for a rotating pendulum the
+    time of one revolution (``2 sqrt(l/g) K(1/k^2)/k``)."""
+    from scipy.special import ellipk
+
+    w0 = math.sqrt(g / l)
+    k2 = math.sin(psi / 2.0) ** 2 + (psi_dot / (2.0 * w0)) ** 2
+    if k2 < 1e-300:
+        return 2.0 * math.pi / w0
+    if k2 < 1.0:
+        return 4.0 / w0 * float(ellipk(k2))
+    return 2.0 / (w0 * math.sqrt(k2)) * float(ellipk(1.0 / k2))
+
+
+def propagate_to_zero(scene, excitation, t0: float, state0, side: int,
+                      direction: int, span: float) -> tuple[float, float, float, float] | None:
+    """Integrate the analytic rocking equations from ``(t0, state0)`` (theta,
+    theta_dot, psi, psi_dot) on ``side`` forward (``direction=+1``) or backward
+    (``-1``) until ``theta = 0``, within ``span`` seconds.
+
+    Returns ``(t_zero, theta_dot, psi, psi_dot)`` at ``theta = 0`` or None.
+    """
+    b, h, mu, gamma, j, l, g = scene.model_args()
+
+    def rhs(t, y):
+        td, pd = eq.rocking_accelerations(y[0], y[1], y[2], y[3], excitation.acceleration(t),
+                                          side, b, h, mu, gamma, j, l, g)
+        return (y[1], td, y[3], pd)
+
+    def crossing(t, y):
+        return y[0]
+
+    crossing.terminal = True
+    sol = solve_ivp(rhs, (t0, t0 + direction * span), np.asarray(state0, dtype=float),
+                    method="DOP853", rtol=1e-10, atol=1e-12, events=crossing)
+    if sol.t_events[0].size == 0:
+        return None
+    y = sol.y_events[0][0]
+    return float(sol.t_events[0][0]), float(y[1]), float(y[2]), float(y[3])
+
+
+class RunMonitor:
+    """Collects an engine's samples, decides when to stop, builds the Trajectory.
+
+    Call :meth:`record` at every sample (not necessarily every step); it returns
+    True when the verdict is decided.  Then call :meth:`finish`.
+    """
+
+    def __init__(self, scene, excitation, criterion: OverturnCriterion,
+                 t_max: float | None, settings: MonitorSettings | None = None) -> None:
+        self.scene = scene
+        self.excitation = excitation
+        self.criterion = criterion
+        self.t_max = t_max
+        self.cfg = settings or MonitorSettings()
+        self.args = scene.model_args()
+        self.threshold = criterion.threshold(scene.alpha)
+        self.barrier = eq.overturn_energy_barrier(*self.args[:4], self.args[6])
+        self.t_end_pulse = excitation.end_time
+        self.samples: list[tuple[float, ...]] = []
+        self.mismatch = 0.0
+        self.verdict: Verdict | None = None
+        self._sign = 0
+        self._impacts: list[float] = []
+        self._uplift: float | None = None
+        self._rest_since: float | None = None
+        self.t_stop = (t_max if t_max is not None else self.t_end_pulse + self.cfg.t_cap)
+
+    # ------------------------------------------------------------------ online
+    def record(self, t: float, theta_left: float, theta_right: float, theta_dot: float,
+               psi: float = 0.0, psi_dot: float = 0.0) -> bool:
+        theta = 0.5 * (theta_left + theta_right)
+        values = (t, theta, theta_dot, psi, psi_dot)
+        if not all(math.isfinite(v) for v in values):
+            self.mark_unstable(t, "non-finite state")
+            return True
+        self.samples.append(values)
+        self.mismatch = max(self.mismatch, abs(theta_left - theta_right))
+        cfg = self.cfg
+        if abs(theta) > cfg.uplift_angle:
+            sign = 1 if theta > 0 else -1
+            if self._uplift is None:
+                self._uplift = t
+            if self._sign and sign != self._sign:
+                self._impacts.append(t)
+            self._sign = sign
+        if abs(theta) >= self.threshold:
+            mode = "after-impact" if self._impacts else "no-impact"
+            self.verdict = Verdict("overturned", t, mode, len(self._impacts),
+                                   f"|theta| reached {self.threshold:.4g} rad ({self.criterion.kind})")
+            return True
+        if t >= self.t_end_pulse:
+            if self._survived_by_energy(theta, theta_dot, psi, psi_dot):
+                self.verdict = Verdict("survived", None, None, len(self._impacts),
+                                       "energy below the overturning barrier after the pulse")
+                return True
+            if abs(theta) < cfg.rest_angle and abs(theta_dot) < cfg.rest_rate:
+                if self._rest_since is None:
+                    self._rest_since = t
+                hold = cfg.rest_hold
+                if self.scene.has_pendulum:
+                    hold += free_pendulum_period(psi, psi_dot, self.args[5], self.args[6])
+                if t - self._rest_since >= hold:
+                    self.verdict = Verdict("survived", None, None, len(self._impacts),
+                                           "at rest after the pulse")
+                    return True
+            else:
+                self._rest_since = None
+        if t >= self.t_stop:
+            status = "survived" if self.t_max is not None else "undecided"
+            self.verdict = Verdict(status, None, None, len(self._impacts),
+                                   f"end of run at t = {t:.4g} s")
+            return True
+        return False
+
+    def mark_unstable(self, t: float, reason: str) -> None:
+        self.verdict = Verdict("unstable", t, None, len(self._impacts), reason)
+
+    def _survived_by_energy(self, theta, theta_dot, psi, psi_dot) -> bool:
+        b, h, mu, gamma, j, l, g = self.args
+        side = 1 if (theta > 0 or (theta == 0 and theta_dot > 0)) else -1
+        energy = eq.energy(theta, theta_dot, psi, psi_dot, side, b, h, mu, gamma, j, l, g)
+        return energy < self.barrier
+
+    # ----------------------------------------------------------------- offline
+    def measured_impacts(self) -> list[Event]:
+        """Impact events with velocities propagated to ``theta = 0`` from samples
+        clearly away from the impact (see module docstring)."""
+        if not self.samples:
+            return []
+        data = np.asarray(self.samples)
+        t, theta = data[:, 0], data[:, 1]
+        window = self.cfg.impact_window
+        events = []
+        away = np.abs(theta) >= window
+        sign = np.sign(theta)
+        idx_away = np.flatnonzero(away)
+        for a, b_ in zip(idx_away[:-1], idx_away[1:]):
+            if sign[a] == sign[b_] or sign[a] == 0:
+                continue
+            side_before = int(sign[a])
+            span = max(4.0 * (t[b_] - t[a]), 0.05)
+            pre = propagate_to_zero(self.scene, self.excitation, t[a], data[a, 1:], side_before,
+                                    +1, span)
+            post = propagate_to_zero(self.scene, self.excitation, t[b_], data[b_, 1:],
+                                     -side_before, -1, span)
+            if pre is None or post is None:
+                continue
+            events.append(Event("impact", 0.5 * (pre[0] + post[0]), -side_before,
+                                theta_dot_before=pre[1], theta_dot_after=post[1],
+                                psi=0.5 * (pre[2] + post[2]), psi_dot_before=pre[3],
+                                psi_dot_after=post[3]))
+        return events
+
+    def finish(self, backend: str, settings: dict, diagnostics: dict,
+               wall_time: float) -> Trajectory:
+        if self.verdict is None:  # the engine stopped on its own (should not happen)
+            self.verdict = Verdict("undecided", None, None, len(self._impacts), "run ended early")
+        data = np.asarray(self.samples) if self.samples else np.zeros((0, 5))
+        events: list[Event] = []
+        if self._uplift is not None:
+            events.append(Event("uplift", self._uplift))
+        impacts = self.measured_impacts()
+        if self.verdict.overturned:
+            impacts = [e for e in impacts if e.t <= self.verdict.time]
+        events.extend(impacts)
+        if self.verdict.status in ("overturned", "unstable"):
+            events.append(Event("overturn" if self.verdict.overturned else "unstable",
+                                self.verdict.time))
+        events.sort(key=lambda e: e.t)
+        diagnostics = dict(diagnostics)
+        diagnostics.setdefault("column_mismatch_max", self.mismatch)
+        diagnostics.setdefault("n_samples", len(self.samples))
+        return Trajectory(backend=backend, t=data[:, 0], theta=data[:, 1], theta_dot=data[:, 2],
+                          psi=data[:, 3], psi_dot=data[:, 4], events=tuple(events),
+                          verdict=self.verdict, criterion=self.criterion, t_max=self.t_max,
+                          settings=settings, diagnostics=diagnostics, wall_time=wall_time,
+                          scene=self.scene, excitation=self.excitation)
