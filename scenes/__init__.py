@@ -2,7 +2,11 @@
 
 A scene file has one ``[scene]`` table whose keys are :class:`analytic.Scene`
 fields (``b``, ``lam``, ``mu``, ``gamma``, ``l``, ...).  ``load_scene`` accepts a
-name (a file in ``scenes/data``) or a path.
+name (a file in ``scenes/data``) or a path.  Shipped scenes: ``fig5``, the
+paper's Fig. 8, 9 and 11 grids (``fig8_lam5_gamma0.1``, ``fig9_lam3_b0.4``,
+``fig11_mu2``, ...), ``single_block`` (Housner checks) and ``no_pendulum``;
+each file's header comment says where its numbers come from and how sure
+they are.
 """
 from __future__ import annotations
 
@@ -12,12 +16,13 @@ from pathlib import Path
 
 from analytic.parameters import Scene
 
-__all__ = ["load_scene", "scene_names", "SCENE_DIR"]
+__all__ = ["load_scene", "scene_names", "scene_path", "SCENE_DIR"]
 
 SCENE_DIR = Path(__file__).resolve().parent / "data"
 
 
 def scene_names() -> tuple[str, ...]:
+    """Names of the shipped scene files, sorted."""
     return tuple(sorted(p.stem for p in SCENE_DIR.glob("*.toml")))
 
 
@@ -34,31 +39,59 @@ def _resolve(name_or_path: str | Path) -> Path:
     return path
 
 
+def scene_path(name_or_path: str | Path) -> Path:
+    """The file a scene name (or path) refers to; ``ValueError`` if there is none."""
+    return _resolve(name_or_path)
+
+
+def _check_value(where: str, key: str, value) -> None:
+    """Reject values that ``float()`` would silently accept but a scene file
+    should not contain (booleans, strings), naming the file and the key."""
+    if key == "name":
+        if not isinstance(value, str):
+            raise ValueError(f"{where}: key 'name' must be a string, got {value!r}")
+        return
+    # bool is an int subclass: float(True) == 1.0 would pass unnoticed.
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{where}: key {key!r} must be a number, got {value!r}")
+    if not math.isfinite(float(value)):
+        raise ValueError(f"{where}: key {key!r} must be finite, got {value!r}")
+
+
 def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
     """Read a scene file and apply ``overrides`` (field name -> value).
 
-    Raises ``ValueError`` naming the file and the key for unknown keys or bad values.
+    Raises ``ValueError`` naming the file and the key for unknown keys or bad
+    values (wrong type, out of the range :class:`analytic.Scene` allows).
     """
     path = _resolve(name_or_path)
     try:
         data = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a UTF-8 text file") from None
     table = data.get("scene")
     if not isinstance(table, dict) or set(data) - {"scene"}:
         raise ValueError(f"{path}: expected exactly one [scene] table, found "
                          f"{', '.join(data) or 'none'}")
     fields = set(Scene.field_names())
-    for key in list(table) + list(overrides):
+    allowed = ", ".join(sorted(fields))
+    for key in table:
         if key not in fields:
-            raise ValueError(f"{path}: unknown key {key!r}; allowed: {', '.join(sorted(fields))}")
+            raise ValueError(f"{path}: unknown key {key!r}; allowed: {allowed}")
+    for key in overrides:
+        if key not in fields:
+            raise ValueError(f"{path} (override): unknown key {key!r}; allowed: {allowed}")
+    for key, value in table.items():
+        _check_value(str(path), key, value)
+    for key, value in overrides.items():
+        _check_value(f"{path} (override)", key, value)
     values = {"name": path.stem}
     values.update(table)
     values.update(overrides)
-    for key, value in values.items():
-        if key != "name" and isinstance(value, str):
-            raise ValueError(f"{path}: key {key!r} must be a number, got {value!r}")
     try:
         return Scene(**values)
     except (TypeError, ValueError) as exc:
+        # Scene's messages start with the field name ("b must be in ...").
         raise ValueError(f"{path}: {exc}") from None
