@@ -1,0 +1,104 @@
+"""Helpers of the event-driven simulator (:mod:`analytic.simulate`).
+
+Pure functions only: the free-pendulum period used by the exact survival rule,
+the piecewise-smooth ground acceleration of one integration segment, and the
+collection of output samples.  Kept apart so ``simulate.py`` holds only the
+phase logic.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+from scipy.special import ellipk
+
+__all__ = ["free_pendulum_period", "excitation_window", "segment_acceleration",
+           "SampleBuffer"]
+
+
+def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:
+    """Period [s] of the free pendulum (trilith at rest, ground still) through
+    ``(psi, psi_dot)``.
+
+    With the per-unit-mass energy ``e = l^2 psi_dot^2/2 + g l (1 - cos psi)``:
+
+    * libration (``e < 2 g l``): ``T = 4 sqrt(l/g) K(m)``, ``m = sin^2(psi_max/2)
+      = e / (2 g l)``;
+    * rotation (``e > 2 g l``): ``T = 4 l K(2 g l / e) / sqrt(2 e)``, the time of
+      one full turn (the state, and so the uplift margin of Eq. 9, repeats);
+    * separatrix (``e = 2 g l``): ``inf`` (the motion is not periodic).
+
+    ``K`` is the complete elliptic integral of the first kind with parameter
+    ``m = k^2`` (``scipy.special.ellipk``).  A pendulum hanging still has the
+    small-amplitude period ``2 pi sqrt(l/g)``.
+    """
+    e = 0.5 * l * l * psi_dot * psi_dot + g * l * (1.0 - math.cos(psi))
+    sep = 2.0 * g * l
+    if e < sep:
+        return 4.0 * math.sqrt(l / g) * float(ellipk(e / sep))
+    if e > sep:
+        return 4.0 * l * float(ellipk(sep / e)) / math.sqrt(2.0 * e)
+    return math.inf
+
+
+def excitation_window(excitation) -> tuple[float, float]:
+    """``(t_on, t_off)``: outside this interval the ground is still.
+
+    Both ends are breakpoints of the integration: the one-cosine pulse jumps at
+    ``t = 0`` and at ``T_s`` (Eq. 23), a record may start with a non-zero value.
+    """
+    times = getattr(excitation, "times", None)
+    t_on = float(times[0]) if times is not None else 0.0
+    return t_on, float(excitation.end_time)
+
+
+def segment_acceleration(excitation, t_a: float, t_b: float) -> Callable[[float], float]:
+    """``xg_ddot(t)`` for a segment ``[t_a, t_b]`` that lies inside one smooth
+    piece of the excitation: the pulse formula with its values at the segment's
+    ends taken from *inside* the segment (one-sided limits at the jumps)."""
+    t_on, t_off = excitation_window(excitation)
+    mid = 0.5 * (t_a + t_b)
+    if mid < t_on or mid > t_off:
+        return lambda t: 0.0
+    acc = excitation.acceleration
+    lo, hi = max(t_a, t_on), min(t_b, t_off)
+    return lambda t: acc(min(max(t, lo), hi))
+
+
+class SampleBuffer:
+    """Output samples: a uniform grid ``k * dt`` (from dense output) plus the
+    event instants.  ``dt = None`` keeps the integrator's own steps instead."""
+
+    def __init__(self, dt: float | None) -> None:
+        self.dt = dt
+        self._t: list[np.ndarray] = []
+        self._y: list[np.ndarray] = []
+
+    def add_point(self, t: float, theta: float, theta_dot: float, psi: float,
+                  psi_dot: float) -> None:
+        self._t.append(np.array([t]))
+        self._y.append(np.array([[theta, theta_dot, psi, psi_dot]]))
+
+    def add_segment(self, t0: float, t1: float, steps: np.ndarray,
+                    evaluate: Callable[[np.ndarray], np.ndarray]) -> None:
+        """Samples in ``(t0, t1)``; ``evaluate(times)`` returns rows
+        ``(theta, theta_dot, psi, psi_dot)``.  Both ends are added by the caller as
+        points (event instants, breakpoints, the start and the end)."""
+        if self.dt is None:
+            times = np.asarray(steps, dtype=float)
+        else:
+            k0 = math.ceil(t0 / self.dt - 1e-9)
+            k1 = math.ceil(t1 / self.dt - 1e-9)
+            times = np.arange(k0, k1, dtype=float) * self.dt
+        times = times[(times > t0) & (times < t1)]
+        if times.size:
+            self._t.append(times)
+            self._y.append(np.asarray(evaluate(times), dtype=float).reshape(times.size, 4))
+
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        if not self._t:
+            return tuple(np.zeros(0) for _ in range(5))
+        t = np.concatenate(self._t)
+        y = np.concatenate(self._y, axis=0)
+        return t, y[:, 0], y[:, 1], y[:, 2], y[:, 3]

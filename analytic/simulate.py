@@ -1,0 +1,426 @@
+"""Accurate event-driven simulator of the trilith with its pendulum (backend ``"analytic"``).
+
+Phases (the compiled fast path ``analytic/fast.py`` implements the same):
+
+* **REST**: ``theta = theta_dot = 0``; the pendulum obeys Eq. 1
+  (:func:`~analytic.equations.rest_pendulum_acceleration`).  Uplift about side
+  ``s`` when :func:`~analytic.equations.uplift_margin` (Eq. 9) reaches 0 from
+  above (root-found for both sides); if it is already ``<= 0`` when a REST
+  segment starts, uplift at once.
+* **ROCK s** (``s = +1`` left corners, Eq. 8; ``s = -1`` right corners, Eq. A.1):
+  :func:`~analytic.equations.rocking_accelerations`.  Impact when ``s*theta``
+  falls through 0: Eq. 19/21 (:func:`~analytic.equations.impact_velocities`),
+  then ROCK ``-s``, or REST if ``|theta_dot+| < rest_velocity`` (this ends the
+  Zeno accumulation of impacts).  Overturned when ``|theta|`` reaches
+  ``criterion.threshold(alpha)``.
+
+Integration segments never straddle a discontinuity of ``xg_ddot`` (the ends of
+the excitation window).  Without a pendulum (``gamma = 0``) ``psi`` and
+``psi_dot`` stay 0 and are not integrated.
+
+Deciding survival exactly (``t_max = None``): after the excitation the base frame
+is inertial and the energy (:func:`~analytic.equations.energy`,
+:func:`~analytic.equations.rest_energy`) never increases (it only drops at
+impacts), so
+
+1. energy below :func:`~analytic.equations.overturn_energy_barrier` with
+   ``|theta| < alpha`` at the end of the excitation or after any later impact or
+   rest: survived (the well condition matters: past ``alpha`` the potential
+   falls below the barrier, so a trilith leaning out at the pulse end can have
+   little energy and still topple, e.g. Fig. 5 case D);
+2. at REST after the excitation without a pendulum: survived;
+3. at REST after the excitation with a swinging pendulum: the free pendulum is
+   periodic (:func:`~analytic.events.free_pendulum_period`), so no uplift during
+   one full period means none ever: survived;
+4. otherwise continue; at ``end_time + t_cap`` the verdict is 'undecided'.
+
+With a fixed ``t_max`` the run always goes on to ``t_max`` (unless it overturns)
+and a run that has not overturned is 'survived' (the paper's fixed-window
+convention); ``Verdict.reason`` says whether an exact rule had decided it.
+See ``docs/overturning.md``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy
+from scipy.integrate import solve_ivp
+
+from . import equations as eq
+from .events import SampleBuffer, excitation_window, free_pendulum_period, segment_acceleration
+from .parameters import Scene
+from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
+
+__all__ = ["NAME", "Settings", "simulate", "version"]
+
+NAME = "analytic"
+METHODS = ("DOP853", "RK45", "Radau", "LSODA")
+REASON_BARRIER = "energy below the overturning barrier after the pulse"
+REASON_REST = "at rest after the pulse without pendulum"
+REASON_PERIOD = "at rest after the pulse: no uplift during one free-pendulum period"
+REASON_WINDOW = "t_max reached without overturning (fixed window)"
+REASON_CAP = "t_cap reached after the pulse before the outcome was certain"
+
+
+def version() -> str:
+    """Backend version string carried into reports."""
+    return f"analytic-scipy-{scipy.__version__}"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Numerical settings of the accurate simulator."""
+
+    criterion: OverturnCriterion = OverturnCriterion()  # topple at 1.5 rad: the columns have fallen
+    t_max: float | None = None  # None: run until the verdict is decided exactly
+    t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> any rocking decay)
+    rtol: float = 1e-10  # energy drift between impacts ~1e-10, far below any engine's error
+    atol: float = 1e-12  # rad, rad/s: below rest_velocity by six decades
+    method: str = "DOP853"  # 8th order with 7th-order dense output for the event roots
+    sample_dt: float | None = 1e-3  # s; 1 ms resolves the fastest rocking (periods ~0.1 s)
+    rest_velocity: float = 1e-6  # rad/s: an impact slower than this ends in rest (Zeno)
+    rest_step_fraction: float = 1e-3  # max REST step / forcing period: a margin dip is not skipped
+    max_events: int = 100_000  # guard against a non-progressing event loop
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.criterion, OverturnCriterion):
+            raise ValueError(f"criterion must be an OverturnCriterion, got {self.criterion!r}")
+        if self.t_max is not None:
+            _check("t_max", self.t_max, 0.0, 1e5)
+        _check("t_cap", self.t_cap, 0.0, 1e5)
+        _check("rtol", self.rtol, 1e-14, 1e-2, lo_open=False)
+        _check("atol", self.atol, 0.0, 1.0)
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.sample_dt is not None:
+            _check("sample_dt", self.sample_dt, 0.0, 10.0)
+        _check("rest_velocity", self.rest_velocity, 0.0, 1.0)
+        _check("rest_step_fraction", self.rest_step_fraction, 0.0, 0.1)
+        if not isinstance(self.max_events, int) or self.max_events < 1:
+            raise ValueError(f"max_events must be an integer >= 1, got {self.max_events!r}")
+
+
+def _check(name: str, value, lo: float, hi: float, lo_open: bool = True) -> None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    ok = math.isfinite(v) and (v > lo if lo_open else v >= lo) and v <= hi
+    if not ok:
+        raise ValueError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {value!r}")
+
+
+class _Run:
+    """Mutable state of one run (the phase machine of the module docstring)."""
+
+    def __init__(self, scene: Scene, excitation, st: Settings) -> None:
+        self.st = st
+        self.args = scene.model_args()
+        b, h, mu, gamma, j, l, g = self.args
+        self.pend = gamma > 0.0
+        self.alpha = scene.alpha
+        self.threshold = st.criterion.threshold(scene.alpha)
+        self.barrier = eq.overturn_energy_barrier(b, h, mu, gamma, g)
+        self.excitation = excitation
+        self.t_on, self.t_off = excitation_window(excitation)
+        self.t_stop = st.t_max if st.t_max is not None else self.t_off + st.t_cap
+        self.breaks = sorted({x for x in (self.t_on, self.t_off) if 0.0 < x < self.t_stop})
+        times = getattr(excitation, "times", None)
+        self.forcing_step = (float(np.min(np.diff(times))) if times is not None
+                             else excitation.end_time)
+        self.t, self.phase = 0.0, 0
+        self.theta = self.theta_dot = self.psi = self.psi_dot = 0.0
+        self.events: list[Event] = []
+        self.samples = SampleBuffer(st.sample_dt)
+        self.n_impacts = 0
+        self.verdict: Verdict | None = None
+        self.decided = ""  # exact rule that decided survival (kept going when t_max is set)
+        self.diag = {"n_steps": 0, "n_rhs_evals": 0, "n_segments": 0}
+
+    # --- helpers ---------------------------------------------------------------
+    def after_pulse(self, t: float) -> bool:
+        return t >= self.t_off
+
+    def current_energy(self) -> float:
+        b, h, mu, gamma, j, l, g = self.args
+        if self.phase == 0:
+            return eq.rest_energy(self.psi, self.psi_dot, gamma, l, g)
+        return eq.energy(self.theta, self.theta_dot, self.psi, self.psi_dot, self.phase,
+                         *self.args)
+
+    def survive(self, reason: str) -> bool:
+        """Record an exact survival rule; returns True when the run must stop."""
+        if not self.decided:
+            self.decided = reason
+        if self.st.t_max is None:
+            self.verdict = Verdict("survived", None, None, self.n_impacts, reason)
+            return True
+        return False
+
+    def check_barrier(self) -> bool:
+        """Rule 1 (only after the excitation, and only inside the potential well
+        ``|theta| < alpha``: past alpha the trilith falls with any energy)."""
+        if (self.after_pulse(self.t) and abs(self.theta) < self.alpha
+                and self.current_energy() < self.barrier):
+            return self.survive(REASON_BARRIER)
+        return False
+
+    def point(self) -> None:
+        self.samples.add_point(self.t, self.theta, self.theta_dot, self.psi, self.psi_dot)
+
+    def margins(self, xg: float, psi: float, psi_dot: float) -> tuple[float, float]:
+        b, h, mu, gamma, j, l, g = self.args
+        return (eq.uplift_margin(psi, psi_dot, xg, 1.0, b, h, mu, gamma, l, g),
+                eq.uplift_margin(psi, psi_dot, xg, -1.0, b, h, mu, gamma, l, g))
+
+    def solve(self, fun, t_b, y0, events, max_step=np.inf, first_step=None):
+        sol = solve_ivp(fun, (self.t, t_b), y0, method=self.st.method, rtol=self.st.rtol,
+                        atol=self.st.atol, events=events, dense_output=True,
+                        max_step=max_step, first_step=first_step)
+        self.diag["n_segments"] += 1
+        self.diag["n_steps"] += len(sol.t) - 1
+        self.diag["n_rhs_evals"] += int(sol.nfev)
+        if sol.status < 0:
+            self.events.append(Event("unstable", self.t))
+            self.verdict = Verdict("unstable", self.t, None, self.n_impacts,
+                                   f"integrator failed: {sol.message}")
+        return sol
+
+    @staticmethod
+    def first_event(sol) -> tuple[int, float] | None:
+        if sol.status != 1:
+            return None
+        hits = [(float(te[0]), i) for i, te in enumerate(sol.t_events) if len(te)]
+        t_hit, index = min(hits)
+        return index, t_hit
+
+    # --- phases ----------------------------------------------------------------
+    def uplift(self, side: int) -> None:
+        self.events.append(Event("uplift", self.t, side=side, psi=self.psi))
+        self.phase = side
+        self.theta = self.theta_dot = 0.0
+
+    def rest_segment(self, t_b: float) -> None:
+        """Integrate REST up to ``t_b`` or the first uplift."""
+        xg = segment_acceleration(self.excitation, self.t, t_b)
+        m_plus, m_minus = self.margins(xg(self.t), self.psi, self.psi_dot)
+        if min(m_plus, m_minus) <= 0.0:  # already past the uplift condition: at once
+            self.uplift(1 if m_plus <= m_minus else -1)
+            return
+        period_end = None
+        if self.after_pulse(self.t):
+            if not self.pend:
+                if self.survive(REASON_REST):
+                    return
+            elif not self.decided:
+                period = free_pendulum_period(self.psi, self.psi_dot, self.args[5], self.args[6])
+                if self.t + period < t_b:
+                    t_b = period_end = self.t + period
+        if self.after_pulse(self.t) and not self.pend:
+            # t_max given (else rule 2 stopped the run): nothing moves any more.
+            self.samples.add_segment(self.t, t_b, np.array([]), lambda ts: np.zeros((len(ts), 4)))
+            self.t = t_b
+            self.point()
+            return
+        b, h, mu, gamma, j, l, g = self.args
+        if self.pend:
+            def fun(t, y):
+                return (y[1], eq.rest_pendulum_acceleration(y[0], xg(t), l, g))
+        else:
+            def fun(t, y):
+                return (0.0, 0.0)
+
+        def margin_event(side):
+            def ev(t, y):
+                return eq.uplift_margin(y[0], y[1], xg(t), side, b, h, mu, gamma, l, g)
+            ev.terminal, ev.direction = True, -1
+            return ev
+        forcing = (self.forcing_step if not self.after_pulse(self.t)
+                   else 2.0 * math.pi * math.sqrt(l / g))
+        sol = self.solve(fun, t_b, [self.psi, self.psi_dot],
+                         [margin_event(1), margin_event(-1)],
+                         max_step=self.st.rest_step_fraction * forcing)
+        hit = self.first_event(sol)
+        t1 = sol.t[-1] if hit is None else hit[1]
+        side = 0
+        if hit is not None:
+            side = 1 if hit[0] == 0 else -1
+            # The root is found to ~1e-15 s; step to the first instant where the
+            # margin is <= 0 so the rocking starts with s*theta_ddot >= 0.
+            t1 = self._nudge(sol.sol, xg, side, t1)
+        self.samples.add_segment(self.t, t1, sol.t, lambda ts: _rest_rows(sol.sol(ts)))
+        self.t = t1
+        self.psi, self.psi_dot = (float(v) for v in sol.sol(t1))
+        if sol.status < 0:
+            return
+        self.point()
+        if hit is not None:
+            self.uplift(side)
+        elif period_end is not None and t1 == period_end:
+            self.survive(REASON_PERIOD)
+
+    def _nudge(self, dense, xg, side, t1):
+        b, h, mu, gamma, j, l, g = self.args
+        step = max(abs(t1), 1.0) * np.finfo(float).eps
+        for _ in range(60):
+            psi, psi_dot = dense(t1)
+            if eq.uplift_margin(psi, psi_dot, xg(t1), side, b, h, mu, gamma, l, g) <= 0.0:
+                break
+            t1 += step
+            step *= 2.0
+        return t1
+
+    def rock_segment(self, t_b: float) -> None:
+        """Integrate ROCK ``self.phase`` up to ``t_b``, an impact or overturning."""
+        s = self.phase
+        xg = segment_acceleration(self.excitation, self.t, t_b)
+        args = self.args
+        if self.pend:
+            def fun(t, y):
+                a, c = eq.rocking_accelerations(y[0], y[1], y[2], y[3], xg(t), s, *args)
+                return (y[1], a, y[3], c)
+            y0 = [self.theta, self.theta_dot, self.psi, self.psi_dot]
+        else:
+            def fun(t, y):
+                return (y[1], eq.rocking_accelerations(y[0], y[1], 0.0, 0.0, xg(t), s, *args)[0])
+            y0 = [self.theta, self.theta_dot]
+
+        def impact(t, y):
+            return s * y[0]
+        impact.terminal, impact.direction = True, -1
+        thr = self.threshold
+
+        def overturn(t, y):
+            return s * y[0] - thr
+        overturn.terminal, overturn.direction = True, 1
+        # Starting at theta = 0 moving out but pulled back: the excursion lasts
+        # tau = 2|v/a|; a first step well inside it keeps the impact root bracketed.
+        first = None
+        a0 = fun(self.t, y0)[1]
+        if self.theta == 0.0 and s * self.theta_dot > 0.0 and s * a0 < 0.0:
+            tau = 2.0 * abs(self.theta_dot / a0)
+            if tau < 1e-2:
+                first = min(tau / 8.0, t_b - self.t)
+        sol = self.solve(fun, t_b, y0, [impact, overturn], first_step=first)
+        hit = self.first_event(sol)
+        t1 = sol.t[-1] if hit is None else hit[1]
+        pend = self.pend
+
+        def rows(ts):
+            y = sol.sol(ts)
+            if pend:
+                return y.T
+            zero = np.zeros(len(ts))
+            return np.column_stack([y[0], y[1], zero, zero])
+        self.samples.add_segment(self.t, t1, sol.t, rows)
+        y1 = sol.sol(t1) if hit is not None else sol.y[:, -1]
+        self.t = t1
+        self.theta, self.theta_dot = float(y1[0]), float(y1[1])
+        if pend:
+            self.psi, self.psi_dot = float(y1[2]), float(y1[3])
+        if sol.status < 0:
+            return
+        if hit is None:
+            self.point()
+        elif hit[0] == 1:
+            self.theta = s * thr
+            self.point()
+            mode = "no-impact" if self.n_impacts == 0 else "after-impact"
+            self.events.append(Event("overturn", t1, side=s, psi=self.psi))
+            self.verdict = Verdict("overturned", t1, mode, self.n_impacts,
+                                   f"|theta| reached {thr:.6g} rad ({self.st.criterion.kind})")
+        else:
+            self.theta = 0.0
+            self.point()
+            self.impact()
+
+    def impact(self) -> None:
+        s = self.phase
+        b, h, mu, gamma, j, l, g = self.args
+        td_minus, pd_minus = self.theta_dot, self.psi_dot
+        td_plus, pd_plus = eq.impact_velocities(td_minus, self.psi, pd_minus, -s,
+                                                b, h, mu, gamma, j, l)
+        self.n_impacts += 1
+        self.events.append(Event("impact", self.t, side=-s, theta_dot_before=td_minus,
+                                 theta_dot_after=td_plus, psi=self.psi,
+                                 psi_dot_before=pd_minus, psi_dot_after=pd_plus))
+        self.psi_dot = pd_plus if self.pend else 0.0
+        if abs(td_plus) < self.st.rest_velocity:
+            self.theta_dot = 0.0
+            self.phase = 0
+            self.events.append(Event("rest", self.t, side=0, psi=self.psi))
+        else:
+            self.theta_dot = td_plus
+            self.phase = -s
+        self.point()
+        self.check_barrier()
+
+    def run(self) -> None:
+        self.point()
+        checked_end = False
+        while self.verdict is None:
+            if len(self.events) > self.st.max_events:
+                self.verdict = Verdict("unstable", self.t, None, self.n_impacts,
+                                       f"more than max_events={self.st.max_events} events")
+                break
+            if not checked_end and self.after_pulse(self.t):
+                checked_end = True
+                if self.check_barrier():
+                    break
+            if self.t >= self.t_stop:
+                if self.st.t_max is not None:
+                    reason = f"{self.decided}; ran to t_max" if self.decided else REASON_WINDOW
+                    self.verdict = Verdict("survived", None, None, self.n_impacts, reason)
+                else:
+                    self.verdict = Verdict("undecided", None, None, self.n_impacts, REASON_CAP)
+                break
+            t_b = min([x for x in self.breaks if x > self.t] + [self.t_stop])
+            if self.phase == 0:
+                self.rest_segment(t_b)
+            else:
+                self.rock_segment(t_b)
+
+
+def _rest_rows(y: np.ndarray) -> np.ndarray:
+    n = y.shape[1]
+    return np.column_stack([np.zeros(n), np.zeros(n), y[0], y[1]])
+
+
+def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Trajectory:
+    """Simulate ``scene`` under ``excitation`` with the phase machine of this module.
+
+    Parameters
+    ----------
+    scene : Scene
+    excitation : Pulse or SampledRecord
+        Anything with ``acceleration(t)`` and ``end_time``.
+    settings : Settings, optional
+
+    Returns
+    -------
+    Trajectory
+        Samples on the ``sample_dt`` grid plus every event instant (an impact
+        gives two samples at the same time, before and after), the events
+        (uplift, impact, rest, overturn), the verdict and diagnostics
+        (``n_steps``, ``n_rhs_evals``, ``n_segments``).
+    """
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
+    if not (hasattr(excitation, "acceleration") and hasattr(excitation, "end_time")):
+        raise ValueError("excitation must be a Pulse or a SampledRecord")
+    st = Settings() if settings is None else settings
+    if not isinstance(st, Settings):
+        raise ValueError(f"settings must be analytic.simulate.Settings, got {type(st).__name__}")
+    start = time.perf_counter()
+    run = _Run(scene, excitation, st)
+    run.run()
+    t, theta, theta_dot, psi, psi_dot = run.samples.arrays()
+    return Trajectory(
+        backend=NAME, t=t, theta=theta, theta_dot=theta_dot, psi=psi, psi_dot=psi_dot,
+        events=tuple(run.events), verdict=run.verdict, criterion=st.criterion,
+        t_max=st.t_max, settings=dataclasses.asdict(st), diagnostics=dict(run.diag),
+        wall_time=time.perf_counter() - start, scene=scene, excitation=excitation)
