@@ -42,6 +42,9 @@ class MonitorSettings:
     rest_hold : s; how long it must stay at rest after the pulse (at least one free
         pendulum period is added when there is a pendulum).
     t_cap : s after the pulse end before an undecided run stops ('undecided').
+    energy_rule : stop as 'survived' once the energy is below the overturning
+        barrier after the pulse.  Free-rocking experiments (restitution) turn it
+        off: they need the impacts, not the verdict.
     """
 
     uplift_angle: float = 1e-4
@@ -50,6 +53,7 @@ class MonitorSettings:
     rest_rate: float = 1e-3
     rest_hold: float = 0.5
     t_cap: float = 60.0
+    energy_rule: bool = True
 
 
 def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:
@@ -145,7 +149,7 @@ class RunMonitor:
                                    f"|theta| reached {self.threshold:.4g} rad ({self.criterion.kind})")
             return True
         if t >= self.t_end_pulse:
-            if self._survived_by_energy(theta, theta_dot, psi, psi_dot):
+            if cfg.energy_rule and self._survived_by_energy(theta, theta_dot, psi, psi_dot):
                 self.verdict = Verdict("survived", None, None, len(self._impacts),
                                        "energy below the overturning barrier after the pulse")
                 return True
