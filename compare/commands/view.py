@@ -1,0 +1,27 @@
+"""``trilith view``: watch a run in a window (see ``scenes/view.py``).
+
+Without a display it exits with code 2 and a message pointing at ``trilith record``.
+"""
+from __future__ import annotations
+
+import argparse
+
+from scenes.view import view
+
+from ._common import pulse_from_args, scene_from_args
+from .record import add_watch_args
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "view", help="watch a run in a window (PyBullet GUI or matplotlib animation)",
+        description="Simulate a scene and show it live. Needs a display; otherwise use "
+                    "'trilith record' (exit code 2).")
+    add_watch_args(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = scene_from_args(args)
+    pulse = pulse_from_args(args)
+    view(scene, pulse, args.engine, fps=args.fps, duration=args.duration)
+    return 0

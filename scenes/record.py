@@ -1,0 +1,344 @@
+"""Headless recordings of a run: GIF (Pillow) or MP4 (ffmpeg), one panel per backend.
+
+Every backend runs the same scene under the same excitation; its
+:class:`~analytic.trajectory.Trajectory` is sampled on one common time base
+(``k / fps``) and drawn with :mod:`scenes.draw`, so panels side by side show the
+same instants.  PyBullet panels are rendered by PyBullet's own software renderer
+when ``engines.pybullet_engine`` provides ``render_frames`` (see
+:func:`pybullet_images`); otherwise its trajectory is drawn in 2D like the others.
+
+The figure is drawn with matplotlib's Agg canvas directly (no pyplot), so
+recording works without a display and never touches the GUI backend.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from analytic.parameters import Scene
+from analytic.trajectory import Trajectory
+
+__all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
+           "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
+           "check_output", "record", "ALL_ENGINES", "FORMATS", "DEFAULT_AMPLITUDE",
+           "DEFAULT_OMEGA"]
+
+# ``--engine all``: the accurate analytic reference and every physics engine
+# (``analytic-fast`` is the same model as ``analytic``; a panel for it adds nothing).
+ALL_ENGINES = ("analytic", "pybullet", "pymunk")
+FORMATS = (".gif", ".mp4")
+# The paper integrates to at least ten pulse periods (Sec. 5.1): the default length.
+DEFAULT_PERIODS = 10.0
+# Default pulse of ``trilith view/record``: case A of the paper's Fig. 6
+# (A_s = 19 m/s^2, Omega = 15 rad/s on the Fig. 5 trilith), inside the gain range
+# where the pendulum changes the outcome, so it is worth watching.
+DEFAULT_AMPLITUDE = 19.0
+DEFAULT_OMEGA = 15.0
+MAX_FRAMES = 20000  # about 11 min at 30 fps: beyond that a GIF is not a sensible output
+
+
+@dataclass(frozen=True)
+class RecordSettings:
+    """How a run is turned into frames.
+
+    fps : frames per second of the recording, in (0, 120].  Default 30: smooth for
+        rocking (a few Hz) and exactly representable in GIF delays of 10 ms units
+        only approximately (33 ms), which viewers accept.
+    duration : recorded time span [s], > 0; ``None`` gives ten pulse periods
+        (the paper's ``t_max``, Sec. 5.1).
+    panel_width, panel_height : pixels of one backend's panel, even numbers in
+        [64, 4096]; default 480 x 360 keeps a 10 s GIF around a few MB.
+    """
+
+    fps: float = 30.0
+    duration: float | None = None
+    panel_width: int = 480
+    panel_height: int = 360
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.fps) and 0.0 < self.fps <= 120.0):
+            raise ValueError(f"fps must be in (0, 120], got {self.fps!r}")
+        if self.duration is not None and not (math.isfinite(self.duration)
+                                              and 0.0 < self.duration <= 3600.0):
+            raise ValueError(f"duration must be in (0, 3600] s, got {self.duration!r}")
+        for name in ("panel_width", "panel_height"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and 64 <= value <= 4096 and value % 2 == 0):
+                # Even sizes: MP4 (yuv420p) needs even frame dimensions.
+                raise ValueError(f"{name} must be an even integer in [64, 4096], got {value!r}")
+
+
+@dataclass
+class RecordResult:
+    """What :func:`record` wrote."""
+
+    path: Path
+    n_frames: int
+    fps: float
+    duration: float
+    trajectories: dict[str, Trajectory]
+    renderers: dict[str, str]  # backend -> '2d' or 'pybullet-tiny-renderer'
+
+
+def default_duration(excitation) -> float:
+    """Ten pulse periods (the paper's ``t_max``), from ``excitation.end_time``."""
+    return DEFAULT_PERIODS * float(excitation.end_time)
+
+
+def frame_times(duration: float, fps: float) -> np.ndarray:
+    """The common time base ``k / fps``, ``k = 0 .. round(fps * duration) - 1`` [s]."""
+    n = int(round(duration * fps))
+    if n < 1:
+        raise ValueError(f"duration x fps must give at least one frame, got {duration!r} s "
+                         f"x {fps!r} fps")
+    if n > MAX_FRAMES:
+        raise ValueError(f"duration x fps gives {n} frames; at most {MAX_FRAMES} allowed "
+                         "(shorten --duration or lower --fps)")
+    return np.arange(n) / float(fps)
+
+
+def check_output(path: str | Path) -> Path:
+    """Validate the output path before any simulation: suffix, encoder, folder."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise ValueError(f"--out must end in {' or '.join(FORMATS)}, got {str(path)!r}")
+    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
+        raise ValueError("--out .mp4 needs ffmpeg on PATH, which was not found; "
+                         f"write a GIF instead: --out {path.with_suffix('.gif')}")
+    if not path.parent.is_dir():
+        raise ValueError(f"--out: folder {str(path.parent)!r} does not exist")
+    return path
+
+
+def resolve_engines(engine: str) -> tuple[str, ...]:
+    """``'all'`` -> :data:`ALL_ENGINES`; a registered name -> itself; else ValueError."""
+    from engines import backend_names
+
+    if engine == "all":
+        return ALL_ENGINES
+    if engine not in backend_names():
+        raise ValueError(f"--engine must be one of {', '.join(backend_names())}, all; "
+                         f"got {engine!r}")
+    return (engine,)
+
+
+def load_backend(name: str):
+    """The backend module, or a ValueError saying it is not in this checkout yet."""
+    from engines import BACKENDS, get_backend
+
+    try:
+        return get_backend(name)
+    except ModuleNotFoundError as exc:
+        if exc.name and BACKENDS[name].startswith(exc.name):
+            raise ValueError(f"backend {name!r} is not available in this checkout "
+                             f"(module {BACKENDS[name]} is missing)") from None
+        raise
+
+
+def backend_settings(module, duration: float, **changes):
+    """The backend's default Settings with ``t_max`` set to the recorded span."""
+    settings = module.Settings()
+    names = {f.name for f in dataclasses.fields(settings)}
+    if "t_max" in names:
+        changes["t_max"] = duration
+    unknown = set(changes) - names
+    for key in unknown:
+        del changes[key]
+    return dataclasses.replace(settings, **changes)
+
+
+def run_backend(name: str, scene: Scene, excitation, duration: float) -> Trajectory:
+    """Simulate ``scene`` in backend ``name`` up to ``duration`` seconds."""
+    module = load_backend(name)
+    return module.simulate(scene, excitation, backend_settings(module, duration))
+
+
+def sample_states(traj: Trajectory, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(theta, psi)`` at ``times`` by linear interpolation; after the run's last
+    sample (it stopped: overturned, at rest or ``t_max``) the last state is held."""
+    if len(traj.t) == 0:
+        raise ValueError(f"backend {traj.backend!r} returned an empty trajectory")
+    theta = np.interp(times, traj.t, traj.theta)
+    psi = np.interp(times, traj.t, traj.psi)
+    return theta, psi
+
+
+def _note(traj: Trajectory, t: float) -> str:
+    verdict = traj.verdict
+    if verdict.overturned and verdict.time is not None and t >= verdict.time:
+        mode = f" ({verdict.mode})" if verdict.mode else ""
+        return f"OVERTURNED{mode}"
+    if len(traj.t) and t > traj.t[-1]:
+        return f"run ended: {verdict.status}"
+    return ""
+
+
+class Panels:
+    """One figure, one panel per backend, all on the same time base.
+
+    ``trajectories``: backend -> Trajectory (drawn in 2D).  ``images``: backend
+    -> sequence of RGB frames already rendered at ``times`` (PyBullet's own
+    renderer); those panels show the image with the same text overlay.
+    """
+
+    def __init__(self, scene: Scene, excitation, times: np.ndarray,
+                 trajectories: dict[str, Trajectory], figure,
+                 images: dict[str, list] | None = None) -> None:
+        from scenes.draw import TrilithArtist, view_limits
+
+        self.times = np.asarray(times, dtype=float)
+        self.trajectories = trajectories
+        self.images = images or {}
+        self.x_g = np.array([excitation.displacement(float(t)) for t in self.times])
+        self.states = {name: sample_states(traj, self.times)
+                       for name, traj in trajectories.items()}
+        # One set of limits for every panel, so the panels compare at a glance.
+        all_theta = np.concatenate([s[0] for s in self.states.values()])
+        all_psi = np.concatenate([s[1] for s in self.states.values()])
+        limits = view_limits(scene, all_theta, all_psi, np.tile(self.x_g, len(self.states)))
+        names = list(trajectories)
+        axes = figure.subplots(1, len(names), squeeze=False)[0]
+        figure.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.92, wspace=0.03)
+        self.artists = {}
+        self.image_artists = {}
+        for ax, name in zip(axes, names):
+            if name in self.images:
+                ax.set_title(f"{name} (3D render)", fontsize=10)
+                ax.set_xticks([])
+                ax.set_yticks([])
+                self.image_artists[name] = (
+                    ax.imshow(np.asarray(self.images[name][0])),
+                    ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", ha="left",
+                            family="monospace", fontsize=8, color="#111111"))
+            else:
+                artist = TrilithArtist(ax, scene, title=name)
+                artist.set_limits(*limits)
+                self.artists[name] = artist
+
+    def __len__(self) -> int:
+        return self.times.size
+
+    def update(self, k: int) -> list:
+        """Show frame ``k`` in every panel; returns the changed artists."""
+        t = float(self.times[k])
+        changed = []
+        for name, artist in self.artists.items():
+            theta, psi = self.states[name]
+            changed += artist.update(t, float(theta[k]), float(psi[k]), float(self.x_g[k]),
+                                     note=_note(self.trajectories[name], t))
+        for name, (image, text) in self.image_artists.items():
+            theta, psi = self.states[name]
+            image.set_data(np.asarray(self.images[name][k]))
+            lines = [f"t     = {t:7.3f} s", f"theta = {theta[k]:+7.4f} rad",
+                     f"x_g   = {self.x_g[k]:+7.4f} m", _note(self.trajectories[name], t)]
+            text.set_text("\n".join(line for line in lines if line))
+            changed += [image, text]
+        return changed
+
+
+def render_frames(panels: Panels, figure) -> list[np.ndarray]:
+    """Draw every frame on the Agg canvas of ``figure``; (H, W, 3) uint8 arrays."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(figure)
+    frames = []
+    for k in range(len(panels)):
+        panels.update(k)
+        canvas.draw()
+        frames.append(np.asarray(canvas.buffer_rgba())[:, :, :3].copy())
+    return frames
+
+
+def write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
+    """Animated GIF via Pillow, looping; delay ``1000/fps`` ms (GIF stores 10 ms units)."""
+    from PIL import Image
+
+    images = [Image.fromarray(f) for f in frames]
+    images[0].save(path, save_all=True, append_images=images[1:], loop=0,
+                   duration=int(round(1000.0 / fps)), optimize=False)
+
+
+def write_mp4(frames: list[np.ndarray], path: Path, fps: float) -> None:
+    """H.264 MP4 by piping raw RGB frames to ffmpeg."""
+    ffmpeg = shutil.which("ffmpeg")
+    if ffmpeg is None:
+        raise ValueError("writing .mp4 needs ffmpeg on PATH; use a .gif output instead")
+    height, width = frames[0].shape[:2]
+    cmd = [ffmpeg, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+           "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
+           # Pad to even sizes (yuv420p) and use the most widely playable pixel format.
+           "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", str(path)]
+    proc = subprocess.run(cmd, input=b"".join(np.ascontiguousarray(f).tobytes() for f in frames),
+                          capture_output=True, check=False)
+    if proc.returncode != 0:
+        raise RuntimeError(f"ffmpeg failed: {proc.stderr.decode(errors='replace').strip()}")
+
+
+def pybullet_images(scene: Scene, excitation, times: np.ndarray, duration: float,
+                    width: int, height: int) -> list | None:
+    """PyBullet's own software-rendered frames (``ER_TINY_RENDERER``) at ``times``,
+    if ``engines.pybullet_engine`` provides ``render_frames``; else ``None``."""
+    module = load_backend("pybullet")
+    render = getattr(module, "render_frames", None)
+    if render is None:
+        return None
+    frames = render(scene, excitation, times, backend_settings(module, duration), width, height)
+    frames = [np.asarray(f)[:, :, :3].astype(np.uint8) for f in frames]
+    if len(frames) != len(times):
+        raise RuntimeError(f"pybullet render_frames returned {len(frames)} frames, "
+                           f"expected {len(times)}")
+    return frames
+
+
+def record(scene: Scene, excitation, engine: str, out: str | Path,
+           settings: RecordSettings | None = None,
+           trajectories: dict[str, Trajectory] | None = None) -> RecordResult:
+    """Simulate ``scene`` under ``excitation`` and write an animation to ``out``.
+
+    Parameters
+    ----------
+    engine : str
+        A registered backend name or ``'all'`` (analytic, pybullet, pymunk side
+        by side on the same time base).
+    out : path
+        ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
+    trajectories : dict, optional
+        Backend -> precomputed Trajectory (skips simulation; used by tests and
+        by callers that already ran the backends).
+    """
+    from matplotlib.figure import Figure
+
+    settings = settings or RecordSettings()
+    path = check_output(out)
+    names = tuple(trajectories) if trajectories else resolve_engines(engine)
+    duration = settings.duration if settings.duration is not None else default_duration(excitation)
+    times = frame_times(duration, settings.fps)
+    if trajectories is None:
+        for name in names:  # fail on a missing backend before any long run
+            load_backend(name)
+        trajectories = {name: run_backend(name, scene, excitation, duration) for name in names}
+    images, renderers = {}, {name: "2d" for name in names}
+    if "pybullet" in names:
+        frames = pybullet_images(scene, excitation, times, duration, settings.panel_width,
+                                 settings.panel_height)
+        if frames is not None:
+            images["pybullet"] = frames
+            renderers["pybullet"] = "pybullet-tiny-renderer"
+    dpi = 100
+    figure = Figure(figsize=(len(names) * settings.panel_width / dpi,
+                             settings.panel_height / dpi), dpi=dpi)
+    panels = Panels(scene, excitation, times, trajectories, figure, images)
+    frames = render_frames(panels, figure)
+    if path.suffix.lower() == ".gif":
+        write_gif(frames, path, settings.fps)
+    else:
+        write_mp4(frames, path, settings.fps)
+    return RecordResult(path=path, n_frames=len(frames), fps=settings.fps, duration=duration,
+                        trajectories=trajectories, renderers=renderers)
