@@ -1,0 +1,327 @@
+"""Measurements between a backend and the analytic reference (no physics here).
+
+Three families, each returning a frozen dataclass with ``to_dict()`` that carries
+the provenance (backend, engine version, time step, settings, wall time):
+
+* :func:`compare_trajectories`: theta(t) and psi(t) of a backend against the
+  reference on a common time grid; RMS and max errors normalised by ``alpha``
+  (the static overturning angle) up to the first impact and over the whole
+  common window; uplift, impact-time and peak-angle errors; verdict agreement.
+* :func:`restitution_from_trajectory`: per impact, the measured velocity ratio
+  against Eq. 20 (no pendulum) or Eq. 19 at the measured psi (with pendulum),
+  through :func:`analytic.equations.restitution_ratio`.
+* :func:`engine_threshold` / :func:`engine_jump_frequency`: an engine's first
+  overturning amplitude at one frequency, by a bisection bracketed with the
+  analytic threshold, and the frequency of a mode jump, by a bisection in Omega
+  at an amplitude between the two threshold levels of the jump.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from analytic import equations as eq
+from analytic.trajectory import Trajectory
+
+__all__ = ["Provenance", "TrajectoryComparison", "ImpactRestitution", "RestitutionComparison",
+           "ThresholdPoint", "JumpShift", "backend_version", "provenance_of", "settings_provenance",
+           "compare_trajectories", "restitution_from_trajectory", "engine_threshold",
+           "engine_jump_frequency", "common_grid_values"]
+
+# Grid step of the common time grid [s]: engines sample every ~1 ms and the
+# analytic path writes 1 ms samples; a finer grid only interpolates further.
+GRID_DT = 1e-3
+
+
+def _plain(value):
+    """JSON-friendly copy of a settings value (dataclasses, tuples, numpy scalars)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return _plain(dataclasses.asdict(value))
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if hasattr(value, "describe"):
+        return value.describe()
+    return value
+
+
+@functools.lru_cache(maxsize=None)
+def backend_version(name: str) -> str:
+    """``version()`` of a registered backend, or ``'unknown'`` if it has none."""
+    from engines import get_backend
+    try:
+        return str(get_backend(name).version())
+    except (ValueError, ImportError, AttributeError):
+        return "unknown"
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What produced a number: backend, its version, time step, settings, wall time."""
+
+    backend: str
+    version: str
+    dt: float | None
+    settings: dict = field(default_factory=dict)
+    wall_time: float = math.nan
+
+    def to_dict(self) -> dict:
+        return {"backend": self.backend, "version": self.version, "dt": self.dt,
+                "settings": _plain(self.settings), "wall_time": self.wall_time}
+
+
+def provenance_of(traj: Trajectory, wall_time: float | None = None) -> Provenance:
+    """The provenance of a trajectory (``dt`` is None for adaptive backends)."""
+    settings = _plain(traj.settings or {})
+    dt = settings.get("dt") if isinstance(settings, dict) else None
+    return Provenance(traj.backend, backend_version(traj.backend),
+                      float(dt) if dt is not None else None, settings,
+                      float(traj.wall_time if wall_time is None else wall_time))
+
+
+def settings_provenance(backend: str, settings, wall_time: float) -> Provenance:
+    """Provenance of a result made of several runs with the same ``settings``."""
+    plain = _plain(settings) if settings is not None else {}
+    dt = plain.get("dt") if isinstance(plain, dict) else None
+    return Provenance(backend, backend_version(backend),
+                      float(dt) if dt is not None else None, plain, float(wall_time))
+
+
+# --------------------------------------------------------------------- angles
+def _monotone(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Samples with strictly increasing times.  Backends write two samples at an
+    impact instant (pre- and post-impact); theta and psi are continuous there,
+    so keeping the last sample of each repeated time loses nothing."""
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    if t.size and np.any(np.diff(t) < 0.0):
+        raise ValueError("trajectory times must be non-decreasing")
+    keep = np.r_[np.diff(t) > 0.0, True] if t.size else np.zeros(0, bool)
+    return t[keep], y[keep]
+
+
+def common_grid_values(traj: Trajectory, name: str, grid: np.ndarray) -> np.ndarray:
+    """``traj.<name>`` (``'theta'`` or ``'psi'``) linearly interpolated on ``grid``."""
+    t, y = _monotone(traj.t, getattr(traj, name))
+    if t.size == 0:
+        raise ValueError(f"trajectory of {traj.backend!r} has no samples")
+    return np.interp(grid, t, y)
+
+
+def _end_time(traj: Trajectory) -> float:
+    end = float(traj.t[-1]) if len(traj.t) else 0.0
+    if traj.overturn_time is not None:
+        end = min(end, float(traj.overturn_time))
+    return end
+
+
+def _first_impact(traj: Trajectory) -> float | None:
+    impacts = traj.impacts
+    return float(impacts[0].t) if impacts else None
+
+
+def _errors(ref: Trajectory, test: Trajectory, name: str, t0: float, t1: float,
+            scale: float) -> tuple[float, float]:
+    """RMS and max of ``(test - ref)/scale`` on a uniform grid over ``[t0, t1]``."""
+    if not t1 > t0:
+        return math.nan, math.nan
+    n = max(2, int(math.ceil((t1 - t0) / GRID_DT)) + 1)
+    grid = np.linspace(t0, t1, n)
+    diff = (common_grid_values(test, name, grid) - common_grid_values(ref, name, grid)) / scale
+    return float(np.sqrt(np.mean(diff * diff))), float(np.max(np.abs(diff)))
+
+
+def _peak(traj: Trajectory, name: str, t1: float) -> float:
+    t, y = _monotone(traj.t, getattr(traj, name))
+    mask = t <= t1
+    return float(np.max(np.abs(y[mask]))) if np.any(mask) else 0.0
+
+
+def _rel(a: float, b: float) -> float:
+    return (a - b) / abs(b) if b != 0.0 else math.nan
+
+
+@dataclass(frozen=True)
+class TrajectoryComparison:
+    """A backend's theta(t), psi(t) against the reference (analytic) run.
+
+    Angle errors are ``(test - reference)/alpha`` on a uniform 1 ms grid.
+    ``*_first``: from the earlier uplift to the earlier first impact (or the end
+    of the common window if neither impacts); ``*_all``: over the common window,
+    up to the earlier of the two end times / overturn times.  Time errors are
+    ``test - reference`` [s]; impacts are matched in order.
+    """
+
+    reference: Provenance
+    test: Provenance
+    alpha: float
+    t_start: float
+    t_first_impact: float
+    t_end: float
+    theta_rms_first: float
+    theta_max_first: float
+    theta_rms_all: float
+    theta_max_all: float
+    psi_rms_first: float
+    psi_max_first: float
+    psi_rms_all: float
+    psi_max_all: float
+    uplift_time_error: float
+    impact_time_errors: tuple[float, ...]
+    n_impacts_reference: int
+    n_impacts_test: int
+    peak_theta_reference: float
+    peak_theta_test: float
+    peak_theta_rel_error: float
+    peak_psi_reference: float
+    peak_psi_test: float
+    status_reference: str
+    status_test: str
+    mode_reference: str | None
+    mode_test: str | None
+
+    @property
+    def verdict_agrees(self) -> bool:
+        """Same status and, when overturned, same mode (with/without impact)."""
+        return self.status_reference == self.status_test and self.mode_reference == self.mode_test
+
+    def to_dict(self) -> dict:
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["reference"] = self.reference.to_dict()
+        out["test"] = self.test.to_dict()
+        out["impact_time_errors"] = list(self.impact_time_errors)
+        out["verdict_agrees"] = self.verdict_agrees
+        return out
+
+
+def compare_trajectories(reference: Trajectory, test: Trajectory,
+                         alpha: float | None = None) -> TrajectoryComparison:
+    """Measure ``test`` against ``reference`` (see :class:`TrajectoryComparison`).
+
+    ``alpha`` defaults to the reference scene's slenderness angle ``atan(b/h)``.
+    """
+    if alpha is None:
+        if reference.scene is None:
+            raise ValueError("alpha must be given when the reference trajectory has no scene")
+        alpha = reference.scene.alpha
+    if not (math.isfinite(alpha) and alpha > 0.0):
+        raise ValueError(f"alpha must be in (0, pi/2] rad, got {alpha!r}")
+    for traj in (reference, test):
+        if len(traj.t) == 0:
+            raise ValueError(f"trajectory of {traj.backend!r} has no samples")
+    t_end = min(_end_time(reference), _end_time(test))
+    t_begin = max(float(reference.t[0]), float(test.t[0]))
+    ups = [u for u in (reference.uplift_time, test.uplift_time) if u is not None]
+    t_start = max(min(ups), t_begin) if ups else t_begin
+    firsts = [f for f in (_first_impact(reference), _first_impact(test)) if f is not None]
+    t_fi = min(min(firsts), t_end) if firsts else t_end
+
+    th_rf, th_mf = _errors(reference, test, "theta", t_start, t_fi, alpha)
+    th_ra, th_ma = _errors(reference, test, "theta", t_begin, t_end, alpha)
+    ps_rf, ps_mf = _errors(reference, test, "psi", t_start, t_fi, alpha)
+    ps_ra, ps_ma = _errors(reference, test, "psi", t_begin, t_end, alpha)
+
+    up_ref, up_test = reference.uplift_time, test.uplift_time
+    up_err = (up_test - up_ref) if (up_ref is not None and up_test is not None) else math.nan
+    ref_imp = [e.t for e in reference.impacts if e.t <= t_end]
+    test_imp = [e.t for e in test.impacts if e.t <= t_end]
+    imp_err = tuple(float(b - a) for a, b in zip(ref_imp, test_imp))
+    pk_ref, pk_test = _peak(reference, "theta", t_end), _peak(test, "theta", t_end)
+    return TrajectoryComparison(
+        reference=provenance_of(reference), test=provenance_of(test), alpha=float(alpha),
+        t_start=t_start, t_first_impact=t_fi, t_end=t_end,
+        theta_rms_first=th_rf, theta_max_first=th_mf, theta_rms_all=th_ra, theta_max_all=th_ma,
+        psi_rms_first=ps_rf, psi_max_first=ps_mf, psi_rms_all=ps_ra, psi_max_all=ps_ma,
+        uplift_time_error=float(up_err), impact_time_errors=imp_err,
+        n_impacts_reference=len(ref_imp), n_impacts_test=len(test_imp),
+        peak_theta_reference=pk_ref, peak_theta_test=pk_test,
+        peak_theta_rel_error=_rel(pk_test, pk_ref),
+        peak_psi_reference=_peak(reference, "psi", t_end), peak_psi_test=_peak(test, "psi", t_end),
+        status_reference=reference.verdict.status, status_test=test.verdict.status,
+        mode_reference=reference.verdict.mode, mode_test=test.verdict.mode)
+
+
+# ---------------------------------------------------------------- restitution
+@dataclass(frozen=True)
+class ImpactRestitution:
+    """One impact: measured ``theta_dot+/theta_dot-`` against Eq. 19/20."""
+
+    t: float
+    side: int
+    psi: float
+    measured: float
+    predicted: float
+
+    @property
+    def rel_error(self) -> float:
+        return _rel(self.measured, self.predicted)
+
+    def to_dict(self) -> dict:
+        return {"t": self.t, "side": self.side, "psi": self.psi, "measured": self.measured,
+                "predicted": self.predicted, "rel_error": self.rel_error}
+
+
+@dataclass(frozen=True)
+class RestitutionComparison:
+    """Per-impact restitution of one free-rocking run and its worst relative error."""
+
+    lam: float
+    mu: float
+    gamma: float
+    equation: str
+    impacts: tuple[ImpactRestitution, ...]
+    provenance: Provenance
+
+    @property
+    def max_rel_error(self) -> float:
+        errs = [abs(i.rel_error) for i in self.impacts]
+        return max(errs) if errs else math.nan
+
+    def to_dict(self) -> dict:
+        return {"lam": self.lam, "mu": self.mu, "gamma": self.gamma, "equation": self.equation,
+                "impacts": [i.to_dict() for i in self.impacts],
+                "max_rel_error": self.max_rel_error, "provenance": self.provenance.to_dict()}
+
+
+def restitution_from_trajectory(traj: Trajectory, scene=None,
+                                n_impacts: int | None = None) -> RestitutionComparison:
+    """Measured velocity ratio at each impact event of ``traj`` against the model.
+
+    Eq. 20 without pendulum (``psi = 0``, ``gamma = 0``), Eq. 19 evaluated at the
+    impact's measured ``psi`` with it; the event ``side`` is the side entered.
+    """
+    scene = scene if scene is not None else traj.scene
+    if scene is None:
+        raise ValueError("scene must be given when the trajectory carries none")
+    if n_impacts is not None and n_impacts < 1:
+        raise ValueError(f"n_impacts must be >= 1, got {n_impacts!r}")
+    b, h, mu, gamma, j, _l, _g = scene.model_args()
+    rows = []
+    for ev in traj.impacts[:n_impacts]:
+        psi = ev.psi if (gamma > 0.0 and math.isfinite(ev.psi)) else 0.0
+        side = ev.side if ev.side in (-1, 1) else (1 if ev.theta_dot_after > 0 else -1)
+        rows.append(ImpactRestitution(float(ev.t), int(side), float(psi), float(ev.velocity_ratio),
+                                      eq.restitution_ratio(psi, side, b, h, mu, gamma, j)))
+    return RestitutionComparison(scene.lam, scene.mu, scene.gamma,
+                                 "Eq. 19" if gamma > 0.0 else "Eq. 20", tuple(rows),
+                                 provenance_of(traj))
+
+
+# ----------------------------------------------------------------- thresholds
+_THRESHOLD_NAMES = ("ThresholdPoint", "JumpShift", "engine_threshold", "engine_jump_frequency")
+
+
+def __getattr__(name: str):
+    """Overturning-threshold metrics live in :mod:`compare.thresholds` (they run
+    backends); re-exported here lazily to avoid a circular import."""
+    if name in _THRESHOLD_NAMES:
+        from . import thresholds
+        return getattr(thresholds, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

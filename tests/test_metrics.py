@@ -1,0 +1,196 @@
+"""compare.metrics / compare.thresholds on synthetic trajectories and fake backends.
+
+Expected values come from closed forms (sinusoid differences, Housner's
+restitution), never from running the code under test.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import compare.thresholds as thr
+from analytic.parameters import Scene
+from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from compare import metrics
+
+ALPHA = 0.2
+
+
+def _traj(t, theta, psi=None, events=(), verdict=None, backend="analytic", settings=None,
+          scene=None):
+    t = np.asarray(t, float)
+    theta = np.asarray(theta, float)
+    psi = np.zeros_like(t) if psi is None else np.asarray(psi, float)
+    return Trajectory(backend=backend, t=t, theta=theta, theta_dot=np.zeros_like(t),
+                      psi=psi, psi_dot=np.zeros_like(t), events=tuple(events),
+                      verdict=verdict or Verdict("survived"), criterion=OverturnCriterion(),
+                      t_max=None, settings=settings or {}, wall_time=0.5, scene=scene)
+
+
+def test_constant_offset_gives_exact_rms_and_max():
+    t = np.linspace(0.0, 2.0, 2001)
+    ref = _traj(t, 0.1 * np.sin(3 * t))
+    test = _traj(t, 0.1 * np.sin(3 * t) + 0.004, backend="pymunk", settings={"dt": 1e-4})
+    c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
+    # Linear interpolation of a constant offset is exact: only float rounding remains.
+    assert c.theta_rms_all == pytest.approx(0.004 / ALPHA, rel=1e-9)
+    assert c.theta_max_all == pytest.approx(0.004 / ALPHA, rel=1e-9)
+    assert c.psi_rms_all == 0.0
+    assert c.test.dt == 1e-4 and c.test.backend == "pymunk"
+    d = c.to_dict()
+    assert d["test"]["dt"] == 1e-4 and d["test"]["wall_time"] == 0.5
+
+
+def test_time_shift_matches_closed_form_rms():
+    # theta_test(t) = a sin(w (t - s)): difference RMS over whole periods is
+    # a * 2 sin(w s / 2) / sqrt(2).
+    a, w, s = 0.1, 2 * math.pi, 0.01
+    t = np.linspace(0.0, 3.0, 30001)
+    ref = _traj(t, a * np.sin(w * t))
+    test = _traj(t, a * np.sin(w * (t - s)))
+    c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
+    expected = a * 2 * math.sin(w * s / 2) / math.sqrt(2) / ALPHA
+    # 1 ms grid over 3 whole periods, both end points counted: the discrete mean
+    # of cos^2 is off by ~0.5/3001 relative, i.e. ~2e-4 on the RMS.
+    assert c.theta_rms_all == pytest.approx(expected, rel=5e-4)
+    assert c.theta_max_all == pytest.approx(a * 2 * math.sin(w * s / 2) / ALPHA, rel=1e-3)
+
+
+def test_repeated_impact_samples_and_first_impact_window():
+    # Reference: a triangle wave with an impact at t=1 (two samples at t=1).
+    t_ref = np.r_[np.linspace(0, 1, 101), np.linspace(1, 2, 101)]
+    th_ref = np.r_[np.linspace(0, 0.1, 51), np.linspace(0.1, 0, 51)[1:], -np.linspace(0, 0.05, 101)]
+    assert t_ref.size == th_ref.size
+    ev_ref = [Event("uplift", 0.0), Event("impact", 1.0, -1, -0.2, 0.16)]
+    ev_test = [Event("uplift", 0.01), Event("impact", 1.02, -1, -0.2, 0.16)]
+    ref = _traj(t_ref, th_ref, events=ev_ref)
+    # The test differs only after the impact.
+    th_test = th_ref.copy()
+    th_test[101:] *= 1.2
+    test = _traj(t_ref, th_test, events=ev_test, backend="pybullet")
+    c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
+    assert c.theta_rms_first == pytest.approx(0.0, abs=1e-15)  # identical before the impact
+    assert c.theta_max_all == pytest.approx(0.2 * 0.05 / ALPHA, rel=1e-6)
+    assert c.t_first_impact == 1.0
+    assert c.uplift_time_error == pytest.approx(0.01)
+    assert c.impact_time_errors == pytest.approx((0.02,))
+    assert c.n_impacts_reference == c.n_impacts_test == 1
+
+
+def test_window_stops_at_earlier_overturn_and_verdicts():
+    t = np.linspace(0.0, 2.0, 201)
+    ref = _traj(t, 0.5 * t, verdict=Verdict("overturned", 2.0, "no-impact"))
+    test = _traj(t[:101], 0.5 * t[:101], verdict=Verdict("overturned", 1.0, "no-impact"))
+    c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
+    assert c.t_end == 1.0
+    assert c.peak_theta_reference == pytest.approx(0.5)  # measured in the common window only
+    assert c.verdict_agrees
+    other = _traj(t, 0.5 * t, verdict=Verdict("overturned", 2.0, "after-impact"))
+    assert not metrics.compare_trajectories(ref, other, alpha=ALPHA).verdict_agrees
+
+
+def test_bad_inputs_raise():
+    t = np.linspace(0.0, 1.0, 11)
+    ref = _traj(t, 0 * t)
+    with pytest.raises(ValueError, match="alpha"):
+        metrics.compare_trajectories(ref, ref, alpha=-1.0)
+    with pytest.raises(ValueError, match="alpha must be given"):
+        metrics.compare_trajectories(ref, ref)
+    with pytest.raises(ValueError, match="n_impacts"):
+        metrics.restitution_from_trajectory(ref, Scene(gamma=0.0), n_impacts=0)
+
+
+def test_restitution_against_housner():
+    # mu = 0, gamma = 0, uniform column: Eq. 20 is Housner's 1 - 1.5 sin^2(alpha).
+    scene = Scene(lam=4.0, mu=0.0, gamma=0.0)
+    e_h = 1.0 - 1.5 * math.sin(scene.alpha) ** 2
+    events = [Event("uplift", 0.0),
+              # theta_dot keeps its sign through an impact (theta goes on through 0).
+              Event("impact", 0.5, -1, -0.3, -0.3 * e_h),
+              Event("impact", 0.9, +1, 0.3 * e_h, 0.3 * e_h * e_h * 1.01)]
+    t = np.linspace(0.0, 1.0, 11)
+    r = metrics.restitution_from_trajectory(_traj(t, 0 * t, events=events), scene)
+    assert r.equation == "Eq. 20"
+    assert [i.predicted for i in r.impacts] == pytest.approx([e_h, e_h], rel=1e-12)
+    assert r.impacts[0].rel_error == pytest.approx(0.0, abs=1e-12)
+    assert r.max_rel_error == pytest.approx(0.01, rel=1e-9)
+    assert r.to_dict()["max_rel_error"] == pytest.approx(0.01, rel=1e-9)
+
+
+def test_restitution_with_pendulum_uses_measured_psi():
+    scene = Scene(gamma=0.3)
+    b, h, mu, gamma, j, _, _ = scene.model_args()
+    psi = 0.3
+    t = np.linspace(0.0, 1.0, 11)
+    ev = Event("impact", 0.5, +1, 0.2, 0.15, psi=psi)
+    r = metrics.restitution_from_trajectory(_traj(t, 0 * t, events=[ev]), scene)
+    # Eq. 19 (corrected) typed independently here from the paper's form with the factor 2:
+    c = b * math.cos(psi) + h * math.sin(psi)
+    num = -4 * j + gamma * (b * b + h * h) * math.cos(2 * psi) + (b * b - h * h) * (1 + 2 * mu + gamma)
+    den = 4 * j + 2 * gamma * c * c + (b * b + h * h) * (1 + 2 * mu)
+    assert r.equation == "Eq. 19"
+    assert r.impacts[0].predicted == pytest.approx(-num / den, rel=1e-12)
+    assert r.impacts[0].predicted != pytest.approx(
+        metrics.restitution_from_trajectory(_traj(t, 0 * t, events=[
+            Event("impact", 0.5, +1, 0.2, 0.15, psi=0.0)]), scene).impacts[0].predicted)
+
+
+# ------------------------------------------------------------- thresholds
+@pytest.fixture
+def fake_engine(monkeypatch):
+    """A fake backend: overturns iff A >= threshold(backend, omega)."""
+    table = {}
+    calls = []
+
+    def fake(backend, scene, omega, amplitude, settings=None, kind="sine"):
+        calls.append((backend, omega, amplitude))
+        over = amplitude >= table[backend](omega)
+        return over, "overturned" if over else "survived", "no-impact" if over else None
+
+    monkeypatch.setattr(thr, "overturns", fake)
+    return table, calls
+
+
+def test_threshold_bisection_inside_bracket(fake_engine):
+    table, calls = fake_engine
+    table["pymunk"] = lambda w: 10.1
+    p = thr.engine_threshold("pymunk", Scene(), 12.0, 10.0, None)
+    assert p.a_low < 10.1 <= p.a_engine
+    assert p.a_engine - p.a_low <= 2e-3 * 10.0 + 1e-12
+    assert p.rel_error == pytest.approx(0.01, abs=2e-3)
+    assert p.n_runs == len(calls) <= 2 + 6  # 2 bracket runs + log2(6 %/0.2 %) bisections
+    assert p.mode_engine == "no-impact"
+
+
+@pytest.mark.parametrize("true_a", [7.0, 14.0])
+def test_threshold_bracket_expands(fake_engine, true_a):
+    table, _ = fake_engine
+    table["pymunk"] = lambda w: true_a
+    p = thr.engine_threshold("pymunk", Scene(), 12.0, 10.0, None)
+    assert p.bracketed
+    assert p.a_low < true_a <= p.a_engine <= true_a + 2e-3 * 10.0
+
+
+def test_threshold_not_bracketed_gives_nan(fake_engine):
+    table, _ = fake_engine
+    table["pymunk"] = lambda w: 1e3  # never overturns within 2^5 widenings of 3 %
+    p = thr.engine_threshold("pymunk", Scene(), 12.0, 10.0, None, max_expand=2)
+    assert not p.bracketed and math.isnan(p.rel_error)
+    with pytest.raises(ValueError, match="rel_tol"):
+        thr.engine_threshold("pymunk", Scene(), 12.0, 10.0, None, rel_tol=0.5)
+    with pytest.raises(ValueError, match="omega"):
+        thr.engine_threshold("pymunk", Scene(), 0.0, 10.0, None)
+
+
+def test_jump_frequency_shift(fake_engine):
+    table, _ = fake_engine
+    # Threshold 8 below the jump, 20 above; jumps at 10.0 (model) and 10.3 (engine).
+    table["analytic-fast"] = lambda w: 8.0 if w < 10.0 else 20.0
+    table["pymunk"] = lambda w: 8.0 if w < 10.3 else 20.0
+    j = thr.engine_jump_frequency("pymunk", Scene(), 14.0, 9.5, 10.2, None, omega_tol=0.01)
+    assert j.omega_reference == pytest.approx(10.0, abs=0.01)
+    assert j.omega_engine == pytest.approx(10.3, abs=0.01)  # found after one widening
+    assert j.shift == pytest.approx(0.3, abs=0.02)
+    assert j.to_dict()["shift"] == pytest.approx(j.shift)
