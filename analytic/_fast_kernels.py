@@ -1,0 +1,538 @@
+"""Numba kernels of the fast analytic path: Dormand-Prince 5(4) with dense output
+and event location, over the phases REST / ROCK(+1) / ROCK(-1).
+
+The physics is *not* re-typed here: the scalar functions of
+:mod:`analytic.equations` (Eq. 1, 8, A.1, 9, 19, 21 corrected) are compiled as they
+are with ``numba.njit``.  This module only holds the integrator, the event logic
+and the phase semantics, which are the same as the accurate path's
+(``analytic/simulate.py``, see ``analytic/fast.py`` for the list).
+
+Everything is compiled once per process (``cache=True`` also keeps the machine
+code on disk between processes).  The verdict-only entry point allocates a few
+small arrays per *call* and nothing per step.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import equations as _eq
+
+# --- the equations, compiled from the single source -------------------------------
+_rock = njit(cache=True)(_eq.rocking_accelerations)
+_rest_acc = njit(cache=True)(_eq.rest_pendulum_acceleration)
+_margin = njit(cache=True)(_eq.uplift_margin)
+_impact = njit(cache=True)(_eq.impact_velocities)
+_energy = njit(cache=True)(_eq.energy)
+_rest_energy = njit(cache=True)(_eq.rest_energy)
+_barrier = njit(cache=True)(_eq.overturn_energy_barrier)
+
+# --- codes shared with analytic/fast.py --------------------------------------------
+ST_OVERTURNED, ST_SURVIVED, ST_UNSTABLE, ST_UNDECIDED = 0, 1, 2, 3
+EV_UPLIFT, EV_IMPACT, EV_REST, EV_OVERTURN, EV_UNSTABLE = 0, 1, 2, 3, 4
+(R_OVERTURN, R_BARRIER, R_REST_NO_PENDULUM, R_PENDULUM_PERIOD, R_T_MAX, R_T_CAP,
+ R_NONFINITE, R_STEP_UNDERFLOW, R_STEP_BUDGET) = range(9)
+KIND_SINE, KIND_COSINE = 0, 1
+
+# --- Dormand-Prince 5(4) tableau and its 4th-order dense output (as in scipy's RK45)
+_C = np.array([0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0])
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [0.2, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0]])
+_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0,
+               11.0 / 84.0])
+_E = np.array([-71.0 / 57600.0, 0.0, 71.0 / 16695.0, -71.0 / 1920.0, 17253.0 / 339200.0,
+               -22.0 / 525.0, 1.0 / 40.0])
+_P = np.array([
+    [1.0, -8048581381.0 / 2820520608.0, 8663915743.0 / 2820520608.0,
+     -12715105075.0 / 11282082432.0],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200.0 / 32700410799.0, -68118460800.0 / 10900136933.0,
+     87487479700.0 / 32700410799.0],
+    [0.0, -1754552775.0 / 470086768.0, 14199869525.0 / 1410260304.0,
+     -10690763975.0 / 1880347072.0],
+    [0.0, 127303824393.0 / 49829197408.0, -318862633887.0 / 49829197408.0,
+     701980252875.0 / 199316789632.0],
+    [0.0, -282668133.0 / 205662961.0, 2019193451.0 / 616988883.0,
+     -1453857185.0 / 822651844.0],
+    [0.0, 40617522.0 / 29380423.0, -110615467.0 / 29380423.0, 69997945.0 / 29380423.0]])
+
+_SAFETY = 0.9          # usual step-size safety factor (Hairer)
+_MIN_FACTOR = 0.2      # bounds on the step change per step, as scipy uses
+_MAX_FACTOR = 10.0
+_ROOT_XTOL = 1e-14     # event location: relative position inside the step
+_ROOT_ITER = 200
+
+
+@njit(cache=True)
+def _xg(t, on, amp, omega, kind):
+    """Pulse acceleration (Eq. 22/23); ``on`` is False after the pulse end."""
+    if not on:
+        return 0.0
+    if kind == KIND_COSINE:
+        return amp * math.cos(omega * t)
+    return amp * math.sin(omega * t)
+
+
+@njit(cache=True)
+def _deriv(phase, y, xg, out, b, h, mu, gamma, j, l, g):
+    """Right-hand side in phase ``phase`` (0 = REST, +1/-1 = ROCK about that side)."""
+    if phase == 0:
+        out[0] = 0.0
+        out[1] = 0.0
+        if gamma == 0.0:
+            out[2] = 0.0
+            out[3] = 0.0
+        else:
+            out[2] = y[3]
+            out[3] = _rest_acc(y[2], xg, l, g)
+        return
+    tdd, pdd = _rock(y[0], y[1], y[2], y[3], xg, float(phase), b, h, mu, gamma, j, l, g)
+    out[0] = y[1]
+    out[1] = tdd
+    out[2] = y[3]
+    out[3] = pdd
+
+
+@njit(cache=True)
+def _dense(y0, k, hstep, x, out):
+    """DP5 4th-order continuous extension at ``t0 + x*hstep``."""
+    x2 = x * x
+    q0 = x
+    q1 = x2
+    q2 = x2 * x
+    q3 = x2 * x2
+    for c in range(4):
+        acc = 0.0
+        for i in range(7):
+            acc += k[i, c] * (_P[i, 0] * q0 + _P[i, 1] * q1 + _P[i, 2] * q2 + _P[i, 3] * q3)
+        out[c] = y0[c] + hstep * acc
+
+
+@njit(cache=True)
+def _event_value(kind, side, yx, t, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g):
+    """Event functions; an event happens where the value becomes <= 0.
+
+    kind 0: uplift margin about ``side`` (REST);  kind 1: ``side*theta`` (impact);
+    kind 2: ``thr - side*theta`` (overturn).
+    """
+    if kind == 0:
+        xg = _xg(t, on, amp, omega, pkind)
+        return _margin(yx[2], yx[3], xg, float(side), b, h, mu, gamma, l, g)
+    if kind == 1:
+        return side * yx[0]
+    return thr - side * yx[0]
+
+
+@njit(cache=True)
+def _locate(kind, side, y0, k, t0, hstep, on, amp, omega, pkind, thr, b, h, mu, gamma,
+            l, g, ytmp):
+    """First root in (0, 1] of an event function on the dense output, given
+    value > 0 at x = 0 and <= 0 at x = 1.  Illinois regula falsi; returns the
+    right end of the final bracket (where the event condition holds)."""
+    xa = 0.0
+    _dense(y0, k, hstep, 0.0, ytmp)
+    fa = _event_value(kind, side, ytmp, t0, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g)
+    xb = 1.0
+    _dense(y0, k, hstep, 1.0, ytmp)
+    fb = _event_value(kind, side, ytmp, t0 + hstep, on, amp, omega, pkind, thr, b, h, mu,
+                      gamma, l, g)
+    last = 0
+    for _ in range(_ROOT_ITER):
+        if xb - xa <= _ROOT_XTOL:
+            break
+        if fa != fb:
+            xm = xb - fb * (xb - xa) / (fb - fa)
+        else:
+            xm = 0.5 * (xa + xb)
+        # keep the trial strictly inside; fall back to bisection on a bad secant
+        if not (xa < xm < xb):
+            xm = 0.5 * (xa + xb)
+        _dense(y0, k, hstep, xm, ytmp)
+        fm = _event_value(kind, side, ytmp, t0 + xm * hstep, on, amp, omega, pkind, thr, b,
+                          h, mu, gamma, l, g)
+        if fm <= 0.0:
+            xb = xm
+            fb = fm
+            if last == -1:
+                fa *= 0.5
+            last = -1
+        else:
+            xa = xm
+            fa = fm
+            if last == 1:
+                fb *= 0.5
+            last = 1
+    return xb
+
+
+@njit(cache=True)
+def _ellipk(m):
+    """Complete elliptic integral of the first kind ``K(m)``, ``0 <= m < 1``, by
+    the arithmetic-geometric mean: ``K = pi / (2 AGM(1, sqrt(1 - m)))``."""
+    a = 1.0
+    bb = math.sqrt(1.0 - m)
+    for _ in range(60):
+        if abs(a - bb) <= 1e-16 * a:
+            break
+        a, bb = 0.5 * (a + bb), math.sqrt(a * bb)
+    return math.pi / (2.0 * a)
+
+
+@njit(cache=True)
+def _pendulum_period(psi, psi_dot, l, g):
+    """Free-pendulum period [s] through ``(psi, psi_dot)`` (same cases as
+    ``analytic.events.free_pendulum_period``): libration ``4 sqrt(l/g) K(m)``,
+    ``m = sin^2(psi_max/2) = e/(2 g l)``; rotation ``4 l K(2gl/e) / sqrt(2e)``
+    (one full turn); ``inf`` on the separatrix."""
+    e = 0.5 * l * l * psi_dot * psi_dot + g * l * (1.0 - math.cos(psi))
+    sep = 2.0 * g * l
+    if e < sep:
+        return 4.0 * math.sqrt(l / g) * _ellipk(e / sep)
+    if e > sep:
+        return 4.0 * l * _ellipk(sep / e) / math.sqrt(2.0 * e)
+    return math.inf
+
+
+@njit(cache=True)
+def _grow(arr, n):
+    out = np.empty((2 * arr.shape[0], arr.shape[1]))
+    out[:n] = arr[:n]
+    return out
+
+
+@njit(cache=True)
+def _push(buf, n, row):
+    if n >= buf.shape[0]:
+        buf = _grow(buf, n)
+    for c in range(row.shape[0]):
+        buf[n, c] = row[c]
+    return buf, n + 1
+
+
+@njit(cache=True)
+def _push_event(ev, ne, kind, t, side, tdb, tda, psi, pdb, pda, record):
+    if not record:
+        return ev, ne + 1
+    if ne >= ev.shape[0]:
+        ev = _grow(ev, ne)
+    ev[ne, 0] = kind
+    ev[ne, 1] = t
+    ev[ne, 2] = side
+    ev[ne, 3] = tdb
+    ev[ne, 4] = tda
+    ev[ne, 5] = psi
+    ev[ne, 6] = pdb
+    ev[ne, 7] = pda
+    return ev, ne + 1
+
+
+@njit(cache=True)
+def _samples_until(buf, n, next_s, sample_dt, t_end, y0, k, t0, hstep, ytmp, row):
+    """Append grid samples in (t0, t_end] from the step's dense output."""
+    while next_s <= t_end + 1e-12 * max(1.0, t_end):
+        x = (next_s - t0) / hstep if hstep > 0.0 else 1.0
+        if x > 1.0:
+            x = 1.0
+        _dense(y0, k, hstep, x, ytmp)
+        row[0] = next_s
+        row[1] = ytmp[0]
+        row[2] = ytmp[1]
+        row[3] = ytmp[2]
+        row[4] = ytmp[3]
+        buf, n = _push(buf, n, row)
+        next_s = (round(next_s / sample_dt) + 1.0) * sample_dt
+    return buf, n, next_s
+
+
+@njit(cache=True)
+def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, atol,
+        rest_velocity, t_max, t_cap, max_steps, record, sample_dt):
+    """Integrate one run.  ``t_max <= 0`` means exact survival (no fixed horizon).
+
+    Returns ``(status, reason, t_verdict, n_impacts, samples, n_samples, events,
+    n_events, n_steps)``; ``samples`` rows are ``t, theta, theta_dot, psi, psi_dot``,
+    ``events`` rows ``kind, t, side, td-, td+, psi, pd-, pd+``.  With ``record``
+    False the two buffers stay 1-row placeholders (verdict only).
+    """
+    exact = t_max <= 0.0
+    t_stop = t_end_pulse + t_cap if exact else t_max
+    # The barrier argument only holds on the stable side (|theta| < alpha): beyond
+    # alpha an energy below the barrier means the frame can no longer come back.
+    barrier = _barrier(b, h, mu, gamma, g)
+    alpha = math.atan2(b, h)
+    quarter = 0.25 * t_end_pulse
+
+    y = np.zeros(4)
+    ynew = np.empty(4)
+    ytmp = np.empty(4)
+    ystage = np.empty(4)
+    k = np.empty((7, 4))
+    f = np.empty(4)
+    row = np.empty(5)
+    if record:
+        samples = np.empty((1024, 5))
+        events = np.empty((64, 8))
+    else:
+        samples = np.empty((1, 5))
+        events = np.empty((1, 8))
+    ns = 0
+    ne = 0
+    if record:
+        row[:] = 0.0
+        samples, ns = _push(samples, ns, row)
+    next_s = sample_dt
+
+    t = 0.0
+    phase = 0
+    n_imp = 0
+    hstep = min(1e-3, 0.01 * t_end_pulse)  # first trial; error control adapts it
+    need_k0 = True
+    check_margin = True
+    rest_deadline = math.inf
+    pulse_done = False
+    status = -1
+    reason = -1
+    t_verdict = math.nan
+    n_steps = 0
+
+    while True:
+        # -- pulse end: the excitation stops, energy can only decrease from now on
+        if not pulse_done and t >= t_end_pulse:
+            pulse_done = True
+            need_k0 = True
+            check_margin = True
+            if phase == 0:
+                en = _rest_energy(y[2], y[3], gamma, l, g)
+            else:
+                en = _energy(y[0], y[1], y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
+            if exact and en < barrier and abs(y[0]) < alpha:
+                status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
+                break
+            if exact and phase == 0:
+                if gamma == 0.0:
+                    status, reason, t_verdict = ST_SURVIVED, R_REST_NO_PENDULUM, t
+                    break
+                rest_deadline = t + _pendulum_period(y[2], y[3], l, g)
+        on = t < t_end_pulse
+        # -- REST: uplift at once when the margin is already <= 0
+        if phase == 0 and check_margin:
+            check_margin = False
+            xg = _xg(t, on, amp, omega, pkind)
+            mp = _margin(y[2], y[3], xg, 1.0, b, h, mu, gamma, l, g)
+            mm = _margin(y[2], y[3], xg, -1.0, b, h, mu, gamma, l, g)
+            if mp <= 0.0 or mm <= 0.0:
+                side = 1 if mp <= mm else -1
+                events, ne = _push_event(events, ne, EV_UPLIFT, t, side, 0.0, 0.0, y[2],
+                                         y[3], y[3], record)
+                phase = side
+                y[0] = 0.0
+                y[1] = 0.0
+                rest_deadline = math.inf
+                need_k0 = True
+        if exact and phase == 0 and pulse_done and t >= rest_deadline:
+            status, reason, t_verdict = ST_SURVIVED, R_PENDULUM_PERIOD, t
+            break
+        if t >= t_stop:
+            status = ST_UNDECIDED if exact else ST_SURVIVED
+            reason = R_T_CAP if exact else R_T_MAX
+            t_verdict = t
+            break
+        if n_steps >= max_steps:
+            status, reason, t_verdict = ST_UNDECIDED, R_STEP_BUDGET, t
+            break
+        # -- next breakpoint: quarter periods of the pulse (extrema of the sine's
+        #    margin, the pulse end), the stop time, the rest deadline
+        t_next = t_stop
+        if on:
+            for q in range(1, 5):
+                bp = q * quarter if q < 4 else t_end_pulse
+                if bp > t * (1.0 + 1e-14) + 1e-300:
+                    if bp < t_next:
+                        t_next = bp
+                    break
+        if phase == 0 and rest_deadline < t_next:
+            t_next = rest_deadline
+        if need_k0:
+            _deriv(phase, y, _xg(t, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
+            for c in range(4):
+                k[0, c] = f[c]
+            need_k0 = False
+        hit = False
+        if hstep >= t_next - t:
+            hstep = t_next - t
+            hit = True
+        if not (hstep > 1e-14 * max(1.0, t)):
+            if hit:  # already at the breakpoint up to round-off
+                t = t_next
+                continue
+            status, reason, t_verdict = ST_UNSTABLE, R_STEP_UNDERFLOW, t
+            events, ne = _push_event(events, ne, EV_UNSTABLE, t, phase, math.nan, math.nan,
+                                     y[2], math.nan, math.nan, record)
+            break
+        # -- one Dormand-Prince step
+        for s in range(1, 6):
+            for c in range(4):
+                acc = 0.0
+                for i in range(s):
+                    acc += _A[s, i] * k[i, c]
+                ystage[c] = y[c] + hstep * acc
+            _deriv(phase, ystage, _xg(t + _C[s] * hstep, on, amp, omega, pkind), f, b, h,
+                   mu, gamma, j, l, g)
+            for c in range(4):
+                k[s, c] = f[c]
+        for c in range(4):
+            acc = 0.0
+            for i in range(6):
+                acc += _B[i] * k[i, c]
+            ynew[c] = y[c] + hstep * acc
+        t1 = t_next if hit else t + hstep
+        _deriv(phase, ynew, _xg(t1, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
+        for c in range(4):
+            k[6, c] = f[c]
+        err = 0.0
+        finite = True
+        for c in range(4):
+            acc = 0.0
+            for i in range(7):
+                acc += _E[i] * k[i, c]
+            sc = atol + rtol * max(abs(y[c]), abs(ynew[c]))
+            e = hstep * acc / sc
+            err += e * e
+            if not math.isfinite(ynew[c]):
+                finite = False
+        err = math.sqrt(err / 4.0)
+        n_steps += 1
+        if not finite:
+            status, reason, t_verdict = ST_UNSTABLE, R_NONFINITE, t
+            events, ne = _push_event(events, ne, EV_UNSTABLE, t, phase, math.nan, math.nan,
+                                     y[2], math.nan, math.nan, record)
+            break
+        if err > 1.0:
+            hstep *= max(_MIN_FACTOR, _SAFETY * err ** -0.2)
+            continue
+        h_used = hstep
+        if err == 0.0:
+            factor = _MAX_FACTOR
+        else:
+            factor = min(_MAX_FACTOR, _SAFETY * err ** -0.2)
+        # -- events inside the accepted step: the earliest wins
+        ev_kind = -1
+        ev_side = 0
+        ev_x = 2.0
+        if phase == 0:
+            for side in (1, -1):
+                m1 = _margin(ynew[2], ynew[3], _xg(t1, on, amp, omega, pkind), float(side), b,
+                             h, mu, gamma, l, g)
+                if m1 <= 0.0:
+                    x = _locate(0, side, y, k, t, h_used, on, amp, omega, pkind, thr, b, h,
+                                mu, gamma, l, g, ytmp)
+                    if x < ev_x:
+                        ev_x, ev_kind, ev_side = x, EV_UPLIFT, side
+        else:
+            s = float(phase)
+            if s * y[0] > 0.0 and s * ynew[0] <= 0.0:
+                x = _locate(1, s, y, k, t, h_used, on, amp, omega, pkind, thr, b, h, mu,
+                            gamma, l, g, ytmp)
+                ev_x, ev_kind = x, EV_IMPACT
+            elif s * ynew[0] >= thr:
+                x = _locate(2, s, y, k, t, h_used, on, amp, omega, pkind, thr, b, h, mu,
+                            gamma, l, g, ytmp)
+                ev_x, ev_kind = x, EV_OVERTURN
+        if ev_kind < 0:
+            if record:
+                samples, ns, next_s = _samples_until(samples, ns, next_s, sample_dt, t1, y,
+                                                     k, t, h_used, ytmp, row)
+            t = t1
+            for c in range(4):
+                y[c] = ynew[c]
+                k[0, c] = k[6, c]
+            hstep = h_used * factor
+            continue
+        # -- an event at t_e: state from the dense output
+        t_e = t + ev_x * h_used
+        if ev_x >= 1.0:
+            t_e = t1
+        _dense(y, k, h_used, ev_x, ytmp)
+        if record:
+            samples, ns, next_s = _samples_until(samples, ns, next_s, sample_dt, t_e, y, k,
+                                                 t, h_used, ynew, row)
+        t = t_e
+        need_k0 = True
+        hstep = h_used * min(factor, 1.0)
+        if ev_kind == EV_UPLIFT:
+            phase = ev_side
+            y[0] = 0.0
+            y[1] = 0.0
+            y[2] = ytmp[2]
+            y[3] = ytmp[3]
+            rest_deadline = math.inf
+            events, ne = _push_event(events, ne, EV_UPLIFT, t, ev_side, 0.0, 0.0, y[2], y[3],
+                                     y[3], record)
+        elif ev_kind == EV_OVERTURN:
+            for c in range(4):
+                y[c] = ytmp[c]
+            events, ne = _push_event(events, ne, EV_OVERTURN, t, phase, y[1], y[1], y[2],
+                                     y[3], y[3], record)
+            status, reason, t_verdict = ST_OVERTURNED, R_OVERTURN, t
+            if record:
+                row[0] = t
+                for c in range(4):
+                    row[c + 1] = y[c]
+                samples, ns = _push(samples, ns, row)
+            break
+        else:  # impact at theta = 0 (Eq. 13-21), new side = -phase
+            new_side = -phase
+            tdm = ytmp[1]
+            pdm = ytmp[3]
+            tdp, pdp = _impact(tdm, ytmp[2], pdm, float(new_side), b, h, mu, gamma, j, l)
+            n_imp += 1
+            events, ne = _push_event(events, ne, EV_IMPACT, t, new_side, tdm, tdp, ytmp[2],
+                                     pdm, pdp, record)
+            y[0] = 0.0
+            y[2] = ytmp[2]
+            y[3] = pdp
+            if abs(tdp) < rest_velocity:
+                y[1] = 0.0
+                phase = 0
+                check_margin = True
+                events, ne = _push_event(events, ne, EV_REST, t, 0, tdm, 0.0, y[2], pdm, pdp,
+                                         record)
+                if pulse_done and exact:
+                    if _rest_energy(y[2], y[3], gamma, l, g) < barrier:
+                        status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
+                    elif gamma == 0.0:
+                        status, reason, t_verdict = ST_SURVIVED, R_REST_NO_PENDULUM, t
+                    else:
+                        rest_deadline = t + _pendulum_period(y[2], y[3], l, g)
+            else:
+                y[1] = tdp
+                phase = new_side
+                if pulse_done and exact and _energy(
+                        0.0, tdp, y[2], y[3], float(new_side), b, h, mu, gamma, j, l,
+                        g) < barrier:
+                    status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
+        if record:
+            row[0] = t
+            for c in range(4):
+                row[c + 1] = y[c]
+            samples, ns = _push(samples, ns, row)
+        if status >= 0:
+            break
+    return status, reason, t_verdict, n_imp, samples, ns, events, ne, n_steps
+
+
+@njit(cache=True)
+def verdict(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, atol,
+            rest_velocity, t_max, t_cap, max_steps):
+    """Verdict only: ``(status, reason, t_verdict, n_impacts)``."""
+    st, rs, tv, ni, _s, _ns, _e, _ne, _n = run(b, h, mu, gamma, j, l, g, amp, omega, pkind,
+                                              t_end_pulse, thr, rtol, atol, rest_velocity,
+                                              t_max, t_cap, max_steps, False, 1.0)
+    return st, rs, tv, ni

@@ -1,0 +1,202 @@
+"""The compiled fast path of the analytic model (backend ``"analytic-fast"``).
+
+Same model and same phase semantics as the accurate path (``analytic.simulate``,
+scipy DOP853 with events), integrated by a numba-compiled Dormand-Prince 5(4)
+with its 4th-order dense output and event location on the interpolant
+(:mod:`analytic._fast_kernels`).  The equations themselves are the functions of
+:mod:`analytic.equations` compiled as they are.
+
+Phase semantics
+---------------
+* REST (``theta = theta_dot = 0``; the pendulum obeys Eq. 1).  Uplift about side
+  ``s`` when ``uplift_margin`` (Eq. 9 as a moment) reaches 0 from above; at once
+  if it is already ``<= 0`` when a REST segment starts.
+* ROCK ``s`` (Eq. 8 for ``s=+1``, A.1 for ``s=-1``).  Impact when ``s*theta``
+  falls through 0 (never at the start of the phase): Eq. 19/21 give the new
+  velocities; ``|theta_dot+| < rest_velocity`` ends in REST (event 'rest'),
+  otherwise rocking continues about ``-s``.  Overturned when ``|theta|`` reaches
+  ``criterion.threshold(alpha)``; mode 'no-impact' or 'after-impact'.
+* The pulse end, and its quarter periods (the extrema of a sine's uplift margin,
+  so a short uplift window is not stepped over), are breakpoints.
+* Exact survival (``t_max=None``), after the pulse: energy below
+  ``overturn_energy_barrier`` at the pulse end or after any later impact/rest;
+  REST without pendulum; REST with pendulum and no uplift within one free
+  pendulum period (``4 sqrt(l/g) K(k^2)``).  Otherwise the run is 'undecided' at
+  pulse end + ``t_cap``.  With ``t_max`` given the run stops there and a run
+  that has not overturned is 'survived'.
+
+Sampled records are not compiled: :func:`simulate` hands them to the accurate
+path (``analytic.simulate``) and says so in the trajectory's diagnostics.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numba
+import numpy as np
+
+from . import _fast_kernels as _k
+from .excitation import Pulse, SampledRecord
+from .parameters import Scene
+from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
+
+__all__ = ["NAME", "version", "Settings", "simulate", "overturn_verdict", "verdict_for",
+           "warm_up", "STATUS_NAMES"]
+
+NAME = "analytic-fast"
+STATUS_NAMES = ("overturned", "survived", "unstable", "undecided")
+EVENT_NAMES = ("uplift", "impact", "rest", "overturn", "unstable")
+REASONS = ("overturned", "energy below the overturning barrier after the pulse",
+           "at rest after the pulse, no pendulum",
+           "no uplift within one free-pendulum period after the pulse",
+           "t_max reached", "t_cap after the pulse reached", "non-finite state",
+           "step size underflow", "step budget exhausted")
+_KINDS = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
+
+
+def version() -> str:
+    return f"analytic-fast (numba {numba.__version__}, Dormand-Prince 5(4))"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Numerical settings of the fast path."""
+
+    # The shared overturning rule; 'topple' (1.5 rad) unless told otherwise.
+    criterion: OverturnCriterion = field(default_factory=OverturnCriterion)
+    # None = exact survival rules (see module docstring); a number = fixed horizon [s].
+    t_max: float | None = None
+    # Undecided after pulse end + t_cap [s]: far longer than any decaying rocking.
+    t_cap: float = 120.0
+    # DP5 tolerances: verdicts match the rtol 1e-10 accurate path except within
+    # ~1e-6 relative of a threshold amplitude (see tests/test_fast.py).
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    # |theta_dot+| below this after an impact ends rocking (same as the accurate path).
+    rest_velocity: float = 1e-6
+    # Output grid [s] of simulate(); 1 ms resolves the fastest rocking half-cycle.
+    sample_dt: float = 1e-3
+    # Guard against Zeno chatter; no decided run measured needs 1e5 steps.
+    max_steps: int = 2_000_000
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.criterion, OverturnCriterion):
+            raise ValueError("criterion must be an OverturnCriterion")
+        if self.t_max is not None and not (math.isfinite(self.t_max) and self.t_max > 0):
+            raise ValueError(f"t_max must be None or a finite time > 0 s, got {self.t_max!r}")
+        for name, lo, hi in (("t_cap", 0.0, 1e5), ("rtol", 1e-14, 1e-2),
+                             ("atol", 1e-16, 1e-2), ("rest_velocity", 0.0, 1.0),
+                             ("sample_dt", 1e-6, 10.0)):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and lo < v <= hi):
+                raise ValueError(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
+        if not (isinstance(self.max_steps, int) and self.max_steps >= 100):
+            raise ValueError(f"max_steps must be an integer >= 100, got {self.max_steps!r}")
+
+    def describe(self) -> dict:
+        out = asdict(self)
+        out["criterion"] = self.criterion.describe()
+        return out
+
+
+def _kernel_args(scene: Scene, pulse: Pulse, settings: Settings) -> tuple:
+    b, h, mu, gamma, j, l, g = scene.model_args()
+    thr = settings.criterion.threshold(scene.alpha)
+    t_max = -1.0 if settings.t_max is None else float(settings.t_max)
+    return (b, h, mu, gamma, j, l, g, pulse.amplitude, pulse.omega, _KINDS[pulse.kind],
+            pulse.end_time, thr, settings.rtol, settings.atol, settings.rest_velocity,
+            t_max, settings.t_cap, settings.max_steps)
+
+
+def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: float,
+                     g: float, amplitude: float, omega: float, kind: int, threshold: float,
+                     rtol: float = 1e-8, atol: float = 1e-10, rest_velocity: float = 1e-6,
+                     t_max: float = -1.0, t_cap: float = 120.0,
+                     max_steps: int = 2_000_000) -> tuple[int, int, float, int]:
+    """Verdict of one pulse, compiled and allocation-free per step (for spectra).
+
+    No validation (callers validate once); ``kind`` 0 = sine (Eq. 22), 1 = cosine
+    (Eq. 23); ``t_max <= 0`` = exact survival.  Returns ``(status_code,
+    reason_code, time, n_impacts)``; ``STATUS_NAMES[status_code]``, ``REASONS``.
+    """
+    return _k.verdict(b, h, mu, gamma, j, l, g, amplitude, omega, kind,
+                      2.0 * math.pi / omega, threshold, rtol, atol, rest_velocity, t_max,
+                      t_cap, max_steps)
+
+
+def verdict_for(scene: Scene, pulse: Pulse, settings: Settings | None = None) -> Verdict:
+    """The :class:`Verdict` of ``scene`` under ``pulse`` without sampling the trajectory."""
+    settings = _check(scene, pulse, settings)
+    st, rs, tv, ni = _k.verdict(*_kernel_args(scene, pulse, settings))
+    return _make_verdict(st, rs, tv, ni)
+
+
+def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
+    status = STATUS_NAMES[st]
+    mode = None
+    if status == "overturned":
+        mode = "after-impact" if ni > 0 else "no-impact"
+    return Verdict(status, float(tv) if math.isfinite(tv) else None, mode, int(ni),
+                   REASONS[rs])
+
+
+def _check(scene, excitation, settings) -> Settings:
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
+    if not isinstance(excitation, (Pulse, SampledRecord)):
+        raise ValueError("excitation must be a Pulse or a SampledRecord, got "
+                         f"{type(excitation).__name__}")
+    settings = Settings() if settings is None else settings
+    if not isinstance(settings, Settings):
+        raise ValueError(f"settings must be analytic.fast.Settings, got {type(settings).__name__}")
+    return settings
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) every kernel; returns the seconds it took."""
+    t0 = time.perf_counter()
+    scene = Scene()
+    for sc in (scene, scene.without_pendulum()):
+        for kind in ("sine", "cosine"):
+            args = _kernel_args(sc, Pulse(10.0, 10.0, kind), Settings())
+            _k.verdict(*args)
+            _k.run(*args, True, 1e-2)
+    return time.perf_counter() - t0
+
+
+def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Trajectory:
+    """Run ``scene`` under ``excitation``; returns a :class:`Trajectory`.
+
+    Samples on the ``sample_dt`` grid plus one row at every event (the state
+    after it).  A :class:`SampledRecord` is handed to the accurate path.
+    """
+    settings = _check(scene, excitation, settings)
+    if isinstance(excitation, SampledRecord):
+        from . import simulate as accurate  # the fallback the docstring promises
+        acc_settings = accurate.Settings(criterion=settings.criterion, t_max=settings.t_max,
+                                         rest_velocity=settings.rest_velocity)
+        traj = accurate.simulate(scene, excitation, acc_settings)
+        traj.diagnostics["fast_path_fallback"] = "sampled record: accurate path used"
+        return traj
+    t0 = time.perf_counter()
+    (st, rs, tv, ni, samples, ns, events, ne, n_steps) = _k.run(
+        *_kernel_args(scene, excitation, settings), True, settings.sample_dt)
+    wall = time.perf_counter() - t0
+    data = samples[:ns]
+    evs = []
+    for row in events[:ne]:
+        kind = EVENT_NAMES[int(row[0])]
+        if kind in ("impact",):
+            evs.append(Event(kind, float(row[1]), int(row[2]), float(row[3]), float(row[4]),
+                             float(row[5]), float(row[6]), float(row[7])))
+        else:
+            evs.append(Event(kind, float(row[1]), int(row[2]), psi=float(row[5])))
+    settings_dict = settings.describe()
+    return Trajectory(backend=NAME, t=data[:, 0], theta=data[:, 1], theta_dot=data[:, 2],
+                      psi=data[:, 3], psi_dot=data[:, 4], events=tuple(evs),
+                      verdict=_make_verdict(st, rs, tv, ni), criterion=settings.criterion,
+                      t_max=settings.t_max, settings=settings_dict,
+                      diagnostics={"steps": int(n_steps), "version": version()},
+                      wall_time=wall, scene=scene, excitation=excitation)
