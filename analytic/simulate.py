@@ -130,8 +130,9 @@ class _Run:
         self.t_stop = st.t_max if st.t_max is not None else self.t_off + st.t_cap
         self.breaks = sorted({x for x in (self.t_on, self.t_off) if 0.0 < x < self.t_stop})
         times = getattr(excitation, "times", None)
-        self.forcing_step = (float(np.min(np.diff(times))) if times is not None
-                             else excitation.end_time)
+        # A record's xg_ddot has kinks at its samples, where the (then piecewise
+        # linear) margin has its minima: REST segments stop at every sample.
+        self.kinks = np.asarray(times, dtype=float) if times is not None else None
         self.t, self.phase = 0.0, 0
         self.theta = self.theta_dot = self.psi = self.psi_dot = 0.0
         self.events: list[Event] = []
@@ -239,8 +240,15 @@ class _Run:
                 return eq.uplift_margin(y[0], y[1], xg(t), side, b, h, mu, gamma, l, g)
             ev.terminal, ev.direction = True, -1
             return ev
-        forcing = (self.forcing_step if not self.after_pulse(self.t)
-                   else 2.0 * math.pi * math.sqrt(l / g))
+        if self.after_pulse(self.t):
+            forcing = 2.0 * math.pi * math.sqrt(l / g)
+        elif self.kinks is not None:
+            k = int(np.searchsorted(self.kinks, self.t, side="right"))
+            if k < len(self.kinks):
+                t_b = min(t_b, float(self.kinks[k]))
+            forcing = math.inf  # margin linear in xg_ddot between kinks: no dip missed
+        else:
+            forcing = self.excitation.end_time
         sol = self.solve(fun, t_b, [self.psi, self.psi_dot],
                          [margin_event(1), margin_event(-1)],
                          max_step=self.st.rest_step_fraction * forcing)
