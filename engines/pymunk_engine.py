@@ -1,0 +1,370 @@
+"""Pymunk (Chipmunk2D) backend: the trilith as three rigid polygons on a ground box.
+
+The plane scene is built from the :class:`~analytic.parameters.Scene` only: two
+``b x h`` columns at clear gap ``d`` (left column's bottom-left corner at ``x = 0``),
+a ``lintel_length x lintel_thickness`` lintel resting on both column tops, and a
+point-like pendulum bob hinged on the lintel underside with a
+:class:`pymunk.PivotJoint`; the bob collides with nothing, like the analytic
+pendulum (Eq. 1, 8).  ``gamma = 0`` builds no pendulum body.  ``mu = 0`` builds no
+lintel body: the two columns rock independently, which is the ``mu = 0`` rocking
+frame (Eq. 8 and 20 with ``mu = 0`` are a single column's equations because the
+columns are equal and start in phase).
+
+Base motion (``Settings.base_motion``): ``"gravity"`` imposes ``-xg_ddot(t)`` as a
+horizontal gravity component in the base frame (d'Alembert, exact for a rigid
+translating base); ``"ground"`` moves a kinematic ground box along
+``excitation.displacement``.  The run is stopped and judged by
+:class:`engines._common.RunMonitor` (shared with every engine).
+
+Signs: Pymunk's y axis points up and angles are counter-clockwise, so a column's
+rotation angle is ``theta`` directly (``theta > 0``: leaning left on the left
+corners); ``psi`` is the bob's angle about the hinge from the downward vertical.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+
+import pymunk
+
+from analytic import equations as eq
+from analytic.trajectory import OverturnCriterion, Trajectory
+from engines._common import MonitorSettings, RunMonitor
+
+__all__ = ["NAME", "Settings", "simulate", "version", "required_friction", "BASE_MOTIONS"]
+
+NAME = "pymunk"
+BASE_MOTIONS = ("gravity", "ground")
+
+
+def version() -> str:
+    """Pymunk and Chipmunk versions, e.g. ``'pymunk 7.3.1 (chipmunk 2.0.1)'``."""
+    chip = pymunk.chipmunk_version.split("-")[0]
+    return f"pymunk {pymunk.version} (chipmunk {chip})"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Numerical settings of the Pymunk backend; defaults are the calibrated ones.
+
+    Parameters
+    ----------
+    criterion : OverturnCriterion
+        Shared overturning criterion (default: topple at 1.5 rad).
+    t_max : float or None
+        Run length [s]; None lets the monitor stop the run (rest, energy, cap).
+    dt : float
+        Time step [s].  1e-4 s: impacts of a rocking block resolve in a few steps
+        and the restitution error falls below 0.5 % (see ``tests/test_pymunk_engine.py``).
+    theta0, psi0 : float
+        Initial tilt [rad] (released at rest; > 0 on the left corners) and
+        pendulum angle [rad].
+    base_motion : {'gravity', 'ground'}
+        How the base excitation is imposed (see module docstring).
+    sample_every : int
+        Steps between two samples read into the monitor.  10 (1 ms at the default
+        ``dt``): impacts are measured by propagating away from them, so 1 ms is
+        ample, and reading state is the costliest part of a step in Python.
+    monitor : MonitorSettings
+        Shared stop/verdict thresholds.
+    friction : float
+        Coulomb coefficient at every contact.  Pymunk multiplies the two shapes'
+        values, so each shape gets ``sqrt(friction)``.  3.0: above the
+        no-sliding bound :func:`required_friction` for every pulse of the paper's
+        Fig. 5 (peak 25 m/s^2 needs 2.55); a higher value costs nothing.
+    iterations : int
+        Solver iterations per step.  30: the pendulum joint and the stacked
+        contacts (ground-column-lintel) need more than Chipmunk's default 10 for
+        the impulse to settle within one step at the impact.
+    slop_fraction : float
+        ``space.collision_slop`` as a fraction of the column width ``b``.  1e-5:
+        Pymunk's default slop (0.1 m) is a sixth of a column width and lets the
+        corners sink; 1e-5 b keeps penetration near micrometres.
+    collision_bias : float or None
+        Fraction of overlap left uncorrected after one second; None keeps
+        Pymunk's default ``0.9**60`` (position correction is then gentle enough
+        not to inject energy at impacts).
+    pendulum_radius_fraction : float
+        The bob's radius of gyration as a fraction of ``l`` (own inertia
+        ``m4 (f l)^2``).  1e-2: a point mass within 1e-4 of the pendulum's
+        inertia, yet not so small that the joint rows become ill-conditioned.
+    blowup_distance : float
+        A body farther than this many trilith sizes from its start marks the
+        run unstable.  10: as the engine contract states.
+    blowup_speed : float
+        Speed bound [m/s] as a multiple of ``sqrt(g * size) + peak ground speed``.
+        50: a toppling column's tip never exceeds ``~2 sqrt(g size)``.
+    """
+
+    criterion: OverturnCriterion = OverturnCriterion()
+    t_max: float | None = None
+    dt: float = 1e-4
+    theta0: float = 0.0
+    psi0: float = 0.0
+    base_motion: str = "gravity"
+    sample_every: int = 10
+    monitor: MonitorSettings = field(default_factory=MonitorSettings)
+    friction: float = 3.0
+    iterations: int = 30
+    slop_fraction: float = 1e-4
+    collision_bias: float | None = None
+    pendulum_radius_fraction: float = 1e-2
+    blowup_distance: float = 10.0
+    blowup_speed: float = 50.0
+
+    def describe(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["criterion"] = self.criterion.describe()
+        return out
+
+
+def required_friction(scene, excitation) -> float:
+    """Conservative Coulomb coefficient needed for rocking without sliding.
+
+    The largest of three ratios of horizontal to vertical ground reaction:
+
+    * at rest up to uplift the trilith moves with the ground: ``|a_up| / g``
+      (Eq. 9, pendulum hanging still) and, for a sampled or pulse excitation,
+      ``peak |xg_ddot| / g`` (the rigid-body bound if the trilith were carried
+      along for the whole pulse; it over-estimates the rocking phase, where the
+      columns' rotation absorbs most of the horizontal acceleration);
+    * at an impact, the plastic impulse at the new corners of every body in the
+      rocking mechanism has the ratio ``lam (1 - e) / (1 + e)`` with ``e`` the
+      velocity ratio of Eq. 20 (Eq. 19 at ``psi = 0`` with the pendulum): the
+      columns' centres and the lintel move on circles of the same shape.
+    """
+    b, h, mu, gamma, j, l, g = scene.model_args()
+    a_up = abs(eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g))
+    e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
+    impact = (h / b) * (1.0 - e) / (1.0 + e)
+    peak = 0.0
+    if excitation.end_time > 0.0:
+        import numpy as np
+
+        t = np.linspace(0.0, excitation.end_time, 2001)
+        peak = float(np.max(np.abs(excitation.acceleration_array(t))))
+    return max(a_up / g, peak / g, impact)
+
+
+def _validate(scene, excitation, s: Settings) -> None:
+    def finite(name, value, lo, hi, lo_open=True):
+        ok = isinstance(value, (int, float)) and math.isfinite(value) and (
+            value > lo if lo_open else value >= lo) and value <= hi
+        if not ok:
+            left = "(" if lo_open else "["
+            raise ValueError(f"pymunk settings: {name} must be finite in {left}{lo:g}, {hi:g}], "
+                             f"got {value!r}")
+
+    finite("dt", s.dt, 0.0, 1e-2)
+    if s.base_motion not in BASE_MOTIONS:
+        raise ValueError(f"pymunk settings: base_motion must be one of {BASE_MOTIONS}, "
+                         f"got {s.base_motion!r}")
+    if not (isinstance(s.sample_every, int) and 1 <= s.sample_every <= 10_000):
+        raise ValueError(f"pymunk settings: sample_every must be an integer in [1, 10000], "
+                         f"got {s.sample_every!r}")
+    if not (isinstance(s.iterations, int) and 1 <= s.iterations <= 10_000):
+        raise ValueError(f"pymunk settings: iterations must be an integer in [1, 10000], "
+                         f"got {s.iterations!r}")
+    finite("theta0", s.theta0, -scene.alpha, scene.alpha, lo_open=False)
+    if abs(s.theta0) >= scene.alpha:
+        raise ValueError(f"pymunk settings: theta0 must be in (-alpha, alpha) = "
+                         f"(-{scene.alpha:.4g}, {scene.alpha:.4g}) rad, got {s.theta0!r}")
+    finite("psi0", s.psi0, -math.pi, math.pi, lo_open=False)
+    finite("slop_fraction", s.slop_fraction, 0.0, 0.1)
+    if s.collision_bias is not None:
+        finite("collision_bias", s.collision_bias, 0.0, 1.0)
+    finite("pendulum_radius_fraction", s.pendulum_radius_fraction, 0.0, 1.0)
+    finite("blowup_distance", s.blowup_distance, 1.0, 1e6)
+    finite("blowup_speed", s.blowup_speed, 1.0, 1e6)
+    if s.t_max is not None:
+        finite("t_max", s.t_max, 0.0, 1e5)
+    finite("friction", s.friction, 0.0, 1e3)
+    need = required_friction(scene, excitation)
+    if s.friction < need:
+        raise ValueError(f"pymunk settings: friction must be >= {need:.3g} for rocking without "
+                         f"sliding in this scene and excitation (see required_friction), "
+                         f"got {s.friction!r}")
+
+
+# ----------------------------------------------------------------------------- world
+def _rotate(v: tuple[float, float], angle: float) -> tuple[float, float]:
+    c, s = math.cos(angle), math.sin(angle)
+    return (c * v[0] - s * v[1], s * v[0] + c * v[1])
+
+
+def _column_com(x_left: float, theta: float, b: float, h: float) -> tuple[float, float]:
+    """Centre of a column tilted by ``theta`` about the base corner of its side."""
+    if theta >= 0.0:  # left corner at (x_left, 0) stays put
+        r = _rotate((0.5 * b, 0.5 * h), theta)
+        return (x_left + r[0], r[1])
+    r = _rotate((-0.5 * b, 0.5 * h), theta)
+    return (x_left + b + r[0], r[1])
+
+
+def _lintel_shift(theta: float, b: float, h: float) -> tuple[float, float]:
+    """Translation of the lintel: that of the column-top corner it rests on
+    (top-right corners for ``theta > 0``, top-left ones for ``theta < 0``)."""
+    corner = (b, h) if theta >= 0.0 else (-b, h)
+    r = _rotate(corner, theta)
+    return (r[0] - corner[0], r[1] - corner[1])
+
+
+class _World:
+    """A fresh Pymunk space holding one trilith; nothing is shared between runs."""
+
+    def __init__(self, scene, s: Settings) -> None:
+        b, h, d = scene.b, scene.h, scene.d
+        t_l = scene.lintel_thickness
+        self.size = max(scene.lintel_length, h + t_l)
+        space = pymunk.Space()
+        space.iterations = s.iterations
+        space.collision_slop = s.slop_fraction * b
+        if s.collision_bias is not None:
+            space.collision_bias = s.collision_bias
+        space.gravity = (0.0, -scene.g)
+        shape_friction = math.sqrt(s.friction)  # Pymunk multiplies the pair's values
+
+        def add_box(body, w, hh):
+            shape = pymunk.Poly.create_box(body, (w, hh), radius=0.0)
+            shape.friction = shape_friction
+            shape.elasticity = 0.0
+            space.add(shape)
+            return shape
+
+        kind = pymunk.Body.KINEMATIC if s.base_motion == "ground" else pymunk.Body.STATIC
+        self.ground = pymunk.Body(body_type=kind)
+        # A box, not a segment: its top face is one flat edge under both columns.
+        ground_w = scene.lintel_length + 2.0 * self.size
+        ground_t = max(b, 0.1 * self.size)
+        self.ground.position = (0.5 * scene.lintel_length, -0.5 * ground_t)
+        space.add(self.ground)
+        add_box(self.ground, ground_w, ground_t)
+
+        th = s.theta0
+        self.columns = []
+        self.x_left = (0.0, b + d)
+        for x_left in self.x_left:
+            body = pymunk.Body(scene.m1, scene.inertia_J_G)
+            body.position = _column_com(x_left, th, b, h)
+            body.angle = th
+            space.add(body)
+            add_box(body, b, h)
+            self.columns.append(body)
+
+        shift = _lintel_shift(th, b, h)
+        self.lintel = None
+        self.bob = None
+        if scene.mu > 0.0:
+            length = scene.lintel_length
+            lintel = pymunk.Body(scene.m3, scene.m3 * (length ** 2 + t_l ** 2) / 12.0)
+            lintel.position = (0.5 * length + shift[0], h + 0.5 * t_l + shift[1])
+            space.add(lintel)
+            add_box(lintel, length, t_l)
+            self.lintel = lintel
+        if scene.has_pendulum:
+            l = scene.pendulum_length
+            hinge = (0.5 * scene.lintel_length + scene.hinge_x + shift[0], h + shift[1])
+            radius = s.pendulum_radius_fraction * l
+            bob = pymunk.Body(scene.m4, scene.m4 * radius ** 2)
+            bob.position = (hinge[0] + l * math.sin(s.psi0), hinge[1] - l * math.cos(s.psi0))
+            space.add(bob)
+            dot = pymunk.Circle(bob, radius)
+            dot.filter = pymunk.ShapeFilter(categories=0, mask=0)  # collides with nothing
+            space.add(dot)
+            anchor_bob = (hinge[0] - bob.position.x, hinge[1] - bob.position.y)
+            if self.lintel is not None:
+                anchor_lintel = (scene.hinge_x, -0.5 * t_l)
+                joint = pymunk.PivotJoint(self.lintel, bob, anchor_lintel, anchor_bob)
+            else:  # mu = 0 with a pendulum: hinge on the left column's top-right corner
+                joint = pymunk.PivotJoint(self.columns[0], bob, (0.5 * b, 0.5 * h), anchor_bob)
+            joint.collide_bodies = False
+            space.add(joint)
+            self.bob = bob
+        self.space = space
+        self.bodies = [c for c in self.columns] + [x for x in (self.lintel, self.bob) if x]
+        self.start = [(bd.position.x, bd.position.y) for bd in self.bodies]
+
+
+def _peak_ground_speed(excitation) -> float:
+    if excitation.end_time <= 0.0:
+        return 0.0
+    ts = [excitation.end_time * k / 400.0 for k in range(401)]
+    return max(abs(excitation.velocity(t)) for t in ts)
+
+
+# -------------------------------------------------------------------------- simulate
+def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
+    """Run ``scene`` under ``excitation`` in Pymunk; returns a :class:`Trajectory`.
+
+    Raises ``ValueError`` for bad settings before any stepping (see
+    :class:`Settings` and :func:`required_friction`).  A blown-up run (non-finite
+    state, a body flown away or too fast) gets the verdict ``'unstable'``.
+    """
+    s = settings if settings is not None else Settings()
+    if not isinstance(s, Settings):
+        raise ValueError(f"pymunk settings must be engines.pymunk_engine.Settings, "
+                         f"got {type(s).__name__}")
+    if scene.mu == 0.0 and scene.has_pendulum and scene.hinge_x != 0.0:
+        raise ValueError("hinge_x must be 0 when mu = 0 (no lintel body to carry the hinge)")
+    _validate(scene, excitation, s)
+    wall0 = time.perf_counter()
+    world = _World(scene, s)
+    monitor = RunMonitor(scene, excitation, s.criterion, s.t_max, s.monitor)
+    space, dt, g = world.space, s.dt, scene.g
+    cols, lintel, bob = world.columns, world.lintel, world.bob
+    b, h = scene.b, scene.h
+    gravity_mode = s.base_motion == "gravity"
+    max_dist = s.blowup_distance * world.size
+    max_speed = s.blowup_speed * (math.sqrt(g * world.size) + _peak_ground_speed(excitation))
+    corner_x0 = [(x, x + b) for x in world.x_left]
+    lintel_rot = slide = penetration = 0.0
+    step = 0
+    done = False
+    while not done:
+        t = step * dt
+        if step % s.sample_every == 0:
+            x_ground = 0.0 if gravity_mode else excitation.displacement(t)
+            psi = s.psi0 + bob.angle if bob is not None else 0.0
+            psi_dot = bob.angular_velocity if bob is not None else 0.0
+            theta_dot = 0.5 * (cols[0].angular_velocity + cols[1].angular_velocity)
+            done = monitor.record(t, cols[0].angle, cols[1].angle, theta_dot, psi, psi_dot)
+            for k, col in enumerate(cols):
+                left = col.local_to_world((-0.5 * b, -0.5 * h))
+                right = col.local_to_world((0.5 * b, -0.5 * h))
+                # The pivot is the corner on the side the column leans to.
+                pivot, x0 = (left, corner_x0[k][0]) if col.angle >= 0.0 else (right, corner_x0[k][1])
+                slide = max(slide, abs(pivot.x - x0 - x_ground))
+                penetration = max(penetration, -min(left.y, right.y))
+            if lintel is not None:
+                lintel_rot = max(lintel_rot, abs(lintel.angle))
+            if not done:
+                for body, (x0, y0) in zip(world.bodies, world.start):
+                    pos, vel = body.position, body.velocity
+                    if math.hypot(pos.x - x0 - x_ground, pos.y - y0) > max_dist:
+                        monitor.mark_unstable(t, "a body flew away (> "
+                                              f"{s.blowup_distance:g} trilith sizes)")
+                        done = True
+                        break
+                    if math.hypot(vel.x, vel.y) > max_speed:
+                        monitor.mark_unstable(t, f"a body exceeded {max_speed:.3g} m/s")
+                        done = True
+                        break
+            if done:
+                break
+        if gravity_mode:
+            space.gravity = (-excitation.acceleration(t + 0.5 * dt), -g)
+        else:  # mean ground velocity over the step: the position follows exactly
+            vx = (excitation.displacement(t + dt) - excitation.displacement(t)) / dt
+            world.ground.velocity = (vx, 0.0)
+        space.step(dt)
+        step += 1
+    diagnostics = {"lintel_rotation_max": lintel_rot, "pivot_sliding_max": slide,
+                   "penetration_max": penetration, "steps": step,
+                   "required_friction": required_friction(scene, excitation)}
+    wall = time.perf_counter() - wall0
+    diagnostics["wall_time"] = wall
+    settings_dict = s.describe()
+    settings_dict["engine_version"] = version()
+    return monitor.finish(NAME, settings_dict, diagnostics, wall)
