@@ -1,6 +1,6 @@
 """Helpers of the event-driven simulator (:mod:`analytic.simulate`).
 
-Pure functions only: the free-pendulum period used by the exact survival rule,
+Its ``Settings`` and pure helpers: the free-pendulum period used by the exact survival rule,
 the piecewise-smooth ground acceleration of one integration segment, and the
 collection of output samples.  Kept apart so ``simulate.py`` holds only the
 phase logic.
@@ -9,13 +9,74 @@ from __future__ import annotations
 
 import bisect
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 from scipy.special import ellipk
 
-__all__ = ["free_pendulum_period", "excitation_window", "segment_acceleration",
+from .trajectory import OverturnCriterion
+
+__all__ = ["Settings", "METHODS", "free_pendulum_period", "excitation_window", "segment_acceleration",
            "SampleBuffer"]
+
+
+METHODS = ("DOP853", "RK45", "Radau", "LSODA")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Settings of the accurate simulator :func:`analytic.simulate.simulate`.
+
+    Every field is validated here (``ValueError`` naming the field and its range).
+    The initial state defaults to the trilith at rest with the pendulum hanging;
+    ``theta0 != 0`` (or ``theta0 = 0``, ``theta_dot0 != 0``) starts rocking about
+    the side of its sign.
+    """
+
+    criterion: OverturnCriterion = OverturnCriterion()  # topple at 1.5 rad: the columns have fallen
+    t_max: float | None = None  # None: run until the verdict is decided exactly
+    t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> any rocking decay)
+    rtol: float = 1e-10  # energy drift between impacts ~1e-10, far below any engine's error
+    atol: float = 1e-12  # rad, rad/s: below rest_velocity by six decades
+    method: str = "DOP853"  # 8th order with 7th-order dense output for the event roots
+    sample_dt: float | None = 1e-3  # s; 1 ms resolves the fastest rocking (periods ~0.1 s)
+    rest_velocity: float = 1e-6  # rad/s: an impact slower than this ends in rest (Zeno)
+    rest_step_fraction: float = 1e-3  # max REST step / forcing period: a margin dip is not skipped
+    max_events: int = 100_000  # guard against a non-progressing event loop
+    theta0: float = 0.0  # rad: initial rocking angle (free-rocking tests); 0 = at rest
+    theta_dot0: float = 0.0  # rad/s: initial rocking speed
+    psi0: float = 0.0  # rad: initial pendulum angle
+    psi_dot0: float = 0.0  # rad/s: initial pendulum speed
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.criterion, OverturnCriterion):
+            raise ValueError(f"criterion must be an OverturnCriterion, got {self.criterion!r}")
+        if self.t_max is not None:
+            _check("t_max", self.t_max, 0.0, 1e5)
+        _check("t_cap", self.t_cap, 0.0, 1e5)
+        _check("rtol", self.rtol, 1e-14, 1e-2, lo_open=False)
+        _check("atol", self.atol, 0.0, 1.0)
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.sample_dt is not None:
+            _check("sample_dt", self.sample_dt, 0.0, 10.0)
+        _check("rest_velocity", self.rest_velocity, 0.0, 1.0)
+        _check("rest_step_fraction", self.rest_step_fraction, 0.0, 0.1)
+        if not isinstance(self.max_events, int) or self.max_events < 1:
+            raise ValueError(f"max_events must be an integer >= 1, got {self.max_events!r}")
+        for name in ("theta0", "theta_dot0", "psi0", "psi_dot0"):
+            _check(name, getattr(self, name), -1e3, 1e3, lo_open=False)
+
+
+def _check(name: str, value, lo: float, hi: float, lo_open: bool = True) -> None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    ok = math.isfinite(v) and (v > lo if lo_open else v >= lo) and v <= hi
+    if not ok:
+        raise ValueError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {value!r}")
 
 
 def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:

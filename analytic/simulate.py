@@ -44,21 +44,20 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
 
 from . import equations as eq
-from .events import SampleBuffer, excitation_window, free_pendulum_period, segment_acceleration
+from .events import (Settings, SampleBuffer, excitation_window, free_pendulum_period,
+                     segment_acceleration)
 from .parameters import Scene
-from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from .trajectory import Event, Trajectory, Verdict
 
 __all__ = ["NAME", "Settings", "simulate", "version"]
 
 NAME = "analytic"
-METHODS = ("DOP853", "RK45", "Radau", "LSODA")
 REASON_BARRIER = "energy below the overturning barrier after the pulse"
 REASON_REST = "at rest after the pulse without pendulum"
 REASON_PERIOD = "at rest after the pulse: no uplift during one free-pendulum period"
@@ -69,49 +68,6 @@ REASON_CAP = "t_cap reached after the pulse before the outcome was certain"
 def version() -> str:
     """Backend version string carried into reports."""
     return f"analytic-scipy-{scipy.__version__}"
-
-
-@dataclass(frozen=True)
-class Settings:
-    """Numerical settings of the accurate simulator."""
-
-    criterion: OverturnCriterion = OverturnCriterion()  # topple at 1.5 rad: the columns have fallen
-    t_max: float | None = None  # None: run until the verdict is decided exactly
-    t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> any rocking decay)
-    rtol: float = 1e-10  # energy drift between impacts ~1e-10, far below any engine's error
-    atol: float = 1e-12  # rad, rad/s: below rest_velocity by six decades
-    method: str = "DOP853"  # 8th order with 7th-order dense output for the event roots
-    sample_dt: float | None = 1e-3  # s; 1 ms resolves the fastest rocking (periods ~0.1 s)
-    rest_velocity: float = 1e-6  # rad/s: an impact slower than this ends in rest (Zeno)
-    rest_step_fraction: float = 1e-3  # max REST step / forcing period: a margin dip is not skipped
-    max_events: int = 100_000  # guard against a non-progressing event loop
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.criterion, OverturnCriterion):
-            raise ValueError(f"criterion must be an OverturnCriterion, got {self.criterion!r}")
-        if self.t_max is not None:
-            _check("t_max", self.t_max, 0.0, 1e5)
-        _check("t_cap", self.t_cap, 0.0, 1e5)
-        _check("rtol", self.rtol, 1e-14, 1e-2, lo_open=False)
-        _check("atol", self.atol, 0.0, 1.0)
-        if self.method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
-        if self.sample_dt is not None:
-            _check("sample_dt", self.sample_dt, 0.0, 10.0)
-        _check("rest_velocity", self.rest_velocity, 0.0, 1.0)
-        _check("rest_step_fraction", self.rest_step_fraction, 0.0, 0.1)
-        if not isinstance(self.max_events, int) or self.max_events < 1:
-            raise ValueError(f"max_events must be an integer >= 1, got {self.max_events!r}")
-
-
-def _check(name: str, value, lo: float, hi: float, lo_open: bool = True) -> None:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    ok = math.isfinite(v) and (v > lo if lo_open else v >= lo) and v <= hi
-    if not ok:
-        raise ValueError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {value!r}")
 
 
 class _Run:
@@ -133,8 +89,11 @@ class _Run:
         # A record's xg_ddot has kinks at its samples, where the (then piecewise
         # linear) margin has its minima: REST segments stop at every sample.
         self.kinks = np.asarray(times, dtype=float) if times is not None else None
-        self.t, self.phase = 0.0, 0
-        self.theta = self.theta_dot = self.psi = self.psi_dot = 0.0
+        self.t = 0.0
+        self.theta, self.theta_dot = st.theta0, st.theta_dot0
+        self.psi, self.psi_dot = st.psi0, st.psi_dot0
+        lead = self.theta if self.theta != 0.0 else self.theta_dot
+        self.phase = 0 if lead == 0.0 else (1 if lead > 0.0 else -1)
         self.events: list[Event] = []
         self.samples = SampleBuffer(st.sample_dt)
         self.n_impacts = 0
@@ -423,6 +382,12 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     st = Settings() if settings is None else settings
     if not isinstance(st, Settings):
         raise ValueError(f"settings must be analytic.simulate.Settings, got {type(st).__name__}")
+    if abs(st.theta0) >= st.criterion.threshold(scene.alpha):
+        raise ValueError(f"theta0 must be in (-{st.criterion.threshold(scene.alpha):.6g}, "
+                         f"{st.criterion.threshold(scene.alpha):.6g}) rad (below the overturn "
+                         f"threshold), got {st.theta0!r}")
+    if not scene.has_pendulum and (st.psi0 != 0.0 or st.psi_dot0 != 0.0):
+        raise ValueError("psi0 and psi_dot0 must be 0 without a pendulum (gamma = 0)")
     start = time.perf_counter()
     run = _Run(scene, excitation, st)
     run.run()
