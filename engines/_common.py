@@ -176,6 +176,9 @@ class RunMonitor:
         self.verdict = Verdict("unstable", t, None, len(self._impacts), reason)
 
     def _survived_by_energy(self, theta, theta_dot, psi, psi_dot) -> bool:
+        # Only inside the potential well: past alpha the trilith falls with any energy.
+        if abs(theta) >= self.scene.alpha:
+            return False
         b, h, mu, gamma, j, l, g = self.args
         side = 1 if (theta > 0 or (theta == 0 and theta_dot > 0)) else -1
         energy = eq.energy(theta, theta_dot, psi, psi_dot, side, b, h, mu, gamma, j, l, g)
