@@ -8,7 +8,8 @@ point-like pendulum bob hinged on the lintel underside with a
 pendulum (Eq. 1, 8).  ``gamma = 0`` builds no pendulum body.  ``mu = 0`` builds no
 lintel body: the two columns rock independently, which is the ``mu = 0`` rocking
 frame (Eq. 8 and 20 with ``mu = 0`` are a single column's equations because the
-columns are equal and start in phase).
+columns are equal and start in phase); ``mu = 0`` with a pendulum is refused
+(a massless lintel cannot carry the hinge in an engine).
 
 Base motion (``Settings.base_motion``): ``"gravity"`` imposes ``-xg_ddot(t)`` as a
 horizontal gravity component in the base frame (d'Alembert, exact for a rigid
@@ -27,9 +28,11 @@ import math
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
 import pymunk
 
 from analytic import equations as eq
+from analytic.excitation import Pulse, SampledRecord
 from analytic.trajectory import OverturnCriterion, Trajectory
 from engines._common import MonitorSettings, RunMonitor
 
@@ -139,12 +142,15 @@ def required_friction(scene, excitation) -> float:
     a_up = abs(eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g))
     e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
     impact = (h / b) * (1.0 - e) / (1.0 + e)
-    peak = 0.0
-    if excitation.end_time > 0.0:
-        import numpy as np
-
-        t = np.linspace(0.0, excitation.end_time, 2001)
+    if isinstance(excitation, Pulse):
+        peak = abs(excitation.amplitude)
+    elif isinstance(excitation, SampledRecord):  # linear interpolation peaks at a sample
+        peak = max(abs(a) for a in excitation.accelerations)
+    elif excitation.end_time > 0.0:
+        t = np.linspace(0.0, excitation.end_time, 20001)
         peak = float(np.max(np.abs(excitation.acceleration_array(t))))
+    else:
+        peak = 0.0
     return max(a_up / g, peak / g, impact)
 
 
@@ -157,7 +163,7 @@ def _validate(scene, excitation, s: Settings) -> None:
             raise ValueError(f"pymunk settings: {name} must be finite in {left}{lo:g}, {hi:g}], "
                              f"got {value!r}")
 
-    finite("dt", s.dt, 0.0, 1e-2)
+    finite("dt", s.dt, 0.0, 0.1)
     if s.base_motion not in BASE_MOTIONS:
         raise ValueError(f"pymunk settings: base_motion must be one of {BASE_MOTIONS}, "
                          f"got {s.base_motion!r}")
@@ -274,11 +280,8 @@ class _World:
             dot.filter = pymunk.ShapeFilter(categories=0, mask=0)  # collides with nothing
             space.add(dot)
             anchor_bob = (hinge[0] - bob.position.x, hinge[1] - bob.position.y)
-            if self.lintel is not None:
-                anchor_lintel = (scene.hinge_x, -0.5 * t_l)
-                joint = pymunk.PivotJoint(self.lintel, bob, anchor_lintel, anchor_bob)
-            else:  # mu = 0 with a pendulum: hinge on the left column's top-right corner
-                joint = pymunk.PivotJoint(self.columns[0], bob, (0.5 * b, 0.5 * h), anchor_bob)
+            # The bob's body is the rod: its rotation is the pendulum's (psi - psi0).
+            joint = pymunk.PivotJoint(self.lintel, bob, (scene.hinge_x, -0.5 * t_l), anchor_bob)
             joint.collide_bodies = False
             space.add(joint)
             self.bob = bob
@@ -306,8 +309,9 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     if not isinstance(s, Settings):
         raise ValueError(f"pymunk settings must be engines.pymunk_engine.Settings, "
                          f"got {type(s).__name__}")
-    if scene.mu == 0.0 and scene.has_pendulum and scene.hinge_x != 0.0:
-        raise ValueError("hinge_x must be 0 when mu = 0 (no lintel body to carry the hinge)")
+    if scene.mu == 0.0 and scene.has_pendulum:
+        raise ValueError("pymunk: mu must be > 0 when gamma > 0 (a massless lintel, which the "
+                         "analytic model allows, cannot carry the pendulum hinge in an engine)")
     _validate(scene, excitation, s)
     wall0 = time.perf_counter()
     world = _World(scene, s)
