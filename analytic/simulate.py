@@ -232,7 +232,7 @@ class _Run:
 
     def _nudge(self, dense, xg, side, t1):
         b, h, mu, gamma, j, l, g = self.args
-        step = max(abs(t1), 1.0) * np.finfo(float).eps
+        step = max(abs(t1), 1.0) * float(np.finfo(float).eps)
         for _ in range(60):
             psi, psi_dot = dense(t1)
             if eq.uplift_margin(psi, psi_dot, xg(t1), side, b, h, mu, gamma, l, g) <= 0.0:

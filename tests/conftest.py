@@ -1,0 +1,42 @@
+"""Shared fixtures: the paper's Fig. 5 scene (with and without pendulum) and a
+cached accurate-simulator run (several tests look at the same trajectories)."""
+from __future__ import annotations
+
+import functools
+
+import pytest
+
+from analytic.excitation import Pulse
+from analytic.parameters import Scene
+from scenes import load_scene
+
+
+@pytest.fixture(scope="session")
+def fig5() -> Scene:
+    """lam = 5, b = 0.6 m, gamma = 0.3, mu = 1, l = 2h/3 (the paper's Fig. 5)."""
+    return load_scene("fig5")
+
+
+@pytest.fixture(scope="session")
+def fig5_bare(fig5) -> Scene:
+    """The Fig. 5 trilith without its pendulum (gamma = 0)."""
+    return fig5.without_pendulum()
+
+
+@functools.lru_cache(maxsize=64)
+def _cached_run(scene: Scene, amplitude: float, omega: float, kind: str,
+                t_max: float | None, criterion: str):
+    from analytic.simulate import Settings, simulate
+    from analytic.trajectory import OverturnCriterion
+    settings = Settings(t_max=t_max, criterion=OverturnCriterion(criterion))
+    return simulate(scene, Pulse(amplitude, omega, kind), settings)
+
+
+@pytest.fixture(scope="session")
+def run_analytic():
+    """``run_analytic(scene, A, Omega, kind='sine', t_max=None, criterion='topple')``:
+    an accurate-path Trajectory, cached per session (treat it as read-only)."""
+    def run(scene: Scene, amplitude: float, omega: float, kind: str = "sine",
+            t_max: float | None = None, criterion: str = "topple"):
+        return _cached_run(scene, float(amplitude), float(omega), kind, t_max, criterion)
+    return run
