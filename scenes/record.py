@@ -143,15 +143,25 @@ def load_backend(name: str):
 
 
 def backend_settings(module, duration: float, **changes):
-    """The backend's default Settings with ``t_max`` set to the recorded span."""
+    """The backend's default Settings, set to run for the whole recorded span.
+
+    ``t_max`` is the span; an engine's run monitor (``monitor`` field) would stop
+    a run as soon as survival is certain (energy below the barrier, or at rest),
+    which freezes the picture while the pendulum still swings: for a recording
+    those early stops are switched off, so every backend runs to ``t_max``
+    (or until it overturns).
+    """
     settings = module.Settings()
     names = {f.name for f in dataclasses.fields(settings)}
     if "t_max" in names:
         changes["t_max"] = duration
-    unknown = set(changes) - names
-    for key in unknown:
-        del changes[key]
-    return dataclasses.replace(settings, **changes)
+    monitor = getattr(settings, "monitor", None)
+    if "monitor" in names and dataclasses.is_dataclass(monitor):
+        monitor_names = {f.name for f in dataclasses.fields(monitor)}
+        early = {"energy_rule": False, "rest_hold": duration}
+        changes.setdefault("monitor", dataclasses.replace(
+            monitor, **{k: v for k, v in early.items() if k in monitor_names}))
+    return dataclasses.replace(settings, **{k: v for k, v in changes.items() if k in names})
 
 
 def run_backend(name: str, scene: Scene, excitation, duration: float) -> Trajectory:
@@ -256,11 +266,25 @@ def render_frames(panels: Panels, figure) -> list[np.ndarray]:
     return frames
 
 
+def gif_palette(frames: list[np.ndarray], colors: int = 128):
+    """One adaptive palette for the whole GIF, from the first, middle and last
+    frames: quantising each frame on its own costs ~90 ms per frame and makes
+    colours flicker between frames."""
+    from PIL import Image
+
+    picks = [frames[0], frames[len(frames) // 2], frames[-1]]
+    montage = Image.fromarray(np.concatenate(picks, axis=0))
+    return montage.quantize(colors=colors, method=Image.Quantize.MEDIANCUT,
+                            dither=Image.Dither.NONE)
+
+
 def write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
     """Animated GIF via Pillow, looping; delay ``1000/fps`` ms (GIF stores 10 ms units)."""
     from PIL import Image
 
-    images = [Image.fromarray(f) for f in frames]
+    palette = gif_palette(frames)
+    images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
+              for f in frames]
     images[0].save(path, save_all=True, append_images=images[1:], loop=0,
                    duration=int(round(1000.0 / fps)), optimize=False)
 
