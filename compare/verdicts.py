@@ -1,0 +1,70 @@
+"""The verdict table: each measured metric against its tolerance, per engine.
+
+Values are computed from the campaign's measurements (never typed in); a metric
+that could not be measured (no impact, threshold not bracketed) fails with
+``value = None`` rather than passing silently.
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["build_verdicts"]
+
+
+def _finite(values) -> list[float]:
+    return [float(v) for v in values if v is not None and math.isfinite(float(v))]
+
+
+def _row(metric: str, backend: str, values: list, tolerance: float, reason: str, unit: str,
+         n_expected: int, absolute: bool = True) -> dict:
+    """Worst case of ``values`` against ``tolerance``; any missing value fails."""
+    vals = _finite(abs(v) if (absolute and v is not None) else v for v in values)
+    missing = n_expected - len(vals)
+    value = max(vals) if vals else None
+    passed = bool(vals) and missing == 0 and value <= tolerance
+    detail = f"worst of {len(vals)}" + (f"; {missing} not measured" if missing else "")
+    return {"metric": metric, "backend": backend, "value": value, "tolerance": tolerance,
+            "passed": passed, "unit": unit, "reason": reason, "detail": detail}
+
+
+def build_verdicts(result) -> list[dict]:
+    """Verdict rows for every engine of ``result`` (a :class:`CampaignResult`)."""
+    cfg = result.config
+    tol = cfg.tolerances
+    why = tol.reasons()
+    rows: list[dict] = []
+    for name in cfg.engines:
+        for pend, metric, tolerance, key in (
+                (False, "restitution vs Eq. 20 (max rel. error)", tol.restitution, "restitution"),
+                (True, "restitution vs Eq. 19 (max rel. error)", tol.restitution_pendulum,
+                 "restitution_pendulum")):
+            runs = [r for r in result.restitution if r["backend"] == name and r["pendulum"] == pend]
+            if not runs:
+                continue
+            # Every run must deliver at least one impact; each run's worst impact counts.
+            values = [r["max_rel_error"] if r["impacts"] else None for r in runs]
+            rows.append(_row(metric, name, values, tolerance, why[key], "relative", len(runs)))
+        for case, label in (("pendulum", "with pendulum"), ("no_pendulum", "without pendulum")):
+            points = result.spectra.get(case, {}).get("engines", {}).get(name, [])
+            if not points:
+                continue
+            values = [p["rel_error"] if p["bracketed"] else None for p in points]
+            rows.append(_row(f"overturning threshold {label}, away from jumps (max rel. error)",
+                             name, values, tol.threshold, why["threshold"], "relative",
+                             len(points)))
+        comps = [c for c in result.comparisons if c["backend"] == name]
+        if comps:
+            mismatches = [c for c in comps if not c["verdict_agrees"]]
+            rows.append({
+                "metric": "verdict disagreements at A-D (status and mode)", "backend": name,
+                "value": len(mismatches), "tolerance": tol.verdict_mismatches,
+                "passed": len(mismatches) <= tol.verdict_mismatches, "unit": "count",
+                "reason": why["verdict_mismatches"],
+                "detail": ", ".join(f"{c['point']}{'+p' if c['pendulum'] else ''}: "
+                                    f"{c['status_test']}/{c['mode_test']} vs "
+                                    f"{c['status_reference']}/{c['mode_reference']}"
+                                    for c in mismatches) or f"{len(comps)} cases agree"})
+            rows.append(_row("theta RMS error / alpha before the first impact (A-D)", name,
+                             [c["theta_rms_first"] for c in comps], tol.theta_rms_first,
+                             why["theta_rms_first"], "fraction of alpha", len(comps)))
+    return rows
