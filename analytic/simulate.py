@@ -172,20 +172,18 @@ class _Run:
             self.uplift(1 if m_plus <= m_minus else -1)
             return
         period_end = None
-        if self.after_pulse(self.t):
-            if not self.pend:
-                if self.survive(REASON_REST):
-                    return
-            elif not self.decided:
-                period = free_pendulum_period(self.psi, self.psi_dot, self.args[5], self.args[6])
-                if self.t + period < t_b:
-                    t_b = period_end = self.t + period
         if self.after_pulse(self.t) and not self.pend:
-            # t_max given (else rule 2 stopped the run): nothing moves any more.
+            if self.survive(REASON_REST):  # rule 2
+                return
+            # t_max given: nothing moves any more, no need to integrate.
             self.samples.add_segment(self.t, t_b, np.array([]), lambda ts: np.zeros((len(ts), 4)))
             self.t = t_b
             self.point()
             return
+        if self.after_pulse(self.t) and not self.decided:  # rule 3: one free period
+            period = free_pendulum_period(self.psi, self.psi_dot, self.args[5], self.args[6])
+            if self.t + period < t_b:
+                t_b = period_end = self.t + period
         b, h, mu, gamma, j, l, g = self.args
         if self.pend:
             def fun(t, y):
@@ -200,19 +198,21 @@ class _Run:
             ev.terminal, ev.direction = True, -1
             return ev
         if self.after_pulse(self.t):
-            forcing = 2.0 * math.pi * math.sqrt(l / g)
+            # Free pendulum: the margin varies on its time scale only; at least 100
+            # checks per small-amplitude period (the error control takes smaller steps).
+            max_step = 2.0 * math.pi * math.sqrt(l / g) / 100.0
         elif self.kinks is not None:
             k = int(np.searchsorted(self.kinks, self.t, side="right"))
             if k < len(self.kinks):
                 t_b = min(t_b, float(self.kinks[k]))
-            forcing = math.inf  # margin linear in xg_ddot between kinks: no dip missed
+            max_step = math.inf  # between kinks xg_ddot is linear: the margin's minima
+            # are at the kinks (no pendulum) or on the pendulum's slow time scale
         else:
-            forcing = self.excitation.end_time
+            max_step = self.st.rest_step_fraction * self.excitation.end_time
         sol = self.solve(fun, t_b, [self.psi, self.psi_dot],
-                         [margin_event(1), margin_event(-1)],
-                         max_step=self.st.rest_step_fraction * forcing)
+                         [margin_event(1), margin_event(-1)], max_step=max_step)
         hit = self.first_event(sol)
-        t1 = sol.t[-1] if hit is None else hit[1]
+        t1 = float(sol.t[-1]) if hit is None else hit[1]
         side = 0
         if hit is not None:
             side = 1 if hit[0] == 0 else -1
@@ -274,7 +274,7 @@ class _Run:
                 first = min(tau / 8.0, t_b - self.t)
         sol = self.solve(fun, t_b, y0, [impact, overturn], first_step=first)
         hit = self.first_event(sol)
-        t1 = sol.t[-1] if hit is None else hit[1]
+        t1 = float(sol.t[-1]) if hit is None else hit[1]
         pend = self.pend
 
         def rows(ts):
