@@ -241,19 +241,14 @@ def test_near_threshold_runs_are_deterministic(gamma, warm_fast):
 
 
 # --- analytic: a shallow rocking excursion right after an impact ------------------------
-@pytest.mark.parametrize("backend", [
-    "accurate",
-    pytest.param("fast", marks=pytest.mark.xfail(strict=True, reason=(
-        "analytic-fast misses an impact when the first step after an impact (theta = 0, "
-        "so s*theta > 0 fails at the step start) already crosses theta = 0 again: the "
-        "phase then runs on the wrong side to |theta| = 5.9 rad and ends 'undecided' "
-        "(reported to the lead; the accurate path limits that first step to tau/8)"))),
-])
+@pytest.mark.parametrize("backend", ["accurate", "fast"])
 def test_shallow_excursion_after_impact(backend, warm_fast):
     """Fig. 5 trilith, one-sine 2.4 m/s^2 at 6 rad/s (just above uplift): the 4th
     impact (t = 0.586 s) leaves theta_dot+ = 0.014 rad/s against a ground
     acceleration pulling back, so the next excursion lasts a few ms.  The run
-    must see that impact (the accurate path survives with 35 impacts)."""
+    must see that impact (the accurate path survives with 35 impacts).  Regression:
+    the first fast kernel missed it (the step start at theta = 0 failed its
+    ``s*theta > 0`` test) and ran on the wrong side to |theta| = 5.9 rad."""
     scene = Scene()
     pulse = Pulse(2.4, 6.0)
     tr = simulate_accurate(scene, pulse) if backend == "accurate" else fast.simulate(scene, pulse)
