@@ -17,6 +17,14 @@ translating base); ``"ground"`` moves a kinematic ground box along
 ``excitation.displacement``.  The run is stopped and judged by
 :class:`engines._common.RunMonitor` (shared with every engine).
 
+Diagnostics (``Trajectory.diagnostics``): ``lintel_rotation_max`` [rad],
+``pivot_sliding_max`` [m] (horizontal drift of the pivot corners relative to the
+ground), ``penetration_max`` [m] (depth of the base corners below the ground
+top), all over the rocking regime ``|theta| < alpha`` that the analytic model
+describes; ``*_all`` variants over the whole run (a column lying down near the
+topple angle reshapes its contacts with the lintel and may slide), ``steps``,
+``wall_time`` [s], ``required_friction`` and the monitor's column mismatch.
+
 Signs: Pymunk's y axis points up and angles are counter-clockwise, so a column's
 rotation angle is ``theta`` directly (``theta > 0``: leaning left on the left
 corners); ``psi`` is the bob's angle about the hinge from the downward vertical.
@@ -323,7 +331,10 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     max_dist = s.blowup_distance * world.size
     max_speed = s.blowup_speed * (math.sqrt(g * world.size) + _peak_ground_speed(excitation))
     corner_x0 = [(x, x + b) for x in world.x_left]
-    lintel_rot = slide = penetration = 0.0
+    # Contact diagnostics over the rocking regime |theta| < alpha (what the analytic
+    # model describes) and over the whole run (a falling column's contacts reshape).
+    lintel_rot = slide = penetration = slide_all = penetration_all = 0.0
+    alpha = scene.alpha
     step = 0
     done = False
     while not done:
@@ -334,14 +345,20 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
             psi_dot = bob.angular_velocity if bob is not None else 0.0
             theta_dot = 0.5 * (cols[0].angular_velocity + cols[1].angular_velocity)
             done = monitor.record(t, cols[0].angle, cols[1].angle, theta_dot, psi, psi_dot)
+            in_well = abs(cols[0].angle + cols[1].angle) < 2.0 * alpha
             for k, col in enumerate(cols):
                 left = col.local_to_world((-0.5 * b, -0.5 * h))
                 right = col.local_to_world((0.5 * b, -0.5 * h))
                 # The pivot is the corner on the side the column leans to.
                 pivot, x0 = (left, corner_x0[k][0]) if col.angle >= 0.0 else (right, corner_x0[k][1])
-                slide = max(slide, abs(pivot.x - x0 - x_ground))
-                penetration = max(penetration, -min(left.y, right.y))
-            if lintel is not None:
+                sl = abs(pivot.x - x0 - x_ground)
+                pen = -min(left.y, right.y)
+                slide_all = max(slide_all, sl)
+                penetration_all = max(penetration_all, pen)
+                if in_well:
+                    slide = max(slide, sl)
+                    penetration = max(penetration, pen)
+            if lintel is not None and in_well:
                 lintel_rot = max(lintel_rot, abs(lintel.angle))
             if not done:
                 for body, (x0, y0) in zip(world.bodies, world.start):
@@ -365,7 +382,8 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
         space.step(dt)
         step += 1
     diagnostics = {"lintel_rotation_max": lintel_rot, "pivot_sliding_max": slide,
-                   "penetration_max": penetration, "steps": step,
+                   "penetration_max": penetration, "pivot_sliding_max_all": slide_all,
+                   "penetration_max_all": penetration_all, "steps": step,
                    "required_friction": required_friction(scene, excitation)}
     wall = time.perf_counter() - wall0
     diagnostics["wall_time"] = wall
