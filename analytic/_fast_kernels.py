@@ -364,6 +364,15 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             for c in range(4):
                 k[0, c] = f[c]
             need_k0 = False
+        if phase != 0 and y[0] == 0.0:
+            # Rocking starts at theta = 0 moving out but pulled back: the excursion
+            # lasts tau = 2|v/a|; a step well inside it keeps the impact bracketed.
+            sv = phase * y[1]
+            sa = phase * k[0, 1]
+            if sv > 0.0 and sa < 0.0:
+                tau = 2.0 * sv / -sa
+                if hstep > 0.125 * tau:
+                    hstep = 0.125 * tau
         hit = False
         if hstep >= t_next - t:
             hstep = t_next - t
@@ -416,6 +425,23 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             break
         if err > 1.0:
             hstep *= max(_MIN_FACTOR, _SAFETY * err ** -0.2)
+            continue
+        if phase != 0 and phase * y[0] <= 0.0 and phase * ynew[0] < 0.0:
+            # s*theta went below 0 from the start of a rock phase: the excursion
+            # was shorter than the step.  Retry smaller; at round-off it is an
+            # impact at once.
+            if hstep > 1e-12 * max(1.0, t):
+                hstep *= 0.125
+                continue
+            # No measurable excursion: the frame is back at rest (margin re-checked).
+            events, ne = _push_event(events, ne, EV_REST, t, 0, y[1], 0.0, y[2], y[3],
+                                     y[3], record)
+            phase = 0
+            y[0] = 0.0
+            y[1] = 0.0
+            check_margin = True
+            need_k0 = True
+            hstep = 1e-3 * quarter
             continue
         h_used = hstep
         if err == 0.0:
