@@ -118,12 +118,13 @@ def test_positive_pulse_rocks_on_left_corners_like_analytic(fig5, run_analytic):
     assert tr.theta[np.argmax(np.abs(tr.theta) > 1e-3)] > 0
     # And the rocking starts at the same time: the first passage of |theta| = 1e-2
     # rad (the uplift instant itself is invisible in samples: theta grows like
-    # (t - t_up)^3 at first).  2 ms: two samples of the engine.
+    # (t - t_up)^3 at first).  0.5 ms: half a sample period, the linear
+    # interpolation error between samples (measured difference 0.05 ms).
     def first_passage(traj):
         k = np.argmax(np.abs(traj.theta) > 1e-2)
         return np.interp(1e-2, np.abs(traj.theta[k - 1:k + 1]), traj.t[k - 1:k + 1])
 
-    assert first_passage(tr) == pytest.approx(first_passage(ref), abs=2e-3)
+    assert first_passage(tr) == pytest.approx(first_passage(ref), abs=5e-4)
 
 
 # ----------------------------------------------------------------- validation
