@@ -245,8 +245,6 @@ def test_readme_commands_run(command, tmp_path, monkeypatch, capsys):
         assert len(read_gif(out)) == 2
 
 
-# No event loop runs under the fake show(), so matplotlib warns the animation never drew.
-@pytest.mark.filterwarnings("ignore:Animation was deleted without rendering")
 def test_view_with_a_display_animates_the_trajectories(monkeypatch):
     """The window path, with the display faked and ``plt.show`` replaced by a few
     animation steps (the same Panels as recordings)."""
@@ -258,6 +256,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
 
     def fake_show():
         fig = plt.gcf()
+        fig.canvas.draw()  # what a window does first; starts the animation
         for k in (0, 5, 9):
             fig.animation._func(k)  # FuncAnimation's frame callback: Panels.update
         shown["texts"] = [t.get_text() for ax in fig.axes for t in ax.texts]
