@@ -312,7 +312,7 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     t0 = time.perf_counter()
-    fast.warm_up()  # compile (or load) once, before any fork
+    fast.warm_up(record=False)  # compile (or load) once, before any fork
     _JOB.update(scene=scene, settings=ss)
     bar = None
     if progress:
