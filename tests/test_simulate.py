@@ -213,3 +213,25 @@ def test_determinism(fig5):
         assert np.array_equal(getattr(a, name), getattr(b, name))
     assert a.events == b.events and a.verdict == b.verdict
     assert a.diagnostics == b.diagnostics
+
+
+# --- CLI --------------------------------------------------------------------------------------
+def test_cli_json_csv_plot(tmp_path, capsys):
+    from compare.cli import main
+    csv, png = tmp_path / "run.csv", tmp_path / "run.png"
+    code = main(["simulate", "-A", "19", "-w", "15", "--no-pendulum", "--criterion", "alpha",
+                 "--json", "--csv", str(csv), "--plot", str(png)])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "overturned" and out["criterion"] == "alpha"
+    assert out["settings"]["criterion"]["kind"] == "alpha"
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert data.shape[1] == 5 and data[-1, 0] == pytest.approx(out["t_end"])
+    assert png.stat().st_size > 1000 and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_human_summary_and_t_max(capsys):
+    from compare.cli import main
+    assert main(["simulate", "-A", "4", "-w", "9", "--t-max", "3", "--pulse", "cosine"]) == 0
+    out = capsys.readouterr().out
+    assert "verdict: survived" in out and "cosine pulse" in out and "t_end = 3.000 s" in out
