@@ -134,6 +134,7 @@ def test_positive_pulse_rocks_on_left_corners_like_analytic(fig5, run_analytic):
     ({"sample_every": 0}, "sample_every"), ({"iterations": 0}, "iterations"),
     ({"theta0": 0.5}, "theta0"), ({"psi0": 4.0}, "psi0"),
     ({"friction": 1.0}, "friction"),  # point D peaks at 25 m/s^2 = 2.55 g
+    ({"criterion": "topple"}, "criterion"), ({"monitor": None}, "monitor"),
 ])
 def test_bad_settings_raise_before_stepping(fig5, monkeypatch, changes, field):
     def boom(*args, **kwargs):
