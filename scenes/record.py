@@ -254,14 +254,24 @@ class Panels:
 
 
 def render_frames(panels: Panels, figure) -> list[np.ndarray]:
-    """Draw every frame on the Agg canvas of ``figure``; (H, W, 3) uint8 arrays."""
+    """Draw every frame on the Agg canvas of ``figure``; (H, W, 3) uint8 arrays.
+
+    Blitting: the static parts (axes frames, titles) are drawn once and restored
+    for every frame, then only the moving artists are drawn on top, in z-order
+    (a full redraw costs about three times as much).
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     canvas = FigureCanvasAgg(figure)
+    for artist in panels.update(0):
+        artist.set_animated(True)  # left out of the full draw below
+    canvas.draw()
+    background = canvas.copy_from_bbox(figure.bbox)
     frames = []
     for k in range(len(panels)):
-        panels.update(k)
-        canvas.draw()
+        canvas.restore_region(background)
+        for artist in sorted(panels.update(k), key=lambda a: a.get_zorder()):
+            artist.axes.draw_artist(artist)
         frames.append(np.asarray(canvas.buffer_rgba())[:, :, :3].copy())
     return frames
 
