@@ -519,6 +519,13 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             pdm = ytmp[3]
             tdp, pdp = _impact(tdm, ytmp[2], pdm, float(new_side), b, h, mu, gamma, j, l)
             n_imp += 1
+            if record:  # the instant before the impact; the one after is pushed below
+                row[0] = t
+                row[1] = 0.0
+                row[2] = tdm
+                row[3] = ytmp[2]
+                row[4] = pdm
+                samples, ns = _push(samples, ns, row)
             events, ne = _push_event(events, ne, EV_IMPACT, t, new_side, tdm, tdp, ytmp[2],
                                      pdm, pdp, record)
             y[0] = 0.0

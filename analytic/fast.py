@@ -138,8 +138,9 @@ def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
     mode = None
     if status == "overturned":
         mode = "after-impact" if ni > 0 else "no-impact"
-    return Verdict(status, float(tv) if math.isfinite(tv) else None, mode, int(ni),
-                   REASONS[rs])
+    # Like the accurate path: a time only for an overturn (when it happened).
+    t_v = float(tv) if status == "overturned" else None
+    return Verdict(status, t_v, mode, int(ni), REASONS[rs])
 
 
 def _check(scene, excitation, settings) -> Settings:

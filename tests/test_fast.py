@@ -1,0 +1,201 @@
+"""The compiled fast path (``analytic/fast.py``) against the accurate path
+(``analytic/simulate.py``, DOP853 at rtol 1e-10): same verdicts, same events,
+same theta(t); plus its own contract, validation and exact-survival rules."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from scipy.special import ellipk
+
+from analytic import _fast_kernels as kern
+from analytic import fast
+from analytic import simulate as accurate
+from analytic.events import free_pendulum_period
+from analytic.excitation import Pulse, SampledRecord
+from analytic.trajectory import OverturnCriterion
+from engines import get_backend
+
+# The paper's labelled points of Fig. 5 (A_s [m/s^2], Omega [rad/s]) and a few more
+# cases: overturning with and without impact, survival with impacts, low frequency.
+PAPER_POINTS = {"A": (19.0, 15.0), "B": (4.0, 9.0), "C": (10.0, 9.0), "D": (25.0, 11.0)}
+EXTRA = [(3.0, 5.0), (8.0, 12.0), (14.0, 20.0)]
+CASES = [(a, w, kind) for kind in ("sine", "cosine")
+         for a, w in list(PAPER_POINTS.values()) + EXTRA]
+
+# theta agreement [rad].  Both integrators keep the local error at their rtol
+# (1e-8 fast, 1e-10 accurate) and locate events on their dense output; measured
+# differences are <= 2e-7 rad over these runs (most ~1e-9).  Before the first
+# impact nothing amplifies the difference, so 1e-6 rad; over a run the impact map
+# passes on the event-time error (~1e-7 s) times theta_dot, hence 1e-5 rad.
+THETA_TOL_BEFORE_IMPACT = 1e-6
+THETA_TOL_RUN = 1e-5
+# Event times [s]: measured <= 1e-7 s (root location on two different interpolants).
+EVENT_T_TOL = 1e-6
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _compiled():
+    fast.warm_up()  # compile or load once; no test below pays for it
+
+
+def _theta_on(tr, grid):
+    t, first = np.unique(tr.t, return_index=True)  # impact instants appear twice
+    return np.interp(grid, t, tr.theta[first])
+
+
+@pytest.mark.parametrize("with_pendulum", [True, False], ids=["pendulum", "bare"])
+@pytest.mark.parametrize("amp,omega,kind", CASES)
+def test_fast_matches_accurate(fig5, run_analytic, amp, omega, kind, with_pendulum):
+    scene = fig5 if with_pendulum else fig5.without_pendulum()
+    ref = run_analytic(scene, amp, omega, kind)
+    tr = fast.simulate(scene, Pulse(amp, omega, kind))
+    assert (tr.verdict.status, tr.verdict.mode, tr.n_impacts) == (
+        ref.verdict.status, ref.verdict.mode, ref.n_impacts)
+    assert [e.kind for e in tr.events] == [e.kind for e in ref.events]
+    for e, r in zip(tr.events, ref.events):
+        assert e.t == pytest.approx(r.t, abs=EVENT_T_TOL)
+        assert e.side == r.side
+    if tr.overturned:
+        assert tr.verdict.time == pytest.approx(ref.verdict.time, abs=EVENT_T_TOL)
+    t_end = min(tr.t[-1], ref.t[-1])
+    grid = np.arange(0.0, t_end, 1e-3)
+    # Linear interpolation across an event kink is not a model difference: skip
+    # the samples within 2 ms of an event.
+    away = np.ones(grid.size, dtype=bool)
+    for e in ref.events:
+        away &= np.abs(grid - e.t) > 2e-3
+    diff = np.abs(_theta_on(tr, grid) - _theta_on(ref, grid))[away]
+    first_impact = ref.impacts[0].t if ref.impacts else t_end
+    before = grid[away] < first_impact
+    assert np.max(diff[before], initial=0.0) < THETA_TOL_BEFORE_IMPACT
+    assert np.max(diff, initial=0.0) < THETA_TOL_RUN
+
+
+def test_paper_points_qualitative(fig5):
+    """Section 5.2: the pendulum saves case A; C overturns after an impact, D
+    without one (Fig. 7)."""
+    a, w = PAPER_POINTS["A"]
+    assert fast.simulate(fig5, Pulse(a, w)).verdict.status == "survived"
+    assert fast.simulate(fig5.without_pendulum(), Pulse(a, w)).overturned
+    c = fast.simulate(fig5, Pulse(*PAPER_POINTS["C"])).verdict
+    d = fast.simulate(fig5, Pulse(*PAPER_POINTS["D"])).verdict
+    assert (c.status, c.mode) == ("overturned", "after-impact")
+    assert (d.status, d.mode) == ("overturned", "no-impact")
+
+
+@pytest.mark.parametrize("amp,omega", [(8.06, 10.0), (7.05, 11.0), (17.43, 11.0)])
+def test_near_threshold_verdicts(fig5, run_analytic, amp, omega):
+    """Just below spectrum thresholds (many impacts, the pendulum handing energy
+    back): only the verdict is compared, the trajectories are chaotic there."""
+    for scene in (fig5, fig5.without_pendulum()):
+        ref = run_analytic(scene, amp, omega)
+        v = fast.verdict_for(scene, Pulse(amp, omega))
+        assert (v.status, v.mode) == (ref.verdict.status, ref.verdict.mode)
+
+
+def test_verdict_entry_points_agree(fig5):
+    pulse = Pulse(10.0, 9.0)
+    tr = fast.simulate(fig5, pulse)
+    v = fast.verdict_for(fig5, pulse)
+    st, _reason, t, n = fast.overturn_verdict(*fig5.model_args(), 10.0, 9.0, 0,
+                                              OverturnCriterion().threshold(fig5.alpha))
+    assert (v.status, v.time, v.n_impacts) == (tr.verdict.status, tr.verdict.time, tr.n_impacts)
+    assert fast.STATUS_NAMES[st] == v.status and t == v.time and n == v.n_impacts
+
+
+def test_alpha_criterion_and_modes(fig5, run_analytic):
+    st = fast.Settings(criterion=OverturnCriterion("alpha"))
+    for amp, omega in [(10.0, 9.0), (25.0, 11.0), (4.0, 9.0)]:
+        ref = run_analytic(fig5, amp, omega, criterion="alpha")
+        tr = fast.simulate(fig5, Pulse(amp, omega), st)
+        assert (tr.verdict.status, tr.verdict.mode) == (ref.verdict.status, ref.verdict.mode)
+        if tr.overturned:
+            assert tr.max_abs_theta == pytest.approx(fig5.alpha, abs=1e-9)
+
+
+def test_fixed_window(fig5, run_analytic):
+    """With t_max the run goes on to t_max and a survivor is 'survived'."""
+    tr = fast.simulate(fig5, Pulse(4.0, 9.0), fast.Settings(t_max=3.0))
+    ref = run_analytic(fig5, 4.0, 9.0, t_max=3.0)
+    assert tr.verdict.status == ref.verdict.status == "survived"
+    assert tr.t[-1] == pytest.approx(3.0, abs=1e-12)
+    assert tr.n_impacts == ref.n_impacts
+
+
+def test_samples_and_events(fig5):
+    tr = fast.simulate(fig5, Pulse(5.0, 9.0), fast.Settings(t_max=3.0))
+    assert tr.t[0] == 0.0 and np.all(np.diff(tr.t) >= 0.0)
+    imp = tr.impacts[0]
+    at = np.flatnonzero(tr.t == imp.t)
+    assert len(at) == 2  # before and after, like the accurate path
+    assert tr.theta_dot[at[0]] == imp.theta_dot_before
+    assert tr.theta_dot[at[1]] == imp.theta_dot_after
+    assert tr.events[0].kind == "uplift" and tr.events[0].side == 1
+
+
+def test_mirror_symmetry(fig5):
+    """A negative amplitude mirrors the response (theta -> -theta, psi -> -psi)."""
+    a = fast.simulate(fig5, Pulse(6.0, 10.0), fast.Settings(t_max=2.0))
+    b = fast.simulate(fig5, Pulse(-6.0, 10.0), fast.Settings(t_max=2.0))
+    n = min(len(a.t), len(b.t))
+    # Same arithmetic up to the sign of b: round-off only.
+    np.testing.assert_allclose(b.theta[:n], -a.theta[:n], atol=1e-9)
+    np.testing.assert_allclose(b.psi[:n], -a.psi[:n], atol=1e-9)
+
+
+def test_deterministic(fig5):
+    a = fast.simulate(fig5, Pulse(10.0, 9.0))
+    b = fast.simulate(fig5, Pulse(10.0, 9.0))
+    assert np.array_equal(a.theta, b.theta) and a.verdict == b.verdict
+
+
+def test_no_pendulum_keeps_psi_zero(fig5):
+    tr = fast.simulate(fig5.without_pendulum(), Pulse(10.0, 9.0))
+    assert not np.any(tr.psi) and not np.any(tr.psi_dot)
+
+
+def test_pendulum_period_kernel_matches_scipy():
+    """The AGM elliptic integral in the kernel against scipy's ellipk, for
+    libration and rotation."""
+    l, g = 2.0, 9.81
+    for psi, psi_dot in [(0.0, 0.0), (0.3, 0.0), (2.5, 0.1), (0.0, 5.0), (1.0, -6.0)]:
+        assert kern._pendulum_period(psi, psi_dot, l, g) == pytest.approx(
+            free_pendulum_period(psi, psi_dot, l, g), rel=1e-12)
+    assert kern._ellipk(0.7) == pytest.approx(float(ellipk(0.7)), rel=1e-14)
+
+
+def test_rest_after_pulse_rules(fig5):
+    """Below uplift nothing moves: without a pendulum the run is decided at the
+    pulse end; with one after a free-pendulum period (or the energy barrier)."""
+    bare = fast.verdict_for(fig5.without_pendulum(), Pulse(1.0, 10.0))
+    assert bare.status == "survived" and "energy" in bare.reason
+    tr = fast.simulate(fig5, Pulse(1.0, 10.0))
+    assert tr.verdict.status == "survived" and not tr.events
+
+
+def test_sampled_record_falls_back_to_accurate(fig5):
+    rec = SampledRecord((0.0, 0.2, 0.4), (0.0, 4.0, 0.0))
+    tr = fast.simulate(fig5, rec, fast.Settings(t_max=1.0))
+    assert tr.backend == accurate.NAME
+    assert "fallback" in " ".join(tr.diagnostics)
+
+
+def test_contract_and_validation(fig5):
+    backend = get_backend("analytic-fast")
+    assert backend is fast and fast.NAME == "analytic-fast" and "numba" in fast.version()
+    assert dataclasses.is_dataclass(fast.Settings) and fast.Settings.__dataclass_params__.frozen
+    for bad in ({"t_max": -1.0}, {"t_max": math.inf}, {"rtol": 0.0}, {"atol": -1.0},
+                {"rest_velocity": math.nan}, {"sample_dt": 0.0}, {"max_steps": 5},
+                {"criterion": "topple"}):
+        name = next(iter(bad))
+        with pytest.raises(ValueError, match=name):
+            fast.Settings(**bad)
+    with pytest.raises(ValueError, match="scene"):
+        fast.simulate("fig5", Pulse(1.0, 1.0))
+    with pytest.raises(ValueError, match="excitation"):
+        fast.simulate(fig5, 3.0)
+    with pytest.raises(ValueError, match="settings"):
+        fast.simulate(fig5, Pulse(1.0, 1.0), accurate.Settings())
