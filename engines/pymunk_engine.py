@@ -67,8 +67,9 @@ class Settings:
     t_max : float or None
         Run length [s]; None lets the monitor stop the run (rest, energy, cap).
     dt : float
-        Time step [s].  1e-4 s: impacts of a rocking block resolve in a few steps
-        and the restitution error falls below 0.5 % (see ``tests/test_pymunk_engine.py``).
+        Time step [s].  1e-4 s: restitution error <= 0.15 % (first four impacts,
+        lam in {3, 5, 7}); it grows about linearly with dt (0.25 % at 2e-4 s,
+        0.8 % at 5e-4 s, 10-24 % at Pymunk's usual 1/60 s).
     theta0, psi0 : float
         Initial tilt [rad] (released at rest; > 0 on the left corners) and
         pendulum angle [rad].
@@ -87,13 +88,17 @@ class Settings:
         the paper's spectra; point D needs 2.55); measured restitution is the
         same to 1e-5 for 1.1, 3 and 10, so headroom costs nothing.
     iterations : int
-        Solver iterations per step.  30: the pendulum joint and the stacked
-        contacts (ground-column-lintel) need more than Chipmunk's default 10 for
-        the impulse to settle within one step at the impact.
+        Solver iterations per step.  30: the stacked contacts (ground-column-
+        lintel) and the pendulum joint need more than Chipmunk's default 10
+        (which gives 3.4 % restitution error at lam = 3); 30 and 100 give the
+        same ratios to 1e-5.
     slop_fraction : float
-        ``space.collision_slop`` as a fraction of the column width ``b``.  1e-5:
-        Pymunk's default slop (0.1 m) is a sixth of a column width and lets the
-        corners sink; 1e-5 b keeps penetration near micrometres.
+        ``space.collision_slop`` as a fraction of the column width ``b``.  1e-4
+        (60 um at b = 0.6 m): just above the contacts' own penetration (~30 um),
+        so Chipmunk's position correction stays idle.  At 1e-5 b it fights that
+        penetration every step and about one impact in five on lam = 3 came out
+        4-6 % too elastic (column and lintel impacts out of step).  Pymunk's
+        default 0.1 m gives the same ratios but would let a corner sink 0.1 m.
     collision_bias : float or None
         Fraction of overlap left uncorrected after one second; None keeps
         Pymunk's default ``0.9**60`` (position correction is then gentle enough
