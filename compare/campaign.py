@@ -30,7 +30,8 @@ from . import metrics
 from .spectra import choose_frequencies, reference_spectrum
 from .thresholds import engine_jump_frequency, engine_threshold
 
-__all__ = ["POINTS", "Tolerances", "CampaignConfig", "run_campaign", "backend_settings"]
+__all__ = ["POINTS", "Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
+           "free_rocking_restitution"]
 
 # The paper's labelled cases (A_s [m/s^2], Omega [rad/s]): Fig. 6 (A, B), Fig. 7 (C, D).
 POINTS: dict[str, tuple[float, float]] = {"A": (19.0, 15.0), "B": (4.0, 9.0),
@@ -74,8 +75,9 @@ class CampaignConfig:
     restitution_mus: tuple[float, ...] = (0.5, 1.0, 2.0)  # issue's grid
     pendulum_lams: tuple[float, ...] = (3.0, 5.0, 7.0)  # Eq. 19 runs (scene's mu, gamma)
     theta0_fraction: float = 0.5  # release tilt / alpha: well inside the well, fast impacts
-    n_impacts: int = 3  # impacts measured per free-rocking run
-    n_frequencies: int = 8  # engine threshold frequencies per case (away from jumps)
+    n_impacts: int = 4  # per free-rocking run: two of each side, as engines/restitution.py
+    spectrum_cases: tuple[str, ...] = ("pendulum", "no_pendulum")  # Fig. 5: both curves
+    n_frequencies: int = 6  # engine threshold frequencies per case (away from jumps); 10-min budget
     omega_range: tuple[float, float] = (4.0, 28.0)  # rad/s: the Fig. 5 axis (3-30) minus its ends
     spectrum_step: float = 0.5  # rad/s: reference spectrum grid, locates the jumps
     jump_margin: float = 1.5  # rad/s kept between a threshold frequency and a jump
@@ -102,6 +104,10 @@ class CampaignConfig:
         if self.engine_dt is not None and not (math.isfinite(self.engine_dt)
                                                and 0.0 < self.engine_dt <= 0.01):
             raise ValueError(f"engine_dt must be in (0, 0.01] s, got {self.engine_dt!r}")
+        for case in self.spectrum_cases:
+            if case not in ("pendulum", "no_pendulum"):
+                raise ValueError(f"spectrum_cases: unknown case {case!r}; allowed: pendulum, "
+                                 "no_pendulum")
         lo, hi = self.omega_range
         if not 0.0 < lo < hi:
             raise ValueError(f"omega_range must satisfy 0 < lo < hi, got {self.omega_range!r}")
@@ -109,8 +115,8 @@ class CampaignConfig:
     @classmethod
     def quick(cls, **changes) -> "CampaignConfig":
         """Smaller grids for ``--quick`` (< 2 min on 2 cores)."""
-        base = dict(restitution_lams=(3.0, 7.0), restitution_mus=(0.5, 2.0), pendulum_lams=(5.0,),
-                    n_frequencies=1, include_jump=False, rel_tol=4e-3)
+        base = dict(restitution_lams=(3.0, 7.0), restitution_mus=(1.0,), pendulum_lams=(5.0,),
+                    n_impacts=3, n_frequencies=1, include_jump=False, rel_tol=4e-3)
         base.update(changes)
         return cls(**base)
 
@@ -147,30 +153,22 @@ def _job_history(name, scene, point, config):
     return get_backend(name).simulate(scene, Pulse(amp, omega), settings)
 
 
-def _job_restitution(name, scene, config):
+def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = None
+                             ) -> metrics.RestitutionComparison:
+    """Release ``scene`` at rest from ``theta0_fraction * alpha`` in backend ``name``
+    (no base motion) and measure the first ``n_impacts`` impacts against Eq. 19/20."""
+    from engines.restitution import analytic_impact_times
+
+    config = config or CampaignConfig()
+
     theta0 = config.theta0_fraction * scene.alpha
-    settings = _free_rocking_settings(name, config, theta0)
-    t_max = _free_rocking_duration(scene, theta0, config.n_impacts)
-    settings = dataclasses.replace(settings, t_max=t_max)
+    # Run just past impact n (halfway to n + 1), timed by the analytic model.
+    times = analytic_impact_times(scene, theta0, 0.0, config.n_impacts + 1)
+    t_max = (0.5 * (times[-2] + times[-1]) if len(times) > config.n_impacts
+             else (times[-1] if times else 0.0) + 0.5)
+    settings = dataclasses.replace(_free_rocking_settings(name, config, theta0), t_max=t_max)
     traj = get_backend(name).simulate(scene, Still(), settings)
     return metrics.restitution_from_trajectory(traj, scene, config.n_impacts)
-
-
-def _free_rocking_duration(scene, theta0: float, n_impacts: int) -> float:
-    """Run length [s] that holds ``n_impacts`` impacts of free rocking from ``theta0``.
-
-    Housner's quarter period of a block, ``acosh(1/(1 - theta0/alpha))/p`` with
-    ``p^2 = g M' / I'`` from the frame's gravity stiffness and inertia, bounds the
-    first quarter cycle; later cycles are shorter (the amplitude decays), so
-    ``2 n + 1`` quarter cycles are enough.
-    """
-    from analytic import equations as eq
-    b, h, mu, gamma, j, _l, g = scene.model_args()
-    inertia = eq.rocking_inertia(b, h, mu, gamma, j)
-    p = math.sqrt(g * eq.total_mass(mu, gamma) * math.hypot(b, h) / inertia)
-    ratio = min(theta0 / scene.alpha, 0.95)
-    quarter = math.acosh(1.0 / (1.0 - ratio)) / p
-    return (2 * n_impacts + 1) * quarter
 
 
 def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omega: float):
@@ -200,7 +198,7 @@ def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
                                  reference_backend=config.spectrum_backend)
 
 
-_JOBS = {"history": _job_history, "restitution": _job_restitution,
+_JOBS = {"history": _job_history, "restitution": free_rocking_restitution,
          "threshold": _job_threshold, "jump": _job_jump}
 
 
@@ -291,12 +289,13 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     # Reference spectra first (in this process: the compiled kernels are then
     # inherited by the forked workers).
     t0 = time.perf_counter()
-    ref_spectra = {pend: reference_spectrum(sc, config) for pend, sc in scenes.items()}
+    ref_spectra = {pend: reference_spectrum(sc, config) for pend, sc in scenes.items()
+                   if ("pendulum" if pend else "no_pendulum") in config.spectrum_cases}
     result.timings["reference_spectra"] = time.perf_counter() - t0
 
     jobs, labels = [], []
-    for pend, sc in scenes.items():
-        spec = ref_spectra[pend]
+    for pend, spec in ref_spectra.items():
+        sc = scenes[pend]
         for omega, a_ref, mode in choose_frequencies(spec, config):
             for name in config.engines:
                 jobs.append(("threshold", (name, sc, omega, a_ref, mode, config)))

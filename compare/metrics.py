@@ -127,6 +127,12 @@ def _first_impact(traj: Trajectory) -> float | None:
     return float(impacts[0].t) if impacts else None
 
 
+def _first_past(traj: Trajectory, angle: float) -> float | None:
+    """First sample time with ``|theta| >= angle``, or None."""
+    idx = np.flatnonzero(np.abs(traj.theta) >= angle)
+    return float(traj.t[idx[0]]) if idx.size else None
+
+
 def _errors(ref: Trajectory, test: Trajectory, name: str, t0: float, t1: float,
             scale: float) -> tuple[float, float]:
     """RMS and max of ``(test - ref)/scale`` on a uniform grid over ``[t0, t1]``."""
@@ -153,8 +159,10 @@ class TrajectoryComparison:
     """A backend's theta(t), psi(t) against the reference (analytic) run.
 
     Angle errors are ``(test - reference)/alpha`` on a uniform 1 ms grid.
-    ``*_first``: from the earlier uplift to the earlier first impact (or the end
-    of the common window if neither impacts); ``*_all``: over the common window,
+    ``*_first``: from the earlier uplift to the earlier first impact, or the
+    first time either run reaches ``|theta| = alpha`` (past it the fall is
+    unstable and amplifies any difference), or the end of the common window;
+    ``*_all``: over the common window,
     up to the earlier of the two end times / overturn times.  Time errors are
     ``test - reference`` [s]; impacts are matched in order.
     """
@@ -220,7 +228,12 @@ def compare_trajectories(reference: Trajectory, test: Trajectory,
     t_begin = max(float(reference.t[0]), float(test.t[0]))
     ups = [u for u in (reference.uplift_time, test.uplift_time) if u is not None]
     t_start = max(min(ups), t_begin) if ups else t_begin
-    firsts = [f for f in (_first_impact(reference), _first_impact(test)) if f is not None]
+    # The "first" window also ends where either run passes alpha: beyond it the
+    # trilith falls (unstable equilibrium), any timing difference grows
+    # exponentially and says nothing about the engine's accuracy.
+    firsts = [f for f in (_first_impact(reference), _first_impact(test),
+                          _first_past(reference, alpha), _first_past(test, alpha))
+              if f is not None]
     t_fi = min(min(firsts), t_end) if firsts else t_end
 
     th_rf, th_mf = _errors(reference, test, "theta", t_start, t_fi, alpha)

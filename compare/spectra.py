@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-__all__ = ["reference_spectrum", "choose_frequencies", "find_jumps"]
+__all__ = ["reference_spectrum", "choose_frequencies", "find_jumps",
+           "first_overturning_amplitude"]
 
 
 def _spectrum_module():
@@ -66,6 +67,21 @@ def _scan_fallback(scene, omegas: np.ndarray, tol: float = 0.01,
     return amps, modes
 
 
+def first_overturning_amplitude(scene, omega: float) -> tuple[float, str | None]:
+    """The analytic first overturning amplitude [m/s^2] at one frequency, and its mode."""
+    if not (math.isfinite(omega) and omega > 0.0):
+        raise ValueError(f"omega must be finite and > 0 rad/s, got {omega!r}")
+    amps, modes = _amplitudes(scene, np.array([float(omega)]))
+    return float(amps[0]), modes[0]
+
+
+def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
+    module = _spectrum_module()
+    if module is not None and hasattr(module, "first_overturning_amplitudes"):
+        return module.first_overturning_amplitudes(scene, omegas)
+    return _scan_fallback(scene, omegas)
+
+
 def find_jumps(omega, amp, mode) -> list[dict]:
     """Consecutive grid points whose overturning mode differs: one jump each."""
     jumps = []
@@ -90,12 +106,8 @@ def reference_spectrum(scene, config) -> dict:
     with the largest threshold step, measured in engines), ``backend``, ``tol``.
     """
     omegas = _grid(config)
-    module = _spectrum_module()
     tol = 0.01
-    if module is not None and hasattr(module, "first_overturning_amplitudes"):
-        amps, modes = module.first_overturning_amplitudes(scene, omegas)
-    else:
-        amps, modes = _scan_fallback(scene, omegas, tol)
+    amps, modes = _amplitudes(scene, omegas)
     amps = [float(a) for a in amps]
     jumps = find_jumps(omegas, amps, modes)
     lo, hi = config.omega_range

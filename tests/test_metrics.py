@@ -194,3 +194,18 @@ def test_jump_frequency_shift(fake_engine):
     assert j.omega_engine == pytest.approx(10.3, abs=0.01)  # found after one widening
     assert j.shift == pytest.approx(0.3, abs=0.02)
     assert j.to_dict()["shift"] == pytest.approx(j.shift)
+
+
+def test_first_window_ends_where_a_run_passes_alpha():
+    # No impact; the test run falls faster once past alpha: that part must not
+    # count in the "before first impact" error.
+    t = np.linspace(0.0, 2.0, 2001)
+    ref_theta = np.where(t < 1.0, 0.1 * t, 0.1 + 0.5 * (t - 1.0))
+    test_theta = np.where(t < 1.0, 0.1 * t, 0.1 + 0.9 * (t - 1.0))
+    ref = _traj(t, ref_theta, events=[Event("uplift", 0.0)])
+    test = _traj(t, test_theta, events=[Event("uplift", 0.0)])
+    c = metrics.compare_trajectories(ref, test, alpha=0.15)
+    # test reaches alpha = 0.15 at t = 1 + 0.05/0.9; the reference later.
+    assert c.t_first_impact == pytest.approx(1.0 + 0.05 / 0.9, abs=1e-3)  # 1 ms samples
+    assert c.theta_max_first <= 0.4 * 0.06 / 0.15 + 1e-9  # only the start of the divergence
+    assert c.theta_max_all > c.theta_max_first

@@ -1,0 +1,80 @@
+"""Regression: every engine tied to the paper's equations with its calibrated defaults.
+
+* free rocking restitution against Eq. 20 within 0.5 % (the issue's acceptance)
+  on a small lam x mu grid (the grid's corners and centre);
+* with the pendulum, against Eq. 19 at the measured psi, within the campaign's
+  stated tolerance (``Tolerances.restitution_pendulum``);
+* one overturning threshold per engine within 2 % of the analytic one at a
+  frequency away from mode jumps.
+
+The expected values are the corrected equations (Eq. 19/20, checked against an
+independent sympy derivation in tests/test_derivation.py) and the analytic
+model's threshold computed here, never numbers recorded from an engine run.
+"""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from compare.campaign import CampaignConfig, Tolerances, backend_settings, free_rocking_restitution
+from compare.spectra import first_overturning_amplitude
+from compare.thresholds import engine_threshold
+from engines import ENGINES
+from scenes import load_scene
+
+TOL = Tolerances()
+CONFIG = CampaignConfig()  # calibrated engine settings, theta0 = alpha/2, 4 impacts
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("lam, mu", [(3.0, 0.5), (5.0, 1.0), (7.0, 2.0)])
+def test_restitution_matches_eq20(engine, lam, mu):
+    scene = load_scene("no_pendulum").replace(lam=lam, mu=mu)
+    r = free_rocking_restitution(engine, scene, CONFIG)
+    assert len(r.impacts) == CONFIG.n_impacts, "engine lost impacts"
+    # Eq. 20 for a uniform column frame with gamma = 0 reduces, at mu = 0, to
+    # Housner; here mu > 0: the prediction must lie between Housner and 1.
+    housner = 1.0 - 1.5 * math.sin(scene.alpha) ** 2
+    assert all(housner < i.predicted < 1.0 for i in r.impacts)
+    errors = [abs(i.rel_error) for i in r.impacts]
+    assert max(errors) <= TOL.restitution, errors  # issue acceptance: 0.5 %
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_restitution_with_pendulum_matches_eq19(engine):
+    scene = load_scene("fig5")
+    r = free_rocking_restitution(engine, scene, CONFIG)
+    assert len(r.impacts) == CONFIG.n_impacts
+    assert r.equation == "Eq. 19"
+    # The pendulum swings during free rocking, so Eq. 19 is evaluated at a
+    # different psi at each impact; the check is meaningful only if psi moved.
+    assert max(abs(i.psi) for i in r.impacts) > 1e-3
+    errors = [abs(i.rel_error) for i in r.impacts]
+    # Tolerance reason: Tolerances.restitution_pendulum (psi read at theta=0 from
+    # samples propagated across the impact).
+    assert max(errors) <= TOL.restitution_pendulum, errors
+
+
+# Omega = 7 rad/s: 3 rad/s below the first mode jump of the Fig. 5 spectrum with the
+# pendulum (between 10 and 10.5 rad/s) and far from the one without (17.5-18).
+OMEGA = 7.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_overturning_threshold_within_2_percent(engine):
+    scene = load_scene("fig5")
+    a_ref, mode_ref = first_overturning_amplitude(scene, OMEGA)
+    # Mode check: the model's threshold at this frequency involves an impact, so
+    # the point is on the smooth after-impact branch, not at a jump.
+    assert mode_ref == "after-impact"
+    p = engine_threshold(engine, scene, OMEGA, a_ref, backend_settings(engine, CONFIG),
+                         mode_reference=mode_ref, rel_tol=4e-3)
+    assert p.bracketed
+    assert p.irregular_runs == 0
+    # Issue acceptance: 2 % away from jumps; the bisection resolves 0.4 %.
+    assert abs(p.rel_error) <= TOL.threshold, (p.a_engine, a_ref)
+    assert p.mode_engine == mode_ref
