@@ -245,3 +245,15 @@ def test_trajectory_metadata(fig5):
     assert tr.diagnostics["steps"] == pytest.approx(0.2 / 1e-4, abs=1)
     # samples every sample_every steps: 1 ms
     assert np.allclose(np.diff(tr.t), 1e-3)
+
+
+def test_friction_at_the_bound_prevents_sliding_while_rocking(fig5):
+    # Point D, the largest peak of the paper's points, run with the friction the
+    # bound asks for: in the rocking regime the pivots stay put.  0.1 mm: the
+    # drift measured with friction 10 is 0.03 mm (contact compliance, not slip),
+    # a Coulomb slip would run to millimetres within one pulse.
+    pulse = Pulse(25.0, 11.0)
+    need = pe.required_friction(fig5, pulse)
+    tr = pe.simulate(fig5, pulse, pe.Settings(friction=need * 1.0001))
+    assert tr.verdict.status == "overturned"
+    assert tr.diagnostics["pivot_sliding_max"] < 1e-4
