@@ -39,13 +39,15 @@ class TrilithShape:
     """Outlines of one trilith state in the ground-fixed drawing frame [m].
 
     ``columns``: two (4, 2) arrays (left column first), corners counter-clockwise
-    from the bottom-left one.  ``lintel``: (4, 2) array, same order.  ``hinge``
+    from the bottom-left one.  ``lintel``: (4, 2) array, same order; ``None``
+    when the scene has no lintel (``mu = 0`` and no pendulum to carry: the
+    engines then build no lintel body and the columns are free blocks).  ``hinge``
     and ``bob``: (2,) arrays, ``None`` without a pendulum.  ``ground_x``: the
     ground displacement ``x_g`` the shape was drawn with.
     """
 
     columns: tuple[np.ndarray, np.ndarray]
-    lintel: np.ndarray
+    lintel: np.ndarray | None
     hinge: np.ndarray | None
     bob: np.ndarray | None
     ground_x: float
@@ -101,7 +103,9 @@ def trilith_shape(scene: Scene, theta: float, psi: float = 0.0, x_g: float = 0.0
     corner = np.array([side * b, h])
     lift = rot @ corner - corner
     length = scene.lintel_length
-    lintel = _rectangle(-0.5 * length, h, length, scene.lintel_thickness) + lift + shift
+    lintel = None
+    if scene.mu > 0.0 or scene.has_pendulum:
+        lintel = _rectangle(-0.5 * length, h, length, scene.lintel_thickness) + lift + shift
     hinge = bob = None
     if scene.has_pendulum:
         hinge = np.array([scene.hinge_x, h]) + lift + shift
@@ -135,7 +139,7 @@ def view_limits(scene: Scene, theta, psi, x_g, margin: float = 0.08, headroom: f
     for k in {int(np.argmin(theta)), int(np.argmax(theta)), int(np.argmin(x_g)),
               int(np.argmax(x_g)), 0, theta.size - 1}:
         shape = trilith_shape(scene, float(theta[k]), float(psi[k]), float(x_g[k]))
-        pts = np.vstack([*shape.columns, shape.lintel])
+        pts = np.vstack([*shape.columns] + ([shape.lintel] if shape.lintel is not None else []))
         xs += [pts[:, 0].min(), pts[:, 0].max()]
         ys += [pts[:, 1].max()]
     if scene.has_pendulum:
@@ -162,6 +166,7 @@ class TrilithArtist:
                                 ec=COLORS["edge"], lw=1.0) for _ in range(2)]
         self.lintel = Polygon(np.zeros((4, 2)), closed=True, fc=COLORS["lintel"],
                               ec=COLORS["edge"], lw=1.0)
+        self.lintel.set_visible(trilith_shape(scene, 0.0).lintel is not None)
         for patch in (*self.columns, self.lintel):
             ax.add_patch(patch)
         self.rod = self.bob = None
@@ -191,7 +196,8 @@ class TrilithArtist:
         shape = trilith_shape(self.scene, theta, psi, x_g)
         for patch, outline in zip(self.columns, shape.columns):
             patch.set_xy(outline)
-        self.lintel.set_xy(shape.lintel)
+        if shape.lintel is not None:
+            self.lintel.set_xy(shape.lintel)
         if self.rod is not None:
             self.rod.set_data([shape.hinge[0], shape.bob[0]], [shape.hinge[1], shape.bob[1]])
             self.bob.center = (float(shape.bob[0]), float(shape.bob[1]))

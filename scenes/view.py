@@ -69,12 +69,14 @@ def _pybullet_gui(scene: Scene, excitation, duration: float) -> bool:
 
 
 def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
-         duration: float | None = None) -> dict:
+         duration: float | None = None, scene_arg: str | None = None) -> dict:
     """Show a run in a window: PyBullet's GUI if available, else a matplotlib
     animation drawn from the backend's Trajectory (several panels for ``'all'``).
 
     Returns the trajectories shown (backend -> Trajectory); empty when PyBullet's
-    own GUI was used.  Raises ``ValueError`` when there is no display.
+    own GUI was used.  Raises ``ValueError`` when there is no display, with the
+    equivalent ``trilith record`` command (``scene_arg``: the ``--scene`` value
+    to quote in it, by default ``scene.name``).
     """
     from scenes.record import (RecordSettings, Panels, default_duration, frame_times,
                                load_backend, resolve_engines, run_backend)
@@ -95,7 +97,7 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
         amplitude = getattr(excitation, "amplitude", 0.0)
         omega = getattr(excitation, "omega", 0.0)
         raise ValueError(f"cannot open a window: {problem}. Record the run to a file "
-                         f"instead: {record_hint(scene.name, engine, amplitude, omega)}")
+                         f"instead: {record_hint(scene_arg or scene.name, engine, amplitude, omega)}")
     for name in names:
         load_backend(name)
     span = settings.duration if settings.duration is not None else default_duration(excitation)
@@ -110,8 +112,10 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     figure = plt.figure(figsize=(4.8 * len(names), 3.6))
     panels = Panels(scene, excitation, times, trajectories, figure)
     # Keep a reference: an unreferenced FuncAnimation is garbage-collected and stops.
+    # blit: only the moving artists are redrawn (Panels.update returns them), which
+    # keeps the window near real time with several panels.
     animation = FuncAnimation(figure, panels.update, frames=np.arange(len(panels)),
-                              interval=1000.0 / settings.fps, blit=False, repeat=True)
+                              interval=1000.0 / settings.fps, blit=True, repeat=True)
     figure.animation = animation
     plt.show()
     return trajectories

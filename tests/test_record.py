@@ -86,6 +86,13 @@ def test_mirror_symmetry_and_pendulum():
     assert trilith_shape(s.without_pendulum(), 0.3).bob is None
 
 
+def test_lintel_only_when_there_is_one():
+    # single_block: mu = 0 and no pendulum, the engines build no lintel body.
+    assert trilith_shape(load_scene("single_block"), 0.1).lintel is None
+    # mu = 0 with a pendulum: the (massless) lintel still carries the hinge.
+    assert trilith_shape(load_scene("single_block", gamma=0.3), 0.1).lintel is not None
+
+
 def test_bad_state_is_rejected():
     with pytest.raises(ValueError, match="theta"):
         trilith_shape(FIG5, math.nan)

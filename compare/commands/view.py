@@ -23,5 +23,5 @@ def add_parser(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     pulse = pulse_from_args(args)
-    view(scene, pulse, args.engine, fps=args.fps, duration=args.duration)
+    view(scene, pulse, args.engine, fps=args.fps, duration=args.duration, scene_arg=args.scene)
     return 0
