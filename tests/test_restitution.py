@@ -22,7 +22,7 @@ from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
 from compare.cli import main
 from engines import BACKENDS
 from engines._common import MonitorSettings
-from engines.restitution import (RestitutionResult, analytic_impact_times,
+from engines.restitution import (analytic_impact_times,
                                  measure_restitution)
 
 
