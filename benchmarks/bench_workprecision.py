@@ -1,0 +1,159 @@
+"""Work-precision benchmarks: run time against error for every backend (issue 6).
+
+``make bench`` (via ``benchmarks/run.py``) and ``trilith bench [--quick] [--out DIR]``
+call :func:`main`.  It measures
+
+* the analytic accurate path (scipy DOP853) and the compiled fast path across
+  their tolerances (:mod:`benchmarks.workprecision_analytic`);
+* PyBullet and Pymunk across the time step and their main solver settings
+  (:mod:`benchmarks.workprecision_engines`);
+
+marks each backend's Pareto front and its default settings, and writes to
+``benchmarks/out/`` (or ``--out``): ``workprecision.json`` (every point, the
+machine, versions, date), ``workprecision_<metric>.png`` (log-log plots) and
+``workprecision.md`` (the tables that ``docs/benchmarks.md`` quotes).
+
+Full run: ~10 min on 2 cores; ``--quick``: < 2 min (fewer tolerances, two time
+steps, no solver sweeps, coarser threshold bisection).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
+    plot_work_precision, write_json
+
+__all__ = ["main", "run", "markdown_tables", "default_report"]
+
+METRICS = {
+    "theta-grid": ("analytic: max |theta - theta_ref| / alpha on a 1 ms grid (4 s window)",
+                   "max |dtheta| / alpha"),
+    "threshold": ("overturning threshold, Fig. 5 trilith, Omega = 4 rad/s",
+                  "|A - A_ref| / A_ref"),
+    "restitution": ("engines: free-rocking restitution vs Eq. 20 (no pendulum)",
+                    "max |r / r_Eq20 - 1|"),
+    "theta-rms": ("engines: RMS(theta - theta_analytic) before the 1st impact / alpha",
+                  "RMS / alpha"),
+}
+
+
+def run(quick: bool = False, out: Path | None = None, engines=("pybullet", "pymunk"),
+        analytic: bool = True, log=print) -> dict:
+    """Measure, mark fronts, write JSON, plots and tables; return the payload."""
+    from .workprecision_analytic import run_analytic
+    from .workprecision_engines import run_engines
+
+    out = Path(out) if out is not None else OUT_DIR
+    machine = machine_info()
+    start = time.perf_counter()
+    points: list[Point] = []
+    if analytic:
+        log("analytic paths:")
+        points += run_analytic(quick, log=log)
+    if engines:
+        log("engines:")
+        points += run_engines(quick, engines=engines, log=log)
+    mark_front(points)
+    elapsed = time.perf_counter() - start
+    machine["loadavg_end"] = machine_info()["loadavg"]
+    meta = {"quick": quick, "elapsed_s": round(elapsed, 1), "metrics": {k: v[0] for k, v in
+                                                                          METRICS.items()}}
+    write_json(out / "workprecision.json", machine, points, meta)
+    for metric, (title, ylabel) in METRICS.items():
+        plot_work_precision(points, metric, out / f"workprecision_{metric}.png", title, ylabel)
+    (out / "workprecision.md").write_text(markdown_tables(points, machine, meta))
+    log(f"wrote {out}/workprecision.json, .md and plots in {elapsed:.0f} s")
+    for line in default_report(points):
+        log(line)
+    return {"machine": machine, "meta": meta, "points": points}
+
+
+def _fmt_params(params: dict) -> str:
+    return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                     for k, v in params.items())
+
+
+def markdown_tables(points: list[Point], machine: dict, meta: dict) -> str:
+    """One table per metric: family, settings, error, median time, time ratio to
+    the backend's default, Pareto flag."""
+    lines = [f"Machine: {machine['nproc']} cores, {machine['cpu']}; load average "
+             f"{machine['loadavg']} at start, {machine.get('loadavg_end')} at end; "
+             f"{machine['date']}.",
+             "Versions: " + ", ".join(f"{k} {v}" for k, v in machine["versions"].items()) + ".",
+             f"Mode: {'quick' if meta['quick'] else 'full'}; run took {meta['elapsed_s']} s.", ""]
+    for metric, (title, _) in METRICS.items():
+        sel = [p for p in points if p.metric == metric]
+        if not sel:
+            continue
+        lines += [f"### {metric}: {title}", "",
+                  "| family | settings | error | time [s] | time / default | front | default |",
+                  "|---|---|---|---|---|---|---|"]
+        for p in sel:
+            backend = p.family.split()[0]
+            base = [q for q in sel if q.default and q.family.split()[0] == backend]
+            ratio = (p.time / base[0].time if base and math.isfinite(p.time)
+                     and base[0].time > 0 else math.nan)
+            err = f"{p.error:.2e}" if math.isfinite(p.error) else "failed"
+            if metric == "threshold" and p.extra.get("resolved") is False:
+                err = f"< {0.5 * p.extra['bracket_rel']:.1e} (unresolved)"
+            lines.append(f"| {p.family} | {_fmt_params(p.params)} | {err} | {p.time:.3g} | "
+                         f"{ratio:.2f} | {'yes' if p.on_front else ''} | "
+                         f"{'**default**' if p.default else ''} |")
+        lines.append("")
+    lines += ["### Defaults against the Pareto front", ""]
+    lines += [f"- {line}" for line in default_report(points)]
+    return "\n".join(lines) + "\n"
+
+
+def default_report(points: list[Point]) -> list[str]:
+    """For each backend and metric: is the default on the front, and if not, the
+    cheapest front point at least as accurate."""
+    out = []
+    groups: dict[tuple[str, str], list[Point]] = {}
+    for p in points:
+        groups.setdefault((p.family.split()[0], p.metric), []).append(p)
+    for (backend, metric), group in sorted(groups.items()):
+        defaults = [p for p in group if p.default]
+        if not defaults:
+            continue
+        d = defaults[0]
+        if d.on_front:
+            out.append(f"{backend} / {metric}: default on the Pareto front "
+                       f"(error {d.error:.2e}, {d.time:.3g} s)")
+            continue
+        better = [p for p in group if p.on_front and p.error <= d.error and p.time <= d.time]
+        if better:
+            b = min(better, key=lambda p: p.time)
+            out.append(f"{backend} / {metric}: default NOT on the front: "
+                       f"{_fmt_params(b.params)} gives error {b.error:.2e} in {b.time:.3g} s "
+                       f"vs default {d.error:.2e} in {d.time:.3g} s")
+        else:
+            out.append(f"{backend} / {metric}: default off the front (error {d.error:.2e}, "
+                       f"{d.time:.3g} s)")
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``python -m benchmarks.bench_workprecision`` and of
+    ``benchmarks/run.py`` (which calls ``main()`` with no arguments: full run)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="the < 2 min variant")
+    parser.add_argument("--out", type=Path, default=None, help=f"output directory [{OUT_DIR}]")
+    parser.add_argument("--engines", default="pybullet,pymunk",
+                        help="comma-separated engines, or 'none' [pybullet,pymunk]")
+    parser.add_argument("--no-analytic", action="store_true", help="skip the analytic paths")
+    args = parser.parse_args([] if argv is None else argv)
+    engines = () if args.engines == "none" else tuple(e for e in args.engines.split(",") if e)
+    for e in engines:
+        if e not in ("pybullet", "pymunk"):
+            raise ValueError(f"--engines: unknown engine {e!r}; allowed: pybullet, pymunk, none")
+    run(quick=args.quick, out=args.out, engines=engines, analytic=not args.no_analytic)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
