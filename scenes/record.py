@@ -48,8 +48,9 @@ class RecordSettings:
     """How a run is turned into frames.
 
     fps : frames per second of the recording, in (0, 120].  Default 30: smooth for
-        rocking (a few Hz); GIF stores delays in 10 ms units, so 30 fps plays at
-        33 ms per frame (1 % slow), which is invisible.
+        rocking (a few Hz).  GIF stores delays in 10 ms units: 30 fps is written
+        as 30 ms per frame, so a GIF plays 10 % fast (25 or 20 fps play exactly);
+        MP4 keeps the exact rate.
     duration : recorded time span [s], > 0; ``None`` gives ten pulse periods
         (the paper's ``t_max``, Sec. 5.1).
     panel_width, panel_height : pixels of one backend's panel, even numbers in
