@@ -1,0 +1,38 @@
+"""Benchmarks (not tests): run times and the accuracy they buy.
+
+``make bench`` runs :mod:`benchmarks.run`, which calls ``main()`` of every
+``benchmarks/bench_*.py``.  Results are printed and written as JSON to
+``benchmarks/out/`` (git-ignored).  Wall-clock numbers live here, never in tests.
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+from datetime import datetime, timezone
+from pathlib import Path
+
+OUT = Path(__file__).resolve().parent / "out"
+
+
+def machine() -> dict:
+    """What a timing depends on: cores, load, versions, date (UTC)."""
+    import numba
+    import numpy
+    import scipy
+    try:
+        load = os.getloadavg()
+    except OSError:
+        load = None
+    return {"nproc": os.cpu_count(), "loadavg": load, "python": platform.python_version(),
+            "numpy": numpy.__version__, "scipy": scipy.__version__,
+            "numba": numba.__version__, "platform": platform.platform(),
+            "date": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+
+
+def write(name: str, payload: dict) -> Path:
+    """Write ``benchmarks/out/<name>.json`` (strict JSON) and return its path."""
+    OUT.mkdir(parents=True, exist_ok=True)
+    path = OUT / f"{name}.json"
+    path.write_text(json.dumps(payload, indent=1, allow_nan=False))
+    return path
