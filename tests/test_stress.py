@@ -255,3 +255,108 @@ def test_shallow_excursion_after_impact(backend, warm_fast):
     check_run(tr, scene)
     assert tr.verdict.status == "survived"
     assert tr.n_impacts > 4
+
+
+# --- engines ---------------------------------------------------------------------------
+ENGINE_GRID = (  # (lam, mu, gamma, l/h, A/g, Omega, dt): corners of the brief's box
+    (1.5, 10.0, 1.0, 0.1, 50.0, 100.0, 1e-2),
+    (30.0, 10.0, 1.0, 2.0, 50.0, 100.0, 1e-2),
+    (30.0, 0.0, 0.0, 1.0, 0.1, 0.5, 1e-2),
+    (1.5, 0.0, 0.0, 1.0, 0.1, 0.5, 1e-3),
+    (1.5, 10.0, 1.0, 2.0, 50.0, 0.5, 1e-3),
+    (30.0, 10.0, 0.0, 1.0, 50.0, 0.5, 2e-2),
+    (5.0, 1.0, 0.3, 2 / 3, 0.35, 6.0, 2e-2),
+    (10.0, 4.0, 0.6, 1.2, 0.2, 20.0, 5e-3),
+)
+
+
+def _engine_settings(name, scene, pulse, **changes):
+    """Engine defaults with ``changes``; enough friction for rocking without sliding
+    (the engines refuse less, see their ``required_friction``), 1 sample per step
+    at coarse steps."""
+    from engines import get_backend
+
+    backend = get_backend(name)
+    base = backend.Settings()
+    if name == "pymunk":
+        changes.setdefault("friction", max(base.friction,
+                                           1.01 * backend.required_friction(scene, pulse)))
+    if "dt" in changes:
+        changes.setdefault("sample_every", max(1, round(1e-3 / changes["dt"])))
+    import dataclasses
+    return backend, dataclasses.replace(base, **changes)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["pybullet", "pymunk"])
+@pytest.mark.parametrize("point", ENGINE_GRID,
+                         ids=lambda p: "lam{}-mu{}-g{}-l{:.2g}-A{}g-w{}-dt{}".format(*p))
+def test_engine_grid(name, point):
+    """Every engine run on the extreme grid ends with a verdict and finite arrays."""
+    lam, mu, gamma, lf, ag, w, dt = point
+    scene = _scene(lam, mu, gamma, lf)
+    pulse = Pulse(ag * G, w)
+    backend, st = _engine_settings(name, scene, pulse, dt=dt, t_max=pulse.end_time + 2.0)
+    tr = backend.simulate(scene, pulse, st)
+    for arr in (tr.t, tr.theta, tr.theta_dot, tr.psi, tr.psi_dot):
+        assert arr.size > 0 and np.all(np.isfinite(arr))
+    # t_max is set: a run that neither overturns nor blows up is 'survived'.
+    assert tr.verdict.status in ("survived", "overturned", "unstable"), tr.verdict
+    for e in tr.impacts:
+        assert math.isfinite(e.theta_dot_before) and math.isfinite(e.theta_dot_after)
+
+
+@pytest.mark.parametrize("name", ["pybullet", "pymunk"])
+def test_engine_invalid_step_raises(name):
+    """A step past the engines' cap (0.1 s) is refused before any stepping, naming dt."""
+    scene = Scene()
+    pulse = Pulse(3.0, 6.0)
+    backend, st = _engine_settings(name, scene, pulse, dt=0.2)
+    with pytest.raises(ValueError, match="dt"):
+        backend.simulate(scene, pulse, st)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["pybullet", "pymunk"])
+@pytest.mark.parametrize("dt", [1e-3, 1e-4])
+def test_engine_reruns_bit_identical(name, dt):
+    """Same scene, pulse and settings: the same numbers, bit for bit (each run
+    builds a fresh world; nothing leaks between runs)."""
+    scene = Scene()
+    pulse = Pulse(3.0, 6.0)
+    backend, st = _engine_settings(name, scene, pulse, dt=dt, t_max=1.2)
+    first = backend.simulate(scene, pulse, st)
+    second = backend.simulate(scene, pulse, st)
+    assert first.verdict == second.verdict
+    for field in ("t", "theta", "theta_dot", "psi", "psi_dot"):
+        assert np.array_equal(getattr(first, field), getattr(second, field)), field
+    assert [e.to_dict() for e in first.events] == [e.to_dict() for e in second.events]
+    assert first.max_abs_theta > 1e-3  # it did rock (uplift at 0.26 s)
+
+
+def test_pymunk_blowup_is_unstable():
+    """A point-like bob (own inertia 1e-18 of the pendulum's) at a coarse step with one
+    solver iteration makes Chipmunk's joint solve divide by ~0: the state goes
+    non-finite.  The run must end 'unstable' with finite returned arrays."""
+    scene = Scene(lam=1.5, mu=10.0, gamma=1.0, l=0.09)
+    pulse = Pulse(0.5 * G, 20.0)
+    backend, st = _engine_settings("pymunk", scene, pulse, dt=1e-2, iterations=1,
+                                   pendulum_radius_fraction=1e-9, t_max=3.0)
+    tr = backend.simulate(scene, pulse, st)
+    assert tr.verdict.status == "unstable", tr.verdict
+    assert any(e.kind == "unstable" for e in tr.events)
+    for arr in (tr.t, tr.theta, tr.theta_dot, tr.psi, tr.psi_dot):
+        assert np.all(np.isfinite(arr))
+
+
+def test_pybullet_blowup_is_unstable():
+    """A 1 cm wide, 30 cm tall trilith carrying a pendulum ten times a column's mass,
+    hit by 50 g at 100 rad/s with a 0.1 s step: the pendulum body is flung away.
+    The run must end 'unstable' with finite returned arrays."""
+    scene = Scene(b=0.01, lam=30.0, mu=0.01, gamma=10.0, l=0.03)
+    pulse = Pulse(50 * G, 100.0)
+    backend, st = _engine_settings("pybullet", scene, pulse, dt=0.1, t_max=3.0)
+    tr = backend.simulate(scene, pulse, st)
+    assert tr.verdict.status == "unstable", tr.verdict
+    for arr in (tr.t, tr.theta, tr.theta_dot, tr.psi, tr.psi_dot):
+        assert np.all(np.isfinite(arr))
