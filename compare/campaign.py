@@ -203,10 +203,20 @@ _JOBS = {"history": _job_history, "restitution": free_rocking_restitution,
 
 
 def _run_one(item):
+    """Run one job; an exception becomes an error record (one bad engine run must
+    not sink a 10-minute campaign; the verdict table then reports it unmeasured)."""
     kind, args = item
     t0 = time.perf_counter()
-    out = _JOBS[kind](*args)
+    try:
+        out = _JOBS[kind](*args)
+    except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
+        out = _JobError(f"{type(exc).__name__}: {exc}")
     return out, time.perf_counter() - t0
+
+
+@dataclass(frozen=True)
+class _JobError:
+    message: str
 
 
 def _progress(total: int):
@@ -247,6 +257,16 @@ def _indexed(pair):
     return i, _run_one(job)
 
 
+def _describe_args(args) -> list:
+    """Job arguments for the error record (scenes and configs by name)."""
+    out = []
+    for a in args:
+        if isinstance(a, CampaignConfig):
+            continue
+        out.append(a.to_dict() if hasattr(a, "to_dict") else a)
+    return metrics._plain(out)
+
+
 # ------------------------------------------------------------------ campaign
 @dataclass
 class CampaignResult:
@@ -262,12 +282,14 @@ class CampaignResult:
     spectra: dict = field(default_factory=dict)
     verdicts: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
+    errors: list = field(default_factory=list)  # jobs that raised, with the message
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
                 "settings": self.settings, "versions": self.versions,
                 "comparisons": self.comparisons, "restitution": self.restitution,
-                "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings}
+                "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
+                "errors": self.errors}
 
 
 def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
@@ -296,7 +318,7 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     jobs, labels = [], []
     for pend, spec in ref_spectra.items():
         sc = scenes[pend]
-        for omega, a_ref, mode in choose_frequencies(spec, config):
+        for omega, a_ref, mode in choose_frequencies(spec, config, sc):
             for name in config.engines:
                 jobs.append(("threshold", (name, sc, omega, a_ref, mode, config)))
                 labels.append(("threshold", pend, name))
@@ -326,10 +348,14 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     outputs = _execute(jobs, config.workers)
     result.timings["engine_runs_wall"] = time.perf_counter() - t0
     cpu: dict[str, float] = {}
-    for label, (out, wall) in zip(labels, outputs):
+    for label, job, (out, wall) in zip(labels, jobs, outputs):
         kind, pend, name = label[:3]
         cpu[f"{kind}:{name}"] = cpu.get(f"{kind}:{name}", 0.0) + wall
-        case = "pendulum" if pend else "no_pendulum"
+        if isinstance(out, _JobError):
+            result.errors.append({"job": kind, "backend": name, "pendulum": pend,
+                                  "label": [str(x) for x in label[3:]],
+                                  "args": _describe_args(job[1]), "error": out.message})
+            continue
         if kind == "history":
             result.histories[(label[3], pend, name)] = out
         elif kind == "restitution":
@@ -338,11 +364,10 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
             ref_spectra[pend].setdefault("engines", {}).setdefault(name, []).append(out.to_dict())
         elif kind == "jump":
             ref_spectra[pend].setdefault("jump_shifts", {})[name] = out.to_dict()
-        del case
     for (point, pend, name), traj in sorted(result.histories.items(), key=str):
-        if name == config.reference:
+        ref = result.histories.get((point, pend, config.reference))
+        if name == config.reference or ref is None:
             continue
-        ref = result.histories[(point, pend, config.reference)]
         comp = metrics.compare_trajectories(ref, traj, scenes[pend].alpha)
         result.comparisons.append({"point": point, "pendulum": pend, "backend": name,
                                    **comp.to_dict()})

@@ -183,7 +183,13 @@ _H = {
                   "uplift time err [s]", "wall [s]"],
     "restitution": ["engine", "λ", "μ", "γ", "equation", "impacts", "max rel. error"],
     "timings": ["what", "seconds"],
+    "errors": ["job", "engine", "pendulum", "label", "error"],
 }
+
+
+def _error_rows(result) -> list[list]:
+    return [[e["job"], e["backend"], e["pendulum"], " ".join(e["label"]), e["error"]]
+            for e in result.errors]
 
 
 def _restitution_rows(result) -> list[list]:
@@ -202,6 +208,7 @@ def render_markdown(result) -> str:
              "## Restitution", _table(_H["restitution"], _restitution_rows(result), md=True),
              "## Time histories A-D", _table(_H["histories"], _history_rows(result), md=True),
              "## Run times", _table(_H["timings"], _timing_rows(result), md=True),
+             "## Runs that raised", _table(_H["errors"], _error_rows(result), md=True),
              "## Versions", "\n".join(f"- {k}: {v}" for k, v in result.versions.items())]
     return "\n\n".join(parts) + "\n"
 
@@ -238,6 +245,7 @@ def render_html(result) -> str:
              "<p>Bisection in Ω at an amplitude between the two threshold levels of the jump, "
              "in the engine and in the reference.</p>", _table(_H["jumps"], _jump_rows(result)),
              "<h2>Run times</h2>", _table(_H["timings"], _timing_rows(result)),
+             "<h2>Runs that raised</h2>", _table(_H["errors"], _error_rows(result)),
              "<h2>Versions</h2>", _table(["backend", "version"],
                                          [[k, v] for k, v in result.versions.items()])]
     return ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>trilith-xval report"

@@ -1,7 +1,7 @@
 """Reference (analytic) spectra for the campaign and the choice of test frequencies.
 
 The reference is the paper's "first overturning amplitude" per Omega from the
-compiled analytic path (:mod:`analytic.spectrum` when present).  Engines are then
+compiled analytic path (:func:`analytic.spectrum.first_overturn_amplitude`).  Engines are then
 tested at a few grid frequencies kept ``jump_margin`` away from every mode jump
 (where a tiny frequency shift moves the threshold a lot), and at the largest jump
 the frequency shift is measured separately.
@@ -13,15 +13,7 @@ import math
 import numpy as np
 
 __all__ = ["reference_spectrum", "choose_frequencies", "find_jumps",
-           "first_overturning_amplitude"]
-
-
-def _spectrum_module():
-    try:
-        from analytic import spectrum
-    except ImportError:
-        return None
-    return spectrum
+           "first_overturning_amplitude", "monotone_above"]
 
 
 def _grid(config) -> np.ndarray:
@@ -29,42 +21,6 @@ def _grid(config) -> np.ndarray:
     step = config.spectrum_step
     # One grid step beyond each end so a jump right at the range end is still seen.
     return np.round(np.arange(lo - step, hi + 1.5 * step, step), 10)
-
-
-def _scan_fallback(scene, omegas: np.ndarray, tol: float = 0.01,
-                   step: float = 0.25) -> tuple[list, list]:
-    """First overturning amplitude per Omega by an upward scan (``step`` m/s^2) from
-    the uplift acceleration and a bisection to ``tol``; used only when
-    :mod:`analytic.spectrum` is unavailable."""
-    from analytic import fast
-    from analytic.excitation import Pulse
-
-    b, h, mu, gamma, j, l, g = scene.model_args()
-    a_up = g / scene.lam  # Eq. 11: nothing moves below it (pendulum hanging still)
-    amps, modes = [], []
-    for w in omegas:
-        lo, a = a_up, a_up
-        v = None
-        while a < 200.0:
-            v = fast.verdict_for(scene, Pulse(a, float(w)))
-            if v.overturned:
-                break
-            lo, a = a, a + step
-        if v is None or not v.overturned:
-            amps.append(math.nan)
-            modes.append(None)
-            continue
-        hi = a
-        while hi - lo > tol:
-            mid = 0.5 * (lo + hi)
-            vm = fast.verdict_for(scene, Pulse(mid, float(w)))
-            if vm.overturned:
-                hi, v = mid, vm
-            else:
-                lo = mid
-        amps.append(hi)
-        modes.append(v.mode)
-    return amps, modes
 
 
 def first_overturning_amplitude(scene, omega: float) -> tuple[float, str | None]:
@@ -76,10 +32,13 @@ def first_overturning_amplitude(scene, omega: float) -> tuple[float, str | None]
 
 
 def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
-    module = _spectrum_module()
-    if module is not None and hasattr(module, "first_overturning_amplitudes"):
-        return module.first_overturning_amplitudes(scene, omegas)
-    return _scan_fallback(scene, omegas)
+    """:func:`analytic.spectrum.first_overturn_amplitude` (scan + bisection with
+    the compiled path, default :class:`~analytic.spectrum.SpectrumSettings`)."""
+    from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
+
+    ss = SpectrumSettings()
+    res = [first_overturn_amplitude(scene, float(w), ss) for w in omegas]
+    return [r[0] for r in res], [r[2] for r in res]
 
 
 def find_jumps(omega, amp, mode) -> list[dict]:
@@ -106,7 +65,9 @@ def reference_spectrum(scene, config) -> dict:
     with the largest threshold step, measured in engines), ``backend``, ``tol``.
     """
     omegas = _grid(config)
-    tol = 0.01
+    from analytic.spectrum import SpectrumSettings
+
+    tol = SpectrumSettings().tol
     amps, modes = _amplitudes(scene, omegas)
     amps = [float(a) for a in amps]
     jumps = find_jumps(omegas, amps, modes)
@@ -117,9 +78,26 @@ def reference_spectrum(scene, config) -> dict:
             "jump": jump, "backend": config.spectrum_backend, "tol": tol}
 
 
-def choose_frequencies(spec: dict, config) -> list[tuple[float, float, str | None]]:
+def monotone_above(scene, omega: float, a_ref: float, span: float, n: int = 12) -> bool:
+    """True when the model overturns at every one of ``n`` amplitudes in
+    ``(a_ref, a_ref (1 + span)]``: no safe island just above the threshold.
+
+    Where the model has narrow overturning windows (the spectrum's low-amplitude
+    region) a bisection in an engine would find *a* transition, not the first
+    one, and the comparison would mean nothing.
+    """
+    from analytic import fast
+    from analytic.excitation import Pulse
+
+    return all(fast.verdict_for(scene, Pulse(a_ref * (1.0 + r), omega)).overturned
+               for r in np.linspace(span / n, span, n))
+
+
+def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, float, str | None]]:
     """``n_frequencies`` grid points ``(omega, a_ref, mode)`` spread over the
-    range, each at least ``jump_margin`` from every mode jump."""
+    range, each at least ``jump_margin`` from every mode jump and, when ``scene``
+    is given, with a monotone model verdict over twice the bisection bracket
+    above the threshold (:func:`monotone_above`)."""
     n = config.n_frequencies
     if n <= 0:
         return []
@@ -128,6 +106,8 @@ def choose_frequencies(spec: dict, config) -> list[tuple[float, float, str | Non
     cand = [(w, a, m) for w, a, m in zip(spec["omega"], spec["a"], spec["mode"])
             if lo <= w <= hi and math.isfinite(a)
             and all(abs(w - wj) >= config.jump_margin for wj in jump_ws)]
+    if scene is not None:
+        cand = [c for c in cand if monotone_above(scene, c[0], c[1], 2.0 * config.rel_bracket)]
     if len(cand) <= n:
         return cand
     # Evenly spread over the candidates (deterministic), ends included.

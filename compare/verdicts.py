@@ -27,8 +27,14 @@ def _row(metric: str, backend: str, values: list, tolerance: float, reason: str,
             "passed": passed, "unit": unit, "reason": reason, "detail": detail}
 
 
+def _n_errors(result, job: str, backend: str, pendulum: bool) -> int:
+    return sum(1 for e in result.errors
+               if e["job"] == job and e["backend"] == backend and e["pendulum"] == pendulum)
+
+
 def build_verdicts(result) -> list[dict]:
-    """Verdict rows for every engine of ``result`` (a :class:`CampaignResult`)."""
+    """Verdict rows for every engine of ``result`` (a :class:`CampaignResult`).
+    Jobs that raised count as unmeasured, so their row fails."""
     cfg = result.config
     tol = cfg.tolerances
     why = tol.reasons()
@@ -39,26 +45,36 @@ def build_verdicts(result) -> list[dict]:
                 (True, "restitution vs Eq. 19 (max rel. error)", tol.restitution_pendulum,
                  "restitution_pendulum")):
             runs = [r for r in result.restitution if r["backend"] == name and r["pendulum"] == pend]
-            if not runs:
+            n_err = _n_errors(result, "restitution", name, pend)
+            if not runs and not n_err:
                 continue
             # Every run must deliver at least one impact; each run's worst impact counts.
             values = [r["max_rel_error"] if r["impacts"] else None for r in runs]
-            rows.append(_row(metric, name, values, tolerance, why[key], "relative", len(runs)))
+            rows.append(_row(metric, name, values, tolerance, why[key], "relative",
+                             len(runs) + n_err))
         for case, label in (("pendulum", "with pendulum"), ("no_pendulum", "without pendulum")):
             points = result.spectra.get(case, {}).get("engines", {}).get(name, [])
-            if not points:
+            n_err = _n_errors(result, "threshold", name, case == "pendulum")
+            if not points and not n_err:
                 continue
             values = [p["rel_error"] if p["bracketed"] else None for p in points]
-            rows.append(_row(f"overturning threshold {label}, away from jumps (max rel. error)",
-                             name, values, tol.threshold, why["threshold"], "relative",
-                             len(points)))
+            row = _row(f"overturning threshold {label}, away from jumps (max rel. error)",
+                       name, values, tol.threshold, why["threshold"], "relative",
+                       len(points) + n_err)
+            irregular = sum(p["irregular_runs"] for p in points)
+            if irregular:  # 'unstable'/'undecided' runs count as survived in the bisection
+                row["detail"] += f"; {irregular} unstable/undecided engine runs"
+            rows.append(row)
         comps = [c for c in result.comparisons if c["backend"] == name]
-        if comps:
+        n_cases = len(cfg.points) * (2 if result.scene.has_pendulum else 1)
+        if cfg.points:
             mismatches = [c for c in comps if not c["verdict_agrees"]]
+            # A case that could not be run counts as a disagreement.
+            n_bad = len(mismatches) + (n_cases - len(comps))
             rows.append({
                 "metric": "verdict disagreements at A-D (status and mode)", "backend": name,
-                "value": len(mismatches), "tolerance": tol.verdict_mismatches,
-                "passed": len(mismatches) <= tol.verdict_mismatches, "unit": "count",
+                "value": n_bad, "tolerance": tol.verdict_mismatches,
+                "passed": n_bad <= tol.verdict_mismatches, "unit": "count",
                 "reason": why["verdict_mismatches"],
                 "detail": ", ".join(f"{c['point']}{'+p' if c['pendulum'] else ''}: "
                                     f"{c['status_test']}/{c['mode_test']} vs "
@@ -66,5 +82,5 @@ def build_verdicts(result) -> list[dict]:
                                     for c in mismatches) or f"{len(comps)} cases agree"})
             rows.append(_row("theta RMS error / alpha before the first impact (A-D)", name,
                              [c["theta_rms_first"] for c in comps], tol.theta_rms_first,
-                             why["theta_rms_first"], "fraction of alpha", len(comps)))
+                             why["theta_rms_first"], "fraction of alpha", n_cases))
     return rows

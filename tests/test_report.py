@@ -86,3 +86,19 @@ def test_cli_bad_input_exits_2(argv, needle, capsys, tmp_path):
     assert main([*argv, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error:") and needle in err and err.count("\n") == 1
+
+
+def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
+    import compare.campaign as campaign
+
+    def broken(name, scene, config=None):
+        raise RuntimeError("engine exploded")
+
+    monkeypatch.setitem(campaign._JOBS, "restitution", broken)
+    cfg = CampaignConfig(**{**TINY, "points": (), "spectrum_cases": (), "pendulum_lams": (),
+                            "workers": 1})
+    result = run_campaign(cfg)
+    assert [e["error"] for e in result.errors] == ["RuntimeError: engine exploded"]
+    (row,) = result.verdicts
+    assert row["value"] is None and row["passed"] is False
+    assert "1 not measured" in row["detail"]
