@@ -157,7 +157,7 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
         n_runs += 1
         status, _r, _t, n_imp = _k.verdict(b, h, mu, gamma, j, l, g, a, omega, kind, period,
                                            thr, st.rtol, st.atol, st.rest_velocity, t_max,
-                                           st.t_cap, st.max_steps)
+                                           st.t_cap, st.max_steps, st.rest_step_fraction)
         if status == _k.ST_UNDECIDED or status == _k.ST_UNSTABLE:
             n_und += 1
         return status == _k.ST_OVERTURNED, n_imp
