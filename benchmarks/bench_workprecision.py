@@ -19,6 +19,7 @@ steps, no solver sweeps, coarser threshold bisection).
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 import time
@@ -27,7 +28,7 @@ from pathlib import Path
 from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
     plot_work_precision, write_json
 
-__all__ = ["main", "run", "markdown_tables", "default_report"]
+__all__ = ["main", "run", "markdown_tables", "default_report", "regenerate", "write_outputs"]
 
 METRICS = {
     "theta-grid": ("analytic: max |theta - theta_ref| / alpha on a 1 ms grid (4 s window)",
@@ -57,19 +58,50 @@ def run(quick: bool = False, out: Path | None = None, engines=("pybullet", "pymu
     if engines:
         log("engines:")
         points += run_engines(quick, engines=engines, log=log)
-    mark_front(points)
     elapsed = time.perf_counter() - start
     machine["loadavg_end"] = machine_info()["loadavg"]
     meta = {"quick": quick, "elapsed_s": round(elapsed, 1), "metrics": {k: v[0] for k, v in
                                                                           METRICS.items()}}
+    write_outputs(points, machine, meta, out, log)
+    return {"machine": machine, "meta": meta, "points": points}
+
+
+def apply_resolution_floor(points: list[Point]) -> list[Point]:
+    """A bisected threshold is only known to within its final bracket: an error
+    below half the bracket's relative width is replaced by that half width and
+    flagged ``resolved = False`` (the measured value stays in ``extra``)."""
+    for p in points:
+        width = p.extra.get("bracket_rel")
+        if p.metric != "threshold" or width is None or not math.isfinite(p.error):
+            continue
+        p.extra.setdefault("raw_error", p.error)
+        floor = 0.5 * width
+        p.extra["resolved"] = p.extra["raw_error"] > floor
+        p.error = max(p.extra["raw_error"], floor)
+    return points
+
+
+def write_outputs(points: list[Point], machine: dict, meta: dict, out: Path, log=print) -> None:
+    """Fronts, JSON, plots and markdown tables from measured points."""
+    apply_resolution_floor(points)
+    mark_front(points)
     write_json(out / "workprecision.json", machine, points, meta)
     for metric, (title, ylabel) in METRICS.items():
         plot_work_precision(points, metric, out / f"workprecision_{metric}.png", title, ylabel)
     (out / "workprecision.md").write_text(markdown_tables(points, machine, meta))
-    log(f"wrote {out}/workprecision.json, .md and plots in {elapsed:.0f} s")
+    log(f"wrote {out}/workprecision.json, .md and plots ({meta['elapsed_s']:.0f} s of measuring)")
     for line in default_report(points):
         log(line)
-    return {"machine": machine, "meta": meta, "points": points}
+
+
+def regenerate(json_path: Path, out: Path | None = None) -> None:
+    """Rewrite fronts, plots and tables from a saved ``workprecision.json``
+    (no measuring): for changes to the presentation only."""
+    data = json.loads(Path(json_path).read_text())
+    points = [Point(d["family"], d["metric"], math.inf if d["error"] is None else d["error"],
+                    d["time"], d["params"], d["default"], d["on_front"], d["extra"])
+              for d in data["points"]]
+    write_outputs(points, data["machine"], data["meta"], Path(out or Path(json_path).parent))
 
 
 def _fmt_params(params: dict) -> str:
@@ -99,7 +131,7 @@ def markdown_tables(points: list[Point], machine: dict, meta: dict) -> str:
                      and base[0].time > 0 else math.nan)
             err = f"{p.error:.2e}" if math.isfinite(p.error) else "failed"
             if metric == "threshold" and p.extra.get("resolved") is False:
-                err = f"< {0.5 * p.extra['bracket_rel']:.1e} (unresolved)"
+                err = f"<= {0.5 * p.extra['bracket_rel']:.1e} (bisection)"
             lines.append(f"| {p.family} | {_fmt_params(p.params)} | {err} | {p.time:.3g} | "
                          f"{ratio:.2f} | {'yes' if p.on_front else ''} | "
                          f"{'**default**' if p.default else ''} |")
@@ -146,7 +178,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--engines", default="pybullet,pymunk",
                         help="comma-separated engines, or 'none' [pybullet,pymunk]")
     parser.add_argument("--no-analytic", action="store_true", help="skip the analytic paths")
+    parser.add_argument("--regenerate", type=Path, default=None, metavar="JSON",
+                        help="only rewrite plots and tables from a saved workprecision.json")
     args = parser.parse_args([] if argv is None else argv)
+    if args.regenerate is not None:
+        regenerate(args.regenerate, args.out)
+        return 0
     engines = () if args.engines == "none" else tuple(e for e in args.engines.split(",") if e)
     for e in engines:
         if e not in ("pybullet", "pymunk"):

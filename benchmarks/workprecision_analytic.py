@@ -105,7 +105,8 @@ def run_analytic(quick: bool, log=print) -> list[Point]:
             err = abs(a_thr - a_ref) / a_ref
             points.append(Point(family, "threshold", err, wall, {"rtol": rtol, "atol": rtol * 1e-2},
                                 default=math.isclose(rtol, default_rtol),
-                                extra={"A_thr": a_thr, "A_ref": a_ref, "runs": runs}))
+                                extra={"A_thr": a_thr, "A_ref": a_ref, "runs": runs,
+                                       "bracket_rel": th["rel_tol"]}))
             log(f"  {family:20s} rtol={rtol:.0e}  threshold err={err:.2e}  t={wall:.2f} s "
                 f"({runs} runs)")
     return points
