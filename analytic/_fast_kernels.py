@@ -19,6 +19,9 @@ import numpy as np
 from numba import njit
 
 from . import equations as _eq
+from ._fast_numerics import (_A, _B, _C, _E, _MAX_FACTOR, _MIN_FACTOR, _ROOT_ITER,
+                             _ROOT_XTOL, _SAFETY, _dense, _ellipk, _push, _push_event,
+                             _samples_until)
 
 # --- the equations, compiled from the single source -------------------------------
 _rock = njit(cache=True)(_eq.rocking_accelerations)
@@ -35,40 +38,6 @@ EV_UPLIFT, EV_IMPACT, EV_REST, EV_OVERTURN, EV_UNSTABLE = 0, 1, 2, 3, 4
 (R_OVERTURN, R_BARRIER, R_REST_NO_PENDULUM, R_PENDULUM_PERIOD, R_T_MAX, R_T_CAP,
  R_NONFINITE, R_STEP_UNDERFLOW, R_STEP_BUDGET) = range(9)
 KIND_SINE, KIND_COSINE = 0, 1
-
-# --- Dormand-Prince 5(4) tableau and its 4th-order dense output (as in scipy's RK45)
-_C = np.array([0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0])
-_A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0],
-    [0.2, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0]])
-_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0,
-               11.0 / 84.0])
-_E = np.array([-71.0 / 57600.0, 0.0, 71.0 / 16695.0, -71.0 / 1920.0, 17253.0 / 339200.0,
-               -22.0 / 525.0, 1.0 / 40.0])
-_P = np.array([
-    [1.0, -8048581381.0 / 2820520608.0, 8663915743.0 / 2820520608.0,
-     -12715105075.0 / 11282082432.0],
-    [0.0, 0.0, 0.0, 0.0],
-    [0.0, 131558114200.0 / 32700410799.0, -68118460800.0 / 10900136933.0,
-     87487479700.0 / 32700410799.0],
-    [0.0, -1754552775.0 / 470086768.0, 14199869525.0 / 1410260304.0,
-     -10690763975.0 / 1880347072.0],
-    [0.0, 127303824393.0 / 49829197408.0, -318862633887.0 / 49829197408.0,
-     701980252875.0 / 199316789632.0],
-    [0.0, -282668133.0 / 205662961.0, 2019193451.0 / 616988883.0,
-     -1453857185.0 / 822651844.0],
-    [0.0, 40617522.0 / 29380423.0, -110615467.0 / 29380423.0, 69997945.0 / 29380423.0]])
-
-_SAFETY = 0.9          # usual step-size safety factor (Hairer)
-_MIN_FACTOR = 0.2      # bounds on the step change per step, as scipy uses
-_MAX_FACTOR = 10.0
-_ROOT_XTOL = 1e-14     # event location: relative position inside the step
-_ROOT_ITER = 200
-
 
 @njit(cache=True)
 def _xg(t, on, amp, omega, kind):
@@ -101,18 +70,41 @@ def _deriv(phase, y, xg, out, b, h, mu, gamma, j, l, g):
 
 
 @njit(cache=True)
-def _dense(y0, k, hstep, x, out):
-    """DP5 4th-order continuous extension at ``t0 + x*hstep``."""
-    x2 = x * x
-    q0 = x
-    q1 = x2
-    q2 = x2 * x
-    q3 = x2 * x2
+def _dp_step(phase, t, t1, y, hstep, on, amp, omega, pkind, rtol, atol, k, ystage, ynew, f,
+             b, h, mu, gamma, j, l, g):
+    """One Dormand-Prince 5(4) step from ``(t, y)`` with ``k[0] = f(t, y)``; fills
+    ``k[1:7]`` (``k[6] = f(t1, ynew)``, first-same-as-last) and ``ynew``.  Returns
+    the RMS error norm (``<= 1`` accepts) and whether ``ynew`` is finite."""
+    for s in range(1, 6):
+        for c in range(4):
+            acc = 0.0
+            for i in range(s):
+                acc += _A[s, i] * k[i, c]
+            ystage[c] = y[c] + hstep * acc
+        _deriv(phase, ystage, _xg(t + _C[s] * hstep, on, amp, omega, pkind), f, b, h, mu,
+               gamma, j, l, g)
+        for c in range(4):
+            k[s, c] = f[c]
+    for c in range(4):
+        acc = 0.0
+        for i in range(6):
+            acc += _B[i] * k[i, c]
+        ynew[c] = y[c] + hstep * acc
+    _deriv(phase, ynew, _xg(t1, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
+    for c in range(4):
+        k[6, c] = f[c]
+    err = 0.0
+    finite = True
     for c in range(4):
         acc = 0.0
         for i in range(7):
-            acc += k[i, c] * (_P[i, 0] * q0 + _P[i, 1] * q1 + _P[i, 2] * q2 + _P[i, 3] * q3)
-        out[c] = y0[c] + hstep * acc
+            acc += _E[i] * k[i, c]
+        sc = atol + rtol * max(abs(y[c]), abs(ynew[c]))
+        e = hstep * acc / sc
+        err += e * e
+        if not math.isfinite(ynew[c]):
+            finite = False
+    return math.sqrt(err / 4.0), finite
 
 
 @njit(cache=True)
@@ -173,19 +165,6 @@ def _locate(kind, side, y0, k, t0, hstep, on, amp, omega, pkind, thr, b, h, mu, 
 
 
 @njit(cache=True)
-def _ellipk(m):
-    """Complete elliptic integral of the first kind ``K(m)``, ``0 <= m < 1``, by
-    the arithmetic-geometric mean: ``K = pi / (2 AGM(1, sqrt(1 - m)))``."""
-    a = 1.0
-    bb = math.sqrt(1.0 - m)
-    for _ in range(60):
-        if abs(a - bb) <= 1e-16 * a:
-            break
-        a, bb = 0.5 * (a + bb), math.sqrt(a * bb)
-    return math.pi / (2.0 * a)
-
-
-@njit(cache=True)
 def _pendulum_period(psi, psi_dot, l, g):
     """Free-pendulum period [s] through ``(psi, psi_dot)`` (same cases as
     ``analytic.events.free_pendulum_period``): libration ``4 sqrt(l/g) K(m)``,
@@ -198,57 +177,6 @@ def _pendulum_period(psi, psi_dot, l, g):
     if e > sep:
         return 4.0 * l * _ellipk(sep / e) / math.sqrt(2.0 * e)
     return math.inf
-
-
-@njit(cache=True)
-def _grow(arr, n):
-    out = np.empty((2 * arr.shape[0], arr.shape[1]))
-    out[:n] = arr[:n]
-    return out
-
-
-@njit(cache=True)
-def _push(buf, n, row):
-    if n >= buf.shape[0]:
-        buf = _grow(buf, n)
-    for c in range(row.shape[0]):
-        buf[n, c] = row[c]
-    return buf, n + 1
-
-
-@njit(cache=True)
-def _push_event(ev, ne, kind, t, side, tdb, tda, psi, pdb, pda, record):
-    if not record:
-        return ev, ne + 1
-    if ne >= ev.shape[0]:
-        ev = _grow(ev, ne)
-    ev[ne, 0] = kind
-    ev[ne, 1] = t
-    ev[ne, 2] = side
-    ev[ne, 3] = tdb
-    ev[ne, 4] = tda
-    ev[ne, 5] = psi
-    ev[ne, 6] = pdb
-    ev[ne, 7] = pda
-    return ev, ne + 1
-
-
-@njit(cache=True)
-def _samples_until(buf, n, next_s, sample_dt, t_end, y0, k, t0, hstep, ytmp, row):
-    """Append grid samples in (t0, t_end] from the step's dense output."""
-    while next_s <= t_end + 1e-12 * max(1.0, t_end):
-        x = (next_s - t0) / hstep if hstep > 0.0 else 1.0
-        if x > 1.0:
-            x = 1.0
-        _dense(y0, k, hstep, x, ytmp)
-        row[0] = next_s
-        row[1] = ytmp[0]
-        row[2] = ytmp[1]
-        row[3] = ytmp[2]
-        row[4] = ytmp[3]
-        buf, n = _push(buf, n, row)
-        next_s = (round(next_s / sample_dt) + 1.0) * sample_dt
-    return buf, n, next_s
 
 
 @njit(cache=True)
@@ -396,38 +324,9 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             events, ne = _push_event(events, ne, EV_UNSTABLE, t, phase, math.nan, math.nan,
                                      y[2], math.nan, math.nan, record)
             break
-        # -- one Dormand-Prince step
-        for s in range(1, 6):
-            for c in range(4):
-                acc = 0.0
-                for i in range(s):
-                    acc += _A[s, i] * k[i, c]
-                ystage[c] = y[c] + hstep * acc
-            _deriv(phase, ystage, _xg(t + _C[s] * hstep, on, amp, omega, pkind), f, b, h,
-                   mu, gamma, j, l, g)
-            for c in range(4):
-                k[s, c] = f[c]
-        for c in range(4):
-            acc = 0.0
-            for i in range(6):
-                acc += _B[i] * k[i, c]
-            ynew[c] = y[c] + hstep * acc
         t1 = t_next if hit else t + hstep
-        _deriv(phase, ynew, _xg(t1, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
-        for c in range(4):
-            k[6, c] = f[c]
-        err = 0.0
-        finite = True
-        for c in range(4):
-            acc = 0.0
-            for i in range(7):
-                acc += _E[i] * k[i, c]
-            sc = atol + rtol * max(abs(y[c]), abs(ynew[c]))
-            e = hstep * acc / sc
-            err += e * e
-            if not math.isfinite(ynew[c]):
-                finite = False
-        err = math.sqrt(err / 4.0)
+        err, finite = _dp_step(phase, t, t1, y, hstep, on, amp, omega, pkind, rtol, atol, k,
+                               ystage, ynew, f, b, h, mu, gamma, j, l, g)
         n_steps += 1
         if not finite:
             status, reason, t_verdict = ST_UNSTABLE, R_NONFINITE, t
@@ -439,8 +338,8 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             continue
         if phase != 0 and phase * y[0] <= 0.0 and phase * ynew[0] < 0.0:
             # s*theta went below 0 from the start of a rock phase: the excursion
-            # was shorter than the step.  Retry smaller; at round-off it is an
-            # impact at once.
+            # was shorter than the step.  Retry smaller; at round-off there was no
+            # excursion at all and the frame is back at rest.
             if hstep > 1e-12 * max(1.0, t):
                 hstep *= 0.125
                 continue
