@@ -270,8 +270,7 @@ class _Run:
         a0 = fun(self.t, y0)[1]
         if self.theta == 0.0 and s * self.theta_dot > 0.0 and s * a0 < 0.0:
             tau = 2.0 * abs(self.theta_dot / a0)
-            if tau < 1e-2:
-                first = min(tau / 8.0, t_b - self.t)
+            first = min(tau / 8.0, t_b - self.t)
         sol = self.solve(fun, t_b, y0, [impact, overturn], first_step=first)
         hit = self.first_event(sol)
         t1 = float(sol.t[-1]) if hit is None else hit[1]
