@@ -123,7 +123,7 @@ class _Run:
 
     def check_barrier(self) -> bool:
         """Rule 1 (only after the excitation, and only inside the potential well
-        ``|theta| < alpha``: past alpha the trilith falls with any energy)."""
+        ``|theta| < alpha``: past alpha the potential is below the barrier)."""
         if (self.after_pulse(self.t) and abs(self.theta) < self.alpha
                 and self.current_energy() < self.barrier):
             return self.survive(REASON_BARRIER)
