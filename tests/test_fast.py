@@ -199,3 +199,17 @@ def test_contract_and_validation(fig5):
         fast.simulate(fig5, 3.0)
     with pytest.raises(ValueError, match="settings"):
         fast.simulate(fig5, Pulse(1.0, 1.0), accurate.Settings())
+
+
+def test_stale_numba_cache_is_dropped(tmp_path):
+    """numba does not notice an edit of equations.py inside a cached kernel: the
+    fast path drops its cache when the source digest changes."""
+    from analytic import _numba_cache
+    kept = tmp_path / "other.func-1.py311.nbi"
+    stale = [tmp_path / "_fast_kernels.run-9.py311.nbi", tmp_path / "equations.energy-3.py311.1.nbc"]
+    for p in stale + [kept]:
+        p.write_text("x")
+    (tmp_path / "_fast_sources.sha256").write_text("not the digest\n")
+    assert _numba_cache.invalidate_if_stale(tmp_path)
+    assert not any(p.exists() for p in stale) and kept.exists()
+    assert not _numba_cache.invalidate_if_stale(tmp_path)  # stamp now current
