@@ -101,6 +101,10 @@ def regenerate(json_path: Path, out: Path | None = None) -> None:
     points = [Point(d["family"], d["metric"], math.inf if d["error"] is None else d["error"],
                     d["time"], d["params"], d["default"], d["on_front"], d["extra"])
               for d in data["points"]]
+    from .workprecision_analytic import THRESHOLD_CASE
+    for p in points:  # files written before the analytic bracket width was stored
+        if p.metric == "threshold" and p.family.startswith("analytic"):
+            p.extra.setdefault("bracket_rel", THRESHOLD_CASE["rel_tol"])
     write_outputs(points, data["machine"], data["meta"], Path(out or Path(json_path).parent))
 
 
@@ -153,20 +157,35 @@ def default_report(points: list[Point]) -> list[str]:
         if not defaults:
             continue
         d = defaults[0]
-        if d.on_front:
-            out.append(f"{backend} / {metric}: default on the Pareto front "
+        better = [p for p in group if p is not d and _dominates(p, d)]
+        if not better:
+            where = "on the Pareto front" if d.on_front else "on the front within noise"
+            out.append(f"{backend} / {metric}: default {where} "
                        f"(error {d.error:.2e}, {d.time:.3g} s)")
             continue
-        better = [p for p in group if p.on_front and p.error <= d.error and p.time <= d.time]
-        if better:
-            b = min(better, key=lambda p: p.time)
-            out.append(f"{backend} / {metric}: default NOT on the front: "
-                       f"{_fmt_params(b.params)} gives error {b.error:.2e} in {b.time:.3g} s "
-                       f"vs default {d.error:.2e} in {d.time:.3g} s")
-        else:
-            out.append(f"{backend} / {metric}: default off the front (error {d.error:.2e}, "
-                       f"{d.time:.3g} s)")
+        b = min(better, key=lambda p: p.time)
+        out.append(f"{backend} / {metric}: default dominated: {_fmt_params(b.params)} gives "
+                   f"error {b.error:.2e} in {b.time:.3g} s vs default {d.error:.2e} in "
+                   f"{d.time:.3g} s ({b.time / d.time:.2f} x the time)")
     return out
+
+
+# Margins for calling a default dominated: on the shared 2-core machine medians of
+# identical work moved by up to ~30 % between sweeps (PyBullet with 10 solver
+# iterations timed slower than with 50), and errors within 10 % are the same for
+# practical purposes.
+TIME_NOISE = 0.15
+ERROR_SAME = 0.10
+
+
+def _dominates(p: Point, d: Point) -> bool:
+    """``p`` is clearly better than ``d``: much more accurate for no more time, or
+    much faster for no less accuracy (beyond the noise margins)."""
+    if not (math.isfinite(p.error) and math.isfinite(p.time)):
+        return False
+    more_accurate = p.error <= (1 - 2 * ERROR_SAME) * d.error and p.time <= (1 + TIME_NOISE) * d.time
+    faster = p.time <= (1 - 2 * TIME_NOISE) * d.time and p.error <= (1 + ERROR_SAME) * d.error
+    return more_accurate or faster
 
 
 def main(argv: list[str] | None = None) -> int:

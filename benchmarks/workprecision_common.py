@@ -152,7 +152,8 @@ def machine_info() -> dict:
     versions = {"python": platform.python_version()}
     for mod in ("numpy", "scipy", "numba", "pymunk", "matplotlib"):
         try:
-            versions[mod] = __import__(mod).__version__
+            m = __import__(mod)
+            versions[mod] = getattr(m, "__version__", None) or getattr(m, "version")
         except Exception:  # noqa: BLE001 -- a missing optional library is reported, not fatal
             versions[mod] = "missing"
     try:
@@ -197,9 +198,13 @@ def plot_work_precision(points: list[Point], metric: str, path: Path, title: str
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     families = sorted({p.family for p in sel})
     for fam in families:
-        pts = sorted((p for p in sel if p.family == fam), key=lambda p: p.time)
+        # sweep order (tolerance or step from loose to tight), not time order
+        pts = [p for p in sel if p.family == fam]
         ax.loglog([p.time for p in pts], [p.error for p in pts], "o-", ms=4, label=fam)
         for p in pts:
+            value = next(iter(p.params.values()))
+            ax.annotate(f"{value:g}", (p.time, p.error), fontsize=5, alpha=0.7,
+                        xytext=(2, 2), textcoords="offset points")
             if p.default:
                 ax.loglog([p.time], [p.error], "o", ms=13, mfc="none", mec="k", mew=1.5)
     for backend in sorted({f.split()[0] for f in families}):
