@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -329,11 +329,18 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
                     bar.update(1)
         else:
             ctx = multiprocessing.get_context("fork")
+            # Highest frequencies first: they scan the most amplitudes, and starting
+            # with them keeps both workers busy to the end.  Results are placed by
+            # index, so the order (and every number) is the same for any count.
+            order = np.argsort(-w, kind="stable")
+            slots: list = [None] * int(w.size)
             with ProcessPoolExecutor(max_workers=min(workers, int(w.size)), mp_context=ctx) as ex:
-                for res in ex.map(_one_frequency, [float(x) for x in w]):
-                    results.append(res)
+                futures = {ex.submit(_one_frequency, float(w[i])): int(i) for i in order}
+                for fut in as_completed(futures):
+                    slots[futures[fut]] = fut.result()
                     if bar is not None:
                         bar.update(1)
+            results = slots
     finally:
         if bar is not None:
             bar.close()
