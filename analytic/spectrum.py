@@ -300,7 +300,7 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
     workers : int
         Processes (fork); results are ordered as ``omegas`` whatever the count.
     progress : bool
-        Show a tqdm bar.
+        Show a tqdm bar (on stderr, only once the run has lasted 1 s).
     """
     ss = SpectrumSettings() if settings is None else settings
     if not isinstance(ss, SpectrumSettings):
@@ -319,7 +319,8 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
     bar = None
     if progress:
         from tqdm import tqdm
-        bar = tqdm(total=int(w.size), unit="freq", desc="spectrum")
+        # delay: the bar appears only if the run lasts more than a second.
+        bar = tqdm(total=int(w.size), unit="freq", desc="spectrum", delay=1.0)
     results = []
     try:
         if workers == 1 or w.size == 1:

@@ -99,8 +99,8 @@ def run(args: argparse.Namespace) -> int:
     settings = _settings(args)
     if not (1 <= args.workers <= 256):
         raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
-    # A bar only for a person watching (TTY) and a run long enough to need one.
-    progress = (not args.json) and sys.stdout.isatty() and omegas.size * 2 > 20
+    # A bar only for a person watching (TTY); it shows up after 1 s of work.
+    progress = (not args.json) and sys.stdout.isatty()
     spec = overturning_spectrum(scene, omegas, settings, workers=args.workers,
                                 progress=progress)
     if args.csv:
