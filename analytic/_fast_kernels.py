@@ -194,6 +194,9 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
     """
     exact = t_max <= 0.0
     t_stop = t_end_pulse + t_cap if exact else t_max
+    # The exact survival rules also decide a fixed-window run ('survived' at t_max
+    # follows from them); only a recorded trajectory must run on to t_max.
+    early = exact or not record
     # The barrier argument only holds on the stable side (|theta| < alpha): beyond
     # alpha an energy below the barrier means the frame can no longer come back.
     barrier = _barrier(b, h, mu, gamma, g)
@@ -245,10 +248,10 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
                 en = _rest_energy(y[2], y[3], gamma, l, g)
             else:
                 en = _energy(y[0], y[1], y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
-            if exact and en < barrier and abs(y[0]) < alpha:
+            if early and en < barrier and abs(y[0]) < alpha:
                 status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
                 break
-            if exact and phase == 0:
+            if early and phase == 0:
                 if gamma == 0.0:
                     status, reason, t_verdict = ST_SURVIVED, R_REST_NO_PENDULUM, t
                     break
@@ -269,7 +272,7 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
                 y[1] = 0.0
                 rest_deadline = math.inf
                 need_k0 = True
-        if exact and phase == 0 and pulse_done and t >= rest_deadline:
+        if early and phase == 0 and pulse_done and t >= rest_deadline:
             status, reason, t_verdict = ST_SURVIVED, R_PENDULUM_PERIOD, t
             break
         if t >= t_stop:
@@ -448,7 +451,7 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
                 check_margin = True
                 events, ne = _push_event(events, ne, EV_REST, t, 0, tdm, 0.0, y[2], pdm, pdp,
                                          record)
-                if pulse_done and exact:
+                if pulse_done and early:
                     if _rest_energy(y[2], y[3], gamma, l, g) < barrier:
                         status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
                     elif gamma == 0.0:
@@ -458,7 +461,7 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             else:
                 y[1] = tdp
                 phase = new_side
-                if pulse_done and exact and _energy(
+                if pulse_done and early and _energy(
                         0.0, tdp, y[2], y[3], float(new_side), b, h, mu, gamma, j, l,
                         g) < barrier:
                     status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t

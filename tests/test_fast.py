@@ -123,6 +123,11 @@ def test_fixed_window(fig5, run_analytic):
     assert tr.verdict.status == ref.verdict.status == "survived"
     assert tr.t[-1] == pytest.approx(3.0, abs=1e-12)
     assert tr.n_impacts == ref.n_impacts
+    # The verdict-only kernel may stop early on an exact rule; same verdict.
+    for amp, omega, t_max in [(4.0, 9.0, 3.0), (10.0, 9.0, 3.0), (10.0, 9.0, 10.0)]:
+        ref = run_analytic(fig5, amp, omega, t_max=t_max).verdict
+        v = fast.verdict_for(fig5, Pulse(amp, omega), fast.Settings(t_max=t_max))
+        assert (v.status, v.mode) == (ref.status, ref.mode)
 
 
 def test_samples_and_events(fig5):
