@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 __all__ = ["reference_spectrum", "choose_frequencies", "find_jumps",
-           "first_overturning_amplitude", "monotone_above"]
+           "first_overturning_amplitude", "monotone_above", "locate_tongue_tip"]
 
 
 def _grid(config) -> np.ndarray:
@@ -52,9 +52,7 @@ def find_jumps(omega, amp, mode) -> list[dict]:
                       "omega": 0.5 * float(omega[i] + omega[i + 1]),
                       "a_lo": float(a0), "a_hi": float(a1),
                       "mode_lo": mode[i], "mode_hi": mode[i + 1],
-                      "rel_step": abs(a1 - a0) / min(a0, a1),
-                      # Between the two levels the verdict flips across the jump.
-                      "probe_amplitude": 0.5 * float(a0 + a1)})
+                      "rel_step": abs(a1 - a0) / min(a0, a1)})
     return jumps
 
 
@@ -74,6 +72,8 @@ def reference_spectrum(scene, config) -> dict:
     lo, hi = config.omega_range
     inside = [jp for jp in jumps if lo <= jp["omega"] <= hi and jp["rel_step"] > 0.05]
     jump = max(inside, key=lambda jp: jp["rel_step"]) if inside else None
+    if jump is not None:
+        jump = {**jump, **locate_tongue_tip(scene, jump)}
     return {"omega": omegas.tolist(), "a": amps, "mode": list(modes), "jumps": jumps,
             "jump": jump, "backend": config.spectrum_backend, "tol": tol}
 
@@ -91,6 +91,54 @@ def monotone_above(scene, omega: float, a_ref: float, span: float, n: int = 12) 
 
     return all(fast.verdict_for(scene, Pulse(a_ref * (1.0 + r), omega)).overturned
                for r in np.linspace(span / n, span, n))
+
+
+def locate_tongue_tip(scene, jump: dict, d_omega: float = 0.02, rel_da: float = 0.01) -> dict:
+    """Refine a mode jump on the model: where the lower branch's overturning
+    "tongue" closes.
+
+    Near a jump the lower threshold branch is a tongue in the (Omega, A) plane
+    that narrows and closes at the jump frequency (above it the first
+    overturning is on the other branch).  Bisecting Omega (to ``d_omega``) on
+    "some A between the lower level and the middle of the two levels, in
+    ``rel_da`` relative steps, overturns on the lower branch" finds the tip; the
+    tongue's middle amplitude there is the probe at which the verdict flips
+    *at the jump* (a probe elsewhere would flip where it crosses the tongue's
+    edge).  Returns ``omega_tip``, ``probe_amplitude`` and a bracket
+    ``omega_lo``/``omega_hi`` of +-0.25 rad/s around the tip.
+    """
+    from analytic import fast
+    from analytic.excitation import Pulse
+
+    a0, a1 = jump["a_lo"], jump["a_hi"]
+    left = a0 < a1  # the tongue (lower branch) lies below the jump frequency
+    branch = jump["mode_lo"] if left else jump["mode_hi"]
+    # The tongue lies between the lower level and the middle of the two levels.
+    lo_level = min(a0, a1)
+    amps = lo_level * (1.0 + rel_da) ** np.arange(
+        -5, int(math.log(0.5 * (a0 + a1) / lo_level) / math.log1p(rel_da)) + 1)
+
+    def tongue(w: float) -> list[float]:
+        return [float(a) for a in amps
+                if (lambda v: v.overturned and v.mode == branch)(
+                    fast.verdict_for(scene, Pulse(float(a), w)))]
+
+    inside, outside = (jump["omega_lo"], jump["omega_hi"]) if left else (
+        jump["omega_hi"], jump["omega_lo"])
+    hits = tongue(inside)
+    if not hits or tongue(outside):
+        return {}
+    # Bisect the frequency where the tongue closes.
+    while abs(outside - inside) > d_omega:
+        mid = 0.5 * (inside + outside)
+        found = tongue(mid)
+        if found:
+            inside, hits = mid, found
+        else:
+            outside = mid
+    probe = float(np.median(hits))
+    return {"omega_tip": inside, "probe_amplitude": probe, "omega_lo": inside - 0.25,
+            "omega_hi": inside + 0.25, "branch": branch, "d_omega": d_omega}
 
 
 def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, float, str | None]]:

@@ -19,7 +19,7 @@ from compare.report_html import write_report
 # (17.5-18 rad/s), so the one threshold point is away from jumps.
 TINY = dict(engines=("pymunk",), points=("B",), restitution_lams=(5.0,), restitution_mus=(1.0,),
             pendulum_lams=(5.0,), spectrum_cases=("no_pendulum",), n_frequencies=1,
-            omega_range=(6.0, 8.0), include_jump=False, rel_tol=4e-3, workers=2)
+            omega_range=(6.0, 8.0), jump_cases=(), rel_tol=4e-3, workers=2)
 
 
 @pytest.fixture(scope="module")
