@@ -124,6 +124,9 @@ def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: f
     No validation (callers validate once); ``kind`` 0 = sine (Eq. 22), 1 = cosine
     (Eq. 23); ``t_max <= 0`` = exact survival.  Returns ``(status_code,
     reason_code, time, n_impacts)``; ``STATUS_NAMES[status_code]``, ``REASONS``.
+    With a fixed ``t_max`` the exact survival rules still stop the run early (the
+    verdict at ``t_max`` follows from them), so ``n_impacts`` then counts the
+    impacts up to that decision only.
     """
     return _k.verdict(b, h, mu, gamma, j, l, g, amplitude, omega, kind,
                       2.0 * math.pi / omega, threshold, rtol, atol, rest_velocity, t_max,
@@ -131,7 +134,8 @@ def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: f
 
 
 def verdict_for(scene: Scene, pulse: Pulse, settings: Settings | None = None) -> Verdict:
-    """The :class:`Verdict` of ``scene`` under ``pulse`` without sampling the trajectory."""
+    """The :class:`Verdict` of ``scene`` under ``pulse`` without sampling the
+    trajectory (see :func:`overturn_verdict` for fixed-window runs)."""
     settings = _check(scene, pulse, settings)
     st, rs, tv, ni = _k.verdict(*_kernel_args(scene, pulse, settings))
     return _make_verdict(st, rs, tv, ni)
