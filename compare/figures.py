@@ -22,6 +22,7 @@ marked by dashed circles between the two points.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -136,7 +137,25 @@ def _key(panel: Panel) -> tuple:
 
 def compute_spectra(fs: FigureSettings, workers: int = 1, progress: bool = False,
                     figures: tuple[FigureSpec, ...] = FIGURES) -> dict[tuple, Spectrum]:
-    """One :class:`Spectrum` per distinct (model arguments, pulse) of ``figures``."""
+    """One :class:`Spectrum` per distinct (model arguments, pulse) of ``figures``.
+
+    Parameters
+    ----------
+    fs : FigureSettings
+        Frequency grid and the scan/bisection settings (the pulse kind comes from
+        each panel: one-sine Eq. 22 or one-cosine Eq. 23).
+    workers : int
+        Processes per spectrum, in [1, 256].
+    progress : bool
+        A tqdm bar counting spectra.
+    figures : tuple of FigureSpec
+        Which figures' panels to compute (default: all of :data:`FIGURES`).
+
+    Returns
+    -------
+    dict
+        ``{(scene.model_args(), pulse): Spectrum}``.
+    """
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     omegas = omega_grid(fs)
@@ -151,7 +170,7 @@ def compute_spectra(fs: FigureSettings, workers: int = 1, progress: bool = False
     out = {}
     try:
         for key, panel in todo.items():
-            ss = SpectrumSettings(**{**_fields(fs.spectrum), "pulse": panel.pulse})
+            ss = dataclasses.replace(fs.spectrum, pulse=panel.pulse)
             out[key] = overturning_spectrum(load_scene(panel.scene), omegas, ss, workers=workers)
             if bar is not None:
                 bar.update(1)
@@ -159,11 +178,6 @@ def compute_spectra(fs: FigureSettings, workers: int = 1, progress: bool = False
         if bar is not None:
             bar.close()
     return out
-
-
-def _fields(ss: SpectrumSettings) -> dict:
-    # Shallow copy of the fields (asdict would turn the nested Settings into a dict).
-    return {name: getattr(ss, name) for name in ss.__dataclass_fields__}
 
 
 # --- plotting -------------------------------------------------------------------------
@@ -236,8 +250,22 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
                  progress: bool = False) -> dict:
     """Compute every spectrum, write ``<fig>.png`` per figure and ``figures.json``.
 
-    Returns the JSON document (NaN as None): per figure its caption and panels,
-    each panel with its scene name, pulse and the spectrum's ``to_dict()``.
+    Parameters
+    ----------
+    out_dir : str or Path
+        Output directory, created if missing (``ValueError`` if it is a file).
+    fs : FigureSettings, optional
+        Default: Omega = 3..30 rad/s by 0.5, default spectrum settings.
+    workers : int
+        Processes per spectrum, in [1, 256].
+    progress : bool
+        Show a tqdm bar.
+
+    Returns
+    -------
+    dict
+        The JSON document (NaN as None): per figure its caption and panels, each
+        panel with its scene name, pulse and the spectrum's ``to_dict()``.
     """
     fs = FigureSettings() if fs is None else fs
     if not isinstance(fs, FigureSettings):
