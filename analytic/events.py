@@ -42,7 +42,7 @@ class Settings:
     method: str = "DOP853"  # 8th order with 7th-order dense output for the event roots
     sample_dt: float | None = 1e-3  # s; 1 ms resolves the fastest rocking (periods ~0.1 s)
     rest_velocity: float = 1e-6  # rad/s: an impact slower than this ends in rest (Zeno)
-    rest_step_fraction: float = 1e-3  # max REST step / forcing period: a margin dip is not skipped
+    rest_step_fraction: float = 1e-2  # max REST step / pulse period; REST also stops at |xg| peaks
     max_events: int = 100_000  # guard against a non-progressing event loop
     theta0: float = 0.0  # rad: initial rocking angle (free-rocking tests); 0 = at rest
     theta_dot0: float = 0.0  # rad/s: initial rocking speed

@@ -48,6 +48,7 @@ import time
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from . import equations as eq
 from .events import (Settings, SampleBuffer, excitation_window, free_pendulum_period,
@@ -89,6 +90,13 @@ class _Run:
         # A record's xg_ddot has kinks at its samples, where the (then piecewise
         # linear) margin has its minima: REST segments stop at every sample.
         self.kinks = np.asarray(times, dtype=float) if times is not None else None
+        # A pulse's |xg_ddot| extrema, where the margin has its minima: REST
+        # segments stop there too, so a short dip below zero cannot hide inside
+        # one step (exact without a pendulum, whose margin depends on t only).
+        kind = getattr(excitation, "kind", None)
+        quarter = 0.25 * excitation.end_time
+        self.peaks = ([quarter, 3.0 * quarter] if kind == "sine" else
+                      [2.0 * quarter] if kind == "cosine" else [])
         self.t = 0.0
         self.theta, self.theta_dot = st.theta0, st.theta_dot0
         self.psi, self.psi_dot = st.psi0, st.psi_dot0
@@ -164,15 +172,20 @@ class _Run:
         self.phase = side
         self.theta = self.theta_dot = 0.0
 
-    def rest_segment(self, t_b: float) -> None:
-        """Integrate REST up to ``t_b`` or the first uplift."""
+    def rest_segment(self, t_b: float, recover: int = 0) -> None:
+        """Integrate REST up to ``t_b`` or the first uplift.
+
+        ``recover = s``: an uplift about ``s`` whose rocking the integrator could
+        not resolve (``s*theta`` never became positive: the margin dips below 0
+        for a few ns); the frame stays down until the margin is positive again,
+        then Event('rest').  No impact is counted."""
         xg = segment_acceleration(self.excitation, self.t, t_b)
         m_plus, m_minus = self.margins(xg(self.t), self.psi, self.psi_dot)
-        if min(m_plus, m_minus) <= 0.0:  # already past the uplift condition: at once
+        if not recover and min(m_plus, m_minus) <= 0.0:  # past the uplift condition: at once
             self.uplift(1 if m_plus <= m_minus else -1)
             return
         period_end = None
-        if self.after_pulse(self.t) and not self.pend:
+        if self.after_pulse(self.t) and not self.pend and not recover:
             if self.survive(REASON_REST):  # rule 2
                 return
             # t_max given: nothing moves any more, no need to integrate.
@@ -180,7 +193,7 @@ class _Run:
             self.t = t_b
             self.point()
             return
-        if self.after_pulse(self.t) and not self.decided:  # rule 3: one free period
+        if self.after_pulse(self.t) and not self.decided and not recover:  # rule 3
             period = free_pendulum_period(self.psi, self.psi_dot, self.args[5], self.args[6])
             if self.t + period < t_b:
                 t_b = period_end = self.t + period
@@ -192,10 +205,10 @@ class _Run:
             def fun(t, y):
                 return (0.0, 0.0)
 
-        def margin_event(side):
+        def margin_event(side, direction=-1):
             def ev(t, y):
                 return eq.uplift_margin(y[0], y[1], xg(t), side, b, h, mu, gamma, l, g)
-            ev.terminal, ev.direction = True, -1
+            ev.terminal, ev.direction = True, direction
             return ev
         if self.after_pulse(self.t):
             # Free pendulum: the margin varies on its time scale only; at least 100
@@ -208,34 +221,39 @@ class _Run:
             max_step = math.inf  # between kinks xg_ddot is linear: the margin's minima
             # are at the kinks (no pendulum) or on the pendulum's slow time scale
         else:
+            t_b = min([t_b] + [p for p in self.peaks if p > self.t])
             max_step = self.st.rest_step_fraction * self.excitation.end_time
-        sol = self.solve(fun, t_b, [self.psi, self.psi_dot],
-                         [margin_event(1), margin_event(-1)], max_step=max_step)
+        events = ([margin_event(recover, +1)] if recover else
+                  [margin_event(1), margin_event(-1)])
+        sol = self.solve(fun, t_b, [self.psi, self.psi_dot], events, max_step=max_step)
         hit = self.first_event(sol)
         t1 = float(sol.t[-1]) if hit is None else hit[1]
         side = 0
         if hit is not None:
-            side = 1 if hit[0] == 0 else -1
+            side = recover or (1 if hit[0] == 0 else -1)
             # The root is found to ~1e-15 s; step to the first instant where the
-            # margin is <= 0 so the rocking starts with s*theta_ddot >= 0.
-            t1 = self._nudge(sol.sol, xg, side, t1)
+            # margin is <= 0 (> 0 when recovering) so the phases start cleanly.
+            t1 = self._nudge(sol.sol, xg, side, t1, recover=bool(recover))
         self.samples.add_segment(self.t, t1, sol.t, lambda ts: _rest_rows(sol.sol(ts)))
         self.t = t1
         self.psi, self.psi_dot = (float(v) for v in sol.sol(t1))
         if sol.status < 0:
             return
         self.point()
-        if hit is not None:
+        if hit is not None and recover:
+            self.events.append(Event("rest", t1, side=0, psi=self.psi))
+        elif hit is not None:
             self.uplift(side)
         elif period_end is not None and t1 == period_end:
             self.survive(REASON_PERIOD)
 
-    def _nudge(self, dense, xg, side, t1):
+    def _nudge(self, dense, xg, side, t1, recover=False):
         b, h, mu, gamma, j, l, g = self.args
         step = max(abs(t1), 1.0) * float(np.finfo(float).eps)
         for _ in range(60):
             psi, psi_dot = dense(t1)
-            if eq.uplift_margin(psi, psi_dot, xg(t1), side, b, h, mu, gamma, l, g) <= 0.0:
+            m = eq.uplift_margin(psi, psi_dot, xg(t1), side, b, h, mu, gamma, l, g)
+            if (m > 0.0) if recover else (m <= 0.0):
                 break
             t1 += step
             step *= 2.0
@@ -273,6 +291,15 @@ class _Run:
             first = min(tau / 8.0, t_b - self.t)
         sol = self.solve(fun, t_b, y0, [impact, overturn], first_step=first)
         hit = self.first_event(sol)
+        if hit is not None and hit[0] == 0 and hit[1] <= self.t:
+            # s*theta is exactly 0 at the start, so the root finder returns the
+            # start: look inside the step for the real return through 0.
+            t_ret = _return_time(sol.sol.interpolants[-1], s)
+            if t_ret is None:  # excursion below resolution (a margin dip of ~ns)
+                self.phase, self.theta, self.theta_dot = 0, 0.0, 0.0
+                self.rest_segment(t_b, recover=s)
+                return
+            hit = (0, t_ret)
         t1 = float(sol.t[-1]) if hit is None else hit[1]
         pend = self.pend
 
@@ -349,6 +376,18 @@ class _Run:
                 self.rest_segment(t_b)
             else:
                 self.rock_segment(t_b)
+
+
+def _return_time(dense, s: int) -> float | None:
+    """First time in one step's dense output where ``s*theta`` falls back through 0
+    after being positive; None if it never is positive (unresolved excursion)."""
+    ts = np.linspace(dense.t_old, dense.t, 257)
+    g = s * dense(ts)[0]
+    pos = np.flatnonzero(g > 0.0)
+    if pos.size == 0:
+        return None
+    m = pos[0] + int(np.flatnonzero(g[pos[0]:] <= 0.0)[0])
+    return float(brentq(lambda t: s * dense(t)[0], ts[m - 1], ts[m], xtol=1e-15, rtol=1e-15))
 
 
 def _rest_rows(y: np.ndarray) -> np.ndarray:

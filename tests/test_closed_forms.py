@@ -252,3 +252,29 @@ def test_energy_never_increases_at_impacts_random_states():
         assert after <= before + 1e-11 * max(abs(before), 1.0), (args, td, psi, pd)
         checked += 1
     assert checked == 3000
+
+
+@pytest.mark.parametrize("kind", ["sine", "cosine"])
+@pytest.mark.parametrize("excess", [1e-3, 1e-9, 1e-14])
+def test_uplift_threshold_is_sharp_without_pendulum(fig5_bare, kind, excess):
+    # REST stops at the pulse's |xg| peaks, where the margin (a function of t only
+    # here) is smallest, so a dip lasting nanoseconds is not stepped over; the
+    # barely-lifted frame comes back and rests (no endless uplift/rest loop).
+    a_up = fig5_bare.g / fig5_bare.lam
+    omega = 9.0
+    period = 2 * math.pi / omega
+    above = simulate(fig5_bare, Pulse(a_up * (1 + excess), omega, kind))
+    below = simulate(fig5_bare, Pulse(a_up * (1 - excess), omega, kind))
+    assert below.events == () and below.verdict.status == "survived"
+    assert above.verdict.status == "survived" and "barrier" in above.verdict.reason
+    ups = [e for e in above.events if e.kind == "uplift"]
+    # sine: +A at T/4, -A at 3T/4; cosine: +A at 0, -A at T/2 (then +A again at T).
+    peaks = [0.25 * period, 0.75 * period] if kind == "sine" else [0.0, 0.5 * period]
+    firsts = [next(e for e in ups if e.side == side) for side in (1, -1)]
+    half_width = math.sqrt(2 * excess) / omega  # |xg| >= a_up for |t - peak| < this
+    # Round-off of a few eps in the flat margin near the peak moves the root by
+    # ~eps/(Omega^2 half_width); brentq's own xtol adds ~1e-15 s.
+    tol = 1e-12 + 1e-15 / (omega ** 2 * half_width)
+    for e, peak in zip(firsts, peaks):
+        assert peak - half_width - tol <= e.t <= peak + tol  # uplift where the dip starts
+    assert above.max_abs_theta < 1e-6  # a tiny lift only
