@@ -13,12 +13,13 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from scipy.optimize import brentq
 from scipy.special import ellipk
 
 from .trajectory import OverturnCriterion
 
-__all__ = ["Settings", "METHODS", "free_pendulum_period", "excitation_window", "segment_acceleration",
-           "SampleBuffer"]
+__all__ = ["Settings", "METHODS", "free_pendulum_period", "excitation_window",
+           "segment_acceleration", "SampleBuffer", "return_time", "rest_rows"]
 
 
 METHODS = ("DOP853", "RK45", "Radau", "LSODA")
@@ -36,7 +37,7 @@ class Settings:
 
     criterion: OverturnCriterion = OverturnCriterion()  # topple at 1.5 rad: the columns have fallen
     t_max: float | None = None  # None: run until the verdict is decided exactly
-    t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> any rocking decay)
+    t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> rocking decay)
     rtol: float = 1e-10  # energy drift between impacts ~1e-10, far below any engine's error
     atol: float = 1e-12  # rad, rad/s: below rest_velocity by six decades
     method: str = "DOP853"  # 8th order with 7th-order dense output for the event roots
@@ -76,7 +77,8 @@ def _check(name: str, value, lo: float, hi: float, lo_open: bool = True) -> None
         raise ValueError(f"{name} must be a real number, got {value!r}") from None
     ok = math.isfinite(v) and (v > lo if lo_open else v >= lo) and v <= hi
     if not ok:
-        raise ValueError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {value!r}")
+        left = "(" if lo_open else "["
+        raise ValueError(f"{name} must be in {left}{lo:g}, {hi:g}], got {value!r}")
 
 
 def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:
@@ -176,3 +178,21 @@ class SampleBuffer:
         t = np.concatenate(self._t)
         y = np.concatenate(self._y, axis=0)
         return t, y[:, 0], y[:, 1], y[:, 2], y[:, 3]
+
+
+def return_time(dense, s: int) -> float | None:
+    """First time in one step's dense output where ``s*theta`` falls back through 0
+    after being positive; None if it never is positive (unresolved excursion)."""
+    ts = np.linspace(dense.t_old, dense.t, 257)
+    g = s * dense(ts)[0]
+    pos = np.flatnonzero(g > 0.0)
+    if pos.size == 0:
+        return None
+    m = pos[0] + int(np.flatnonzero(g[pos[0]:] <= 0.0)[0])
+    return float(brentq(lambda t: s * dense(t)[0], ts[m - 1], ts[m], xtol=1e-15, rtol=1e-15))
+
+
+def rest_rows(y: np.ndarray) -> np.ndarray:
+    """Sample rows ``(0, 0, psi, psi_dot)`` from a REST dense output ``y`` (2 x n)."""
+    n = y.shape[1]
+    return np.column_stack([np.zeros(n), np.zeros(n), y[0], y[1]])

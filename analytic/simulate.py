@@ -15,7 +15,12 @@ Phases (the compiled fast path ``analytic/fast.py`` implements the same):
   ``criterion.threshold(alpha)``.
 
 Integration segments never straddle a discontinuity of ``xg_ddot`` (the ends of
-the excitation window).  Without a pendulum (``gamma = 0``) ``psi`` and
+the excitation window); REST segments also stop at the pulse's ``|xg_ddot|`` peaks
+(a record's samples), where the margin is smallest, so a short dip below zero is
+not stepped over.  An uplift whose rocking stays below the integrator's
+resolution (``s*theta`` never positive: a margin dip of nanoseconds) keeps the
+trilith down until the margin is positive again, then Event('rest').
+Without a pendulum (``gamma = 0``) ``psi`` and
 ``psi_dot`` stay 0 and are not integrated.
 
 Deciding survival exactly (``t_max = None``): after the excitation the base frame
@@ -48,11 +53,10 @@ import time
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from . import equations as eq
 from .events import (Settings, SampleBuffer, excitation_window, free_pendulum_period,
-                     segment_acceleration)
+                     rest_rows, return_time, segment_acceleration)
 from .parameters import Scene
 from .trajectory import Event, Trajectory, Verdict
 
@@ -234,7 +238,7 @@ class _Run:
             # The root is found to ~1e-15 s; step to the first instant where the
             # margin is <= 0 (> 0 when recovering) so the phases start cleanly.
             t1 = self._nudge(sol.sol, xg, side, t1, recover=bool(recover))
-        self.samples.add_segment(self.t, t1, sol.t, lambda ts: _rest_rows(sol.sol(ts)))
+        self.samples.add_segment(self.t, t1, sol.t, lambda ts: rest_rows(sol.sol(ts)))
         self.t = t1
         self.psi, self.psi_dot = (float(v) for v in sol.sol(t1))
         if sol.status < 0:
@@ -294,7 +298,7 @@ class _Run:
         if hit is not None and hit[0] == 0 and hit[1] <= self.t:
             # s*theta is exactly 0 at the start, so the root finder returns the
             # start: look inside the step for the real return through 0.
-            t_ret = _return_time(sol.sol.interpolants[-1], s)
+            t_ret = return_time(sol.sol.interpolants[-1], s)
             if t_ret is None:  # excursion below resolution (a margin dip of ~ns)
                 self.phase, self.theta, self.theta_dot = 0, 0.0, 0.0
                 self.rest_segment(t_b, recover=s)
@@ -376,23 +380,6 @@ class _Run:
                 self.rest_segment(t_b)
             else:
                 self.rock_segment(t_b)
-
-
-def _return_time(dense, s: int) -> float | None:
-    """First time in one step's dense output where ``s*theta`` falls back through 0
-    after being positive; None if it never is positive (unresolved excursion)."""
-    ts = np.linspace(dense.t_old, dense.t, 257)
-    g = s * dense(ts)[0]
-    pos = np.flatnonzero(g > 0.0)
-    if pos.size == 0:
-        return None
-    m = pos[0] + int(np.flatnonzero(g[pos[0]:] <= 0.0)[0])
-    return float(brentq(lambda t: s * dense(t)[0], ts[m - 1], ts[m], xtol=1e-15, rtol=1e-15))
-
-
-def _rest_rows(y: np.ndarray) -> np.ndarray:
-    n = y.shape[1]
-    return np.column_stack([np.zeros(n), np.zeros(n), y[0], y[1]])
 
 
 def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Trajectory:

@@ -53,7 +53,8 @@ def test_samples_grid_and_event_instants(fig5):
     imp = tr.impacts[0]
     at = np.flatnonzero(tr.t == imp.t)
     assert len(at) == 2
-    assert tr.theta_dot[at[0]] == imp.theta_dot_before and tr.theta_dot[at[1]] == imp.theta_dot_after
+    assert tr.theta_dot[at[0]] == imp.theta_dot_before
+    assert tr.theta_dot[at[1]] == imp.theta_dot_after
     assert np.all(tr.theta[at] == 0.0)
 
 
