@@ -141,7 +141,7 @@ def energy(side: int) -> sp.Expr:
     the pendulum hanging (``theta = psi = 0``)."""
     kin, pot = kinetic_potential(side)
     e = _to_symbols(kin + pot).subs(xgd, 0)
-    return sp.simplify(e - e.subs({th: 0, ps: 0, thd: 0, psd: 0}))
+    return sp.expand(e - e.subs({th: 0, ps: 0, thd: 0, psd: 0}))
 
 
 @functools.lru_cache(maxsize=None)
@@ -161,9 +161,9 @@ def uplift(side: int) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
     m0 = mass.subs(at_rest)
     f0 = rhs.subs(at_rest)
     psi_dd = f0[1] / m0[1, 1]
-    q = sp.simplify(m0[0, 1] * psi_dd - f0[0])
-    a_up = sp.simplify(sp.solve(sp.Eq(q, 0), xgdd)[0])
-    free = sp.simplify(m0.LUsolve(f0)[0])
+    q = sp.expand(sp.cancel(m0[0, 1] * psi_dd - f0[0]))   # linear in xg_ddot
+    a_up = sp.cancel(-q.subs(xgdd, 0) / q.coeff(xgdd))
+    free = sp.cancel(m0.LUsolve(f0)[0])
     return q, a_up, free
 
 

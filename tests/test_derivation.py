@@ -6,7 +6,7 @@ tolerance is ``1e-10`` relative to the size of the terms being summed: both side
 are double-precision evaluations of the same exact quantity arranged differently,
 so they can differ by a few ulps times the cancellation in the sums (~1e-14), while
 any wrong term, sign or factor changes the result at order 1e-3 or more.
-Symbolic comparisons are exact (``simplify(difference) == 0``).
+Symbolic comparisons are exact (:func:`is_zero`).
 """
 from __future__ import annotations
 
@@ -52,7 +52,15 @@ def close(a: float, ref: float, scale: float) -> bool:
 
 
 def is_zero(expr) -> bool:
-    return sp.simplify(sp.expand_trig(sp.expand(expr))) == 0
+    """Exact test that a rational trigonometric expression in theta, psi vanishes:
+    the numerator is expanded into sines and cosines of theta and psi and reduced
+    modulo ``sin^2 + cos^2 - 1`` (faster and surer than ``simplify``)."""
+    s1, c1, s2, c2 = sp.symbols("s1_ c1_ s2_ c2_")
+    num = sp.fraction(sp.together(expr))[0]
+    num = sp.expand(sp.expand_trig(sp.expand(num)))
+    num = num.subs({sp.sin(th): s1, sp.cos(th): c1, sp.sin(ps): s2, sp.cos(ps): c2})
+    rem = sp.reduced(num, [s1 ** 2 + c1 ** 2 - 1, s2 ** 2 + c2 ** 2 - 1], s1, s2, c1, c2)[1]
+    return rem == 0
 
 
 # ------------------------------------------------------------------ positions
@@ -243,3 +251,173 @@ def test_printed_eq9_differs_only_in_psi_dot_term():
     assert is_zero(a_up - fixed)
     assert is_zero((a_up - printed).subs(psd, 0))
     assert not is_zero(a_up - printed)
+
+
+# ------------------------------------------------------------------ impact (Eq. 13-21)
+def impact_cases(seed: int, n: int = 60):
+    """Random cases plus the geometry the paper says does not matter."""
+    rng = np.random.default_rng(seed + 1000)
+    for k, cs in enumerate(random_cases(seed, n)):
+        if k % 4 == 0:  # squat columns, heavy pendulum: the impact can stop the trilith
+            cs["h"] = cs["b"] * rng.uniform(1.0, 1.3)
+            cs["j"] = (cs["b"] ** 2 + cs["h"] ** 2) / 12.0
+            cs["gamma"] = rng.uniform(0.4, 1.0)
+            cs["mu"] = rng.uniform(0.0, 0.3)
+            cs["psi"] = rng.uniform(-0.5, 0.5)
+            cs["l"] = cs["h"] * rng.uniform(0.2, 1.0)
+        geo = (rng.uniform(0.0, 2.0) * cs["h"], *rng.uniform(-1.0, 1.0, 4) * cs["b"],
+               rng.uniform(0.0, 2.0) * cs["b"] ** 2)  # d, b3, h3, b_o, h_o, j3
+        yield cs, geo
+
+
+@pytest.mark.parametrize("new_side", SIDES)
+def test_impact_velocities_match_impulse_momentum(new_side):
+    full = D.impact_numeric(new_side)
+    stop = D.impact_numeric(new_side, True)
+    n_stop = 0
+    for cs, geo in impact_cases(seed=40 + new_side):
+        w_m = new_side * abs(cs["theta_dot"])       # rocking continues in the same sense
+        par = (cs["b"], cs["h"], cs["mu"], cs["gamma"], cs["j"], cs["l"])
+        sol = full(*par, *geo, cs["psi"], w_m, cs["psi_dot"])
+        scale = abs(w_m) + abs(cs["psi_dot"])
+        assert sol["residual"] < 1e-12 * (1 + cs["h"]) ** 3  # a regular 20x20 solve
+        # The lintel does not rotate and both columns turn together: not imposed, found.
+        assert close(sol["w2"], sol["w1"], scale) and abs(sol["w3"]) <= RTOL * scale
+        # Same answer with the irrelevant geometry removed.
+        bare = full(*par, *([0.0] * 6), cs["psi"], w_m, cs["psi_dot"])
+        assert close(bare["w1"], sol["w1"], scale) and close(bare["psi_dot_plus"], sol["psi_dot_plus"], scale)
+        if sol["w1"] / w_m <= 0.0:                   # it would need the ground to pull: it stops
+            n_stop += 1
+            sol = stop(*par, *geo, cs["psi"], w_m, cs["psi_dot"])
+            assert abs(sol["w1"]) <= RTOL * scale
+        got = eq.impact_velocities(w_m, cs["psi"], cs["psi_dot"], new_side, *par)
+        assert close(got[0], sol["w1"], scale), (cs, got, sol)
+        assert close(got[1], sol["psi_dot_plus"], scale * (1 + cs["h"] / cs["l"])), (cs, got, sol)
+        ratio = eq.restitution_ratio(cs["psi"], new_side, *par[:5])
+        assert close(ratio * w_m, got[0], scale)
+    assert 0 < n_stop < N_STATES  # both branches were exercised (seeded: deterministic)
+
+
+def corrected_eq19_21():
+    """``(ratio, psi_dot+)`` for new_side = +1 as documented in ``impact_velocities``."""
+    c = b * sp.cos(ps) + h * sp.sin(ps)
+    dd = b * sp.cos(ps) - h * sp.sin(ps)
+    ratio = -(-4 * j + (b ** 2 - h ** 2) * (1 + 2 * mu) + 2 * gamma * c * dd) / (
+        4 * j + (b ** 2 + h ** 2) * (1 + 2 * mu) + 2 * gamma * c ** 2)
+    w_m, p_m = D.W_MINUS, D.PSI_DOT_MINUS
+    w_p = ratio * w_m
+    psi_p = p_m + (h * sp.cos(ps) * (w_p - w_m) - b * sp.sin(ps) * (w_p + w_m)) / l
+    return ratio, psi_p
+
+
+def test_impact_closed_form_eq19_21():
+    """Exact solve (right -> left, Fig. 3): the corrected Eq. 19 and the printed
+    Eq. 21 hold; the printed Eq. 19 lacks the factor 2 on ``m4 (b cos + h sin)^2``."""
+    ratio, psi_p = D.impact_closed_form(1)
+    doc_ratio, doc_psi = corrected_eq19_21()
+    assert is_zero(ratio - doc_ratio)
+    assert is_zero(psi_p - doc_psi)
+    c = b * sp.cos(ps) + h * sp.sin(ps)
+    num19 = -4 * j + gamma * (b ** 2 + h ** 2) * sp.cos(2 * ps) + (b ** 2 - h ** 2) * (1 + 2 * mu + gamma)
+    den19 = 4 * j + gamma * c ** 2 + (b ** 2 + h ** 2) * (1 + 2 * mu)
+    assert not is_zero(ratio + num19 / den19)
+    assert is_zero(ratio + num19 / (den19 + gamma * c ** 2))
+    w_m, p_m = D.W_MINUS, D.PSI_DOT_MINUS
+    eq21 = p_m - 2 * b * (h * (1 + 2 * (mu + gamma)) * c + 4 * j * sp.sin(ps)) / (
+        l * ((b ** 2 + h ** 2) * (1 + 2 * mu) + 2 * gamma * c ** 2 + 4 * j)) * w_m
+    assert is_zero(psi_p - eq21)
+    # Eq. 20 (m_p -> m1, m_t -> m3): the gamma = 0 limit.
+    eq20 = -(-4 * j + (b ** 2 - h ** 2) * (1 + 2 * mu)) / (4 * j + (b ** 2 + h ** 2) * (1 + 2 * mu))
+    assert sp.simplify(ratio.subs(gamma, 0) - eq20) == 0
+
+
+def test_restitution_makris_vassiliou_and_housner():
+    """gamma = 0, uniform columns: Makris & Vassiliou's rocking frame
+    ``(1 - 3/2 sin^2 a + 3 g cos 2a) / (1 + 3 g)``, ``g = m_beam / (2 m_column) = mu/2``;
+    Housner's ``1 - 3/2 sin^2 a`` when also mu = 0."""
+    ratio = D.impact_closed_form(1)[0].subs(gamma, 0)
+    radius, alpha = sp.symbols("R alpha", positive=True)
+    sub = {b: 2 * radius * sp.sin(alpha), h: 2 * radius * sp.cos(alpha)}
+    uniform = ratio.subs(j, (b ** 2 + h ** 2) / 12).subs(sub)
+    mv = (1 - sp.Rational(3, 2) * sp.sin(alpha) ** 2 + 3 * mu / 2 * sp.cos(2 * alpha)) / (1 + 3 * mu / 2)
+    assert sp.simplify(uniform - mv) == 0
+    assert sp.simplify(uniform.subs(mu, 0) - (1 - sp.Rational(3, 2) * sp.sin(alpha) ** 2)) == 0
+    for cs in random_cases(seed=5, n=20):
+        a = math.atan2(cs["b"], cs["h"])
+        jj = (cs["b"] ** 2 + cs["h"] ** 2) / 12.0
+        for side in SIDES:
+            got = eq.restitution_ratio(0.7, side, cs["b"], cs["h"], cs["mu"], 0.0, jj)
+            g_mv = cs["mu"] / 2.0
+            ref = (1 - 1.5 * math.sin(a) ** 2 + 3 * g_mv * math.cos(2 * a)) / (1 + 3 * g_mv)
+            assert close(got, max(ref, 0.0), 1.0)
+            housner = eq.restitution_ratio(0.7, side, cs["b"], cs["h"], 0.0, 0.0, jj)
+            assert close(housner, 1 - 1.5 * math.sin(a) ** 2, 1.0)
+
+
+def test_printed_impulse_balances_eq13_to_18():
+    """Eqs. 13-18 hold for the derived impulses once read with Fig. 3's convention
+    (impulses drawn as exerted on the ground, i.e. minus those on the columns), with
+    Eq. 17's OCR ``+ -`` -> ``-`` and trailing ``1`` -> ``l``.  Eq. 15/16's
+    ``(m1 h^2/4 - J_G)`` is right: ``+ J_G`` would violate the balance."""
+    solve = D.impact_numeric(1)
+    for cs, geo in impact_cases(seed=6, n=40):
+        bb, hh, mm, gg, jj, ll = (cs[k] for k in ("b", "h", "mu", "gamma", "j", "l"))
+        dd, b3, h3, b0, h0, _ = geo
+        psi, w_m, p_m = cs["psi"], abs(cs["theta_dot"]), cs["psi_dot"]
+        sol = solve(bb, hh, mm, gg, jj, ll, *geo, psi, w_m, p_m)
+        w_p, p_p = sol["w1"], sol["psi_dot_plus"]
+        ax, ay = -sol["ground_1bl_x"], -sol["ground_1bl_y"]  # Fig. 3 convention
+        cx, cy = -sol["ground_2bl_x"], -sol["ground_2bl_y"]
+        big = 1 + mm + gg
+        sp_, cp_ = math.sin(psi), math.cos(psi)
+        scale = big * (hh + dd + abs(b3) + abs(h3) + abs(b0) + abs(h0) + ll) ** 2 * (w_m + abs(p_m))
+        col = (hh ** 2 / 4 - jj) * (w_p - w_m) + bb ** 2 / 4 * (w_m + w_p)
+        residuals = [
+            ax + cx + (hh * big * (w_m - w_p) + gg * ll * cp_ * (p_p - p_m)),           # Eq. 13
+            ay + cy + (bb * big * (w_m + w_p) + gg * ll * sp_ * (p_p - p_m)),           # Eq. 14
+            -ay * bb + ax * hh - col,                                                    # Eq. 15
+            -cy * bb + cx * hh - col,                                                    # Eq. 16
+            cy * (bb + dd) - (-bb * (w_m + w_p) * (gg * (bb + b0 + ll * sp_) + (bb + dd / 2)
+                                                    + mm * (bb + b3))
+                              + (w_m - w_p) * (2 * jj + hh ** 2 / 2 + hh * gg * (hh + h0 - ll * cp_)
+                                               + hh * (hh + h3) * mm)
+                              - ll * gg * (p_p - p_m) * ((bb + b0) * sp_ - (hh + h0) * cp_ + ll)),  # Eq. 17
+            gg * (ll ** 2 * (p_p - p_m) + bb * ll * sp_ * (w_p + w_m) + hh * ll * cp_ * (w_m - w_p)),  # Eq. 18
+        ]
+        for k, res in enumerate(residuals):
+            assert abs(res) <= RTOL * scale, (13 + k, res, cs)
+        plus_j = -ay * bb + ax * hh - (col + 2 * jj * (w_p - w_m))
+        # The "+ J_G" reading misses by 2 J_G (w+ - w-): far beyond the tolerance met above.
+        assert abs(plus_j) > 100 * RTOL * scale
+
+
+# ------------------------------------------------------------------ energy
+@pytest.mark.parametrize("side", SIDES)
+def test_energy_is_derived_t_plus_v(side):
+    e_sym = D.energy(side)
+    # Lagrangian identity dE/dt = sum(q_dot * E_q) (xg fixed): checks the derivation itself.
+    e_th, e_ps = D.lagrange(side)
+    rate = (e_sym.diff(th) * thd + e_sym.diff(thd) * thdd + e_sym.diff(ps) * psd
+            + e_sym.diff(psd) * psdd)
+    assert is_zero(rate - (thd * e_th + psd * e_ps).subs(xgdd, 0))
+    f_e = sp.lambdify((b, h, mu, gamma, j, l, g, th, thd, ps, psd), e_sym, "math")
+    for cs in random_cases(seed=50 + side, n=100):
+        vals = (cs["b"], cs["h"], cs["mu"], cs["gamma"], cs["j"], cs["l"], cs["g"],
+                side * cs["theta"], cs["theta_dot"], cs["psi"], cs["psi_dot"])
+        got = eq.energy(vals[7], vals[8], vals[9], vals[10], side, *vals[:7])
+        scale = (1 + cs["mu"] + cs["gamma"]) * (cs["g"] * cs["h"] + (cs["h"] * cs["theta_dot"]) ** 2
+                                                + (cs["l"] * cs["psi_dot"]) ** 2)
+        assert close(got, f_e(*vals), scale)
+
+
+@pytest.mark.parametrize("new_side", SIDES)
+def test_impact_never_creates_energy(new_side):
+    """A perfectly plastic impact dissipates (independent physical check on the map)."""
+    for cs in random_cases(seed=60 + new_side, n=100):
+        par = (cs["b"], cs["h"], cs["mu"], cs["gamma"], cs["j"], cs["l"])
+        w_m = new_side * abs(cs["theta_dot"])
+        w_p, p_p = eq.impact_velocities(w_m, cs["psi"], cs["psi_dot"], new_side, *par)
+        before = eq.energy(0.0, w_m, cs["psi"], cs["psi_dot"], -new_side, *par, cs["g"])
+        after = eq.energy(0.0, w_p, cs["psi"], p_p, new_side, *par, cs["g"])
+        scale = (1 + cs["mu"] + cs["gamma"]) * ((cs["h"] * w_m) ** 2 + (cs["l"] * cs["psi_dot"]) ** 2)
+        assert after <= before + RTOL * scale
