@@ -137,6 +137,20 @@ def test_grid_accurate_and_fast(point, warm_fast):
     assert fst.verdict.status == acc.verdict.status, (acc.verdict, fst.verdict)
 
 
+@pytest.mark.parametrize("point", GRID[::3], ids=_ids)
+def test_grid_cosine_pulse(point, warm_fast):
+    """The one-cosine pulse (Eq. 23) jumps at t = 0 and at T_s: above the uplift
+    acceleration the trilith uplifts at t = 0 exactly.  Same checks as the sine."""
+    lam, mu, gamma, lf, ag, w = point
+    scene = _scene(lam, mu, gamma, lf)
+    pulse = Pulse(ag * G, w, "cosine")
+    acc = simulate_accurate(scene, pulse)
+    check_run(acc, scene)
+    fst = fast.simulate(scene, pulse)
+    check_run(fst, scene)
+    assert fst.verdict.status == acc.verdict.status, (acc.verdict, fst.verdict)
+
+
 @pytest.mark.parametrize("point", GRID[::7], ids=_ids)
 def test_grid_energy_never_increases_after_pulse(point):
     """After the pulse the base frame is inertial: the energy of Eq. 6-7 can only
