@@ -1,0 +1,397 @@
+"""PyBullet (3D) backend: the trilith as boxes on a box ground, the pendulum as a
+revolute link of the lintel (scene building in :mod:`engines.pybullet_scene`).
+
+Contract (``engines/__init__.py``): ``NAME``, ``version()``, ``Settings``,
+``simulate(scene, excitation, settings) -> Trajectory``; plus
+:func:`render_frames` (headless RGB frames for recordings) and :func:`view`
+(GUI window, real time).
+
+Base motion (DESIGN.md): ``"gravity"`` adds the d'Alembert load ``-xg_ddot(t)``
+to gravity in the base frame (exact for a rigid translating base);
+``"ground"`` moves a heavy ground body kinematically (its prismatic joint state
+is reset to the ground's motion before every step).
+
+Every run opens its own ``pybullet.DIRECT`` client and disconnects at the end.
+Some physics parameters are *process-global* in Bullet (``contactBreakingThreshold``
+in particular): every parameter this module relies on is set explicitly at the
+start of every run, so runs do not depend on what ran before in the process.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pybullet as pb
+
+from analytic import equations as eq
+from analytic.excitation import Still
+from analytic.trajectory import OverturnCriterion, Trajectory
+from engines._common import MonitorSettings, RunMonitor
+from engines import pybullet_scene as ps
+
+__all__ = ["NAME", "Settings", "simulate", "version", "render_frames", "view",
+           "required_friction", "BASE_MOTIONS"]
+
+NAME = "pybullet"
+BASE_MOTIONS = ("gravity", "ground")
+
+
+def version() -> str:
+    """PyBullet's version string (the wheel's, plus its API version)."""
+    from importlib.metadata import version as _v
+
+    return f"pybullet {_v('pybullet')} (API {pb.getAPIVersion()})"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Numerical settings of a PyBullet run; defaults are the calibrated ones.
+
+    Parameters
+    ----------
+    criterion : shared overturning criterion (same as the analytic model).
+    t_max : run length cap [s]; None: decided by the monitor (rest / energy rules).
+    dt : time step [s].
+    theta0, psi0 : initial tilt and pendulum angle [rad], released at rest
+        (``theta0 > 0`` leans left, on the left corners).
+    base_motion : "gravity" (d'Alembert load) or "ground" (moving ground body).
+    sample_every : steps between state reads (and overturn/instability checks).
+    monitor : shared stop rules (:class:`engines._common.MonitorSettings`).
+    friction : Coulomb coefficient of every contact.  Bullet combines the two
+        bodies' values by product, so each body gets ``sqrt(friction)``.  Must be
+        >= :func:`required_friction`.
+    solver_iterations : sequential-impulse iterations per step.
+    contact_erp : Baumgarte factor for penetrations deeper than ``contact_slop``.
+    contact_slop : penetration [m] left uncorrected (Bullet's ``contactSlop``).
+    contact_breaking_threshold : distance [m] within which contact points are
+        kept; None: 1 % of the column width.
+    friction_anchor : Bullet's friction anchors (contacts stick in place).
+    out_of_plane_limit : out-of-plane drift, as a fraction of the trilith size,
+        beyond which a standing trilith is flagged unstable.
+
+    Calibration (free rocking, no pendulum, fig. 5 scale ``b = 0.6`` m, impacts
+    measured against Eq. 20; ``lam`` in {3, 5, 7} x ``mu`` in {0.5, 1, 2} x
+    release at {0.3, 0.5, 0.8} ``alpha``, first 4 impacts, 41 impacts):
+
+    * ``contact_slop``: the one setting that matters.  Bullet's default 1e-5 m
+      lets the Baumgarte push-out of the impact penetration (corner travel per
+      step ``b theta_dot dt`` ~ 3e-5 m) inject energy: errors up to +8 % from the
+      second impact on.  Larger slops (3e-4, 1e-3 m) leave random uncorrected
+      penetrations that put the two columns out of step (mismatch ~slop/b) so
+      they land one step apart: errors up to 16 %.  1e-4 m: median |error|
+      0.03 %, 95 % of impacts within 0.5 %, worst 6.5 % (5e-5 m: 7 % beyond
+      0.5 %; 2e-4 m: 12 %).  The outliers coincide with a column mismatch
+      >= 1e-5 rad (``column_mismatch_max``): the two columns land in different
+      steps.
+    * ``dt`` 5e-5 s is no better (10 % of impacts beyond 0.5 %) at twice the cost.
+    * ``solver_iterations`` 10 or 200 and ``solverResidualThreshold`` 0: no gain.
+    * ``friction`` 2, 5, 10: worse (up to unstable at 10); no anchors: worse.
+    * ``maximal coordinates`` (btRigidBody instead of btMultiBody): 2x faster,
+      but the same outliers; PyBullet's split impulse only acts on those.
+    * A column width of 1.5 m (17 t columns) gives outliers of 5-20 % with every
+      setting tried: the calibration holds for the paper's 0.2-0.8 m.
+    """
+
+    criterion: OverturnCriterion = OverturnCriterion()
+    t_max: float | None = None
+    dt: float = 1e-4  # DESIGN.md; 5e-5 measured no better at twice the cost
+    theta0: float = 0.0  # start upright unless a free-rocking run asks otherwise
+    psi0: float = 0.0  # pendulum hanging
+    base_motion: str = "gravity"  # exact for a rigid base, cheapest
+    sample_every: int = 10  # 1 ms samples: impacts are measured by propagation
+    monitor: MonitorSettings = MonitorSettings()
+    friction: float = 1.0  # DESIGN.md; 2, 5, 10 measured worse (up to unstable)
+    solver_iterations: int = 50  # PyBullet default; 10 or 200 measured no better
+    contact_erp: float = 0.2  # PyBullet default; acts only beyond the slop
+    contact_slop: float = 1e-4  # m; measured optimum at dt = 1e-4 (see above)
+    contact_breaking_threshold: float | None = None  # auto 1 % of b; 0.02 m no better
+    friction_anchor: bool = True  # DESIGN.md; without anchors errors reach 9 %
+    out_of_plane_limit: float = 0.1  # fraction of the size: far beyond the 1e-5 m noise
+
+    def describe(self) -> dict:
+        out = asdict(self)
+        out["criterion"] = self.criterion.describe()
+        return out
+
+
+def required_friction(scene, excitation) -> float:
+    """The friction coefficient the trilith needs while it rests on the ground.
+
+    At rest it follows the ground, so the base must supply ``M |xg_ddot|`` with
+    normal force ``M g``: it needs ``|xg_ddot|/g``, but only up to the uplift
+    acceleration (Eq. 9 with the pendulum hanging; ``g/lam`` without it, Eq. 11)
+    because beyond that it rocks instead.  Hence
+    ``min(peak |xg_ddot|, |a_up|) / g`` (zero for :class:`Still`).  This is
+    necessary, not sufficient: during rocking and impacts the demand is set by
+    the dynamics; PyBullet's sliding is therefore *measured* (the
+    ``pivot_sliding_max`` diagnostic, tested to stay below 1 mm at the
+    calibrated friction 1 for the paper's Fig. 5 points).
+    """
+    if isinstance(excitation, Still):
+        return 0.0
+    if hasattr(excitation, "amplitude"):
+        peak = abs(excitation.amplitude)
+    else:
+        peak = float(np.max(np.abs(excitation.accelerations)))
+    b, h, mu, gamma, _, l, g = scene.model_args()
+    a_up = max(abs(eq.uplift_acceleration(0.0, 0.0, side, b, h, mu, gamma, l, g))
+               for side in (1.0, -1.0))
+    return min(peak, a_up) / g
+
+
+def _validate(scene, excitation, s: Settings) -> float:
+    """Check settings before any stepping; return the friction coefficient to use."""
+    if not isinstance(s, Settings):
+        raise ValueError(f"settings must be a pybullet_engine.Settings, got {type(s).__name__}")
+    if not (isinstance(s.dt, (int, float)) and math.isfinite(s.dt) and 0.0 < s.dt <= 0.1):
+        raise ValueError(f"dt must be in (0, 0.1] s, got {s.dt!r}")
+    if s.base_motion not in BASE_MOTIONS:
+        raise ValueError(f"base_motion must be one of {BASE_MOTIONS}, got {s.base_motion!r}")
+    if not (isinstance(s.sample_every, int) and s.sample_every >= 1):
+        raise ValueError(f"sample_every must be an integer >= 1, got {s.sample_every!r}")
+    if s.t_max is not None and not (math.isfinite(s.t_max) and s.t_max > 0.0):
+        raise ValueError(f"t_max must be None or in (0, inf) s, got {s.t_max!r}")
+    limit = min(s.criterion.threshold(scene.alpha), 0.5 * math.pi)
+    if not (math.isfinite(s.theta0) and abs(s.theta0) < limit):
+        raise ValueError(f"theta0 must be in (-{limit:.4g}, {limit:.4g}) rad, got {s.theta0!r}")
+    if not (math.isfinite(s.psi0) and abs(s.psi0) <= math.pi):
+        raise ValueError(f"psi0 must be in [-pi, pi] rad, got {s.psi0!r}")
+    if not (isinstance(s.solver_iterations, int) and 1 <= s.solver_iterations <= 10000):
+        raise ValueError(f"solver_iterations must be an integer in [1, 10000], "
+                         f"got {s.solver_iterations!r}")
+    if not (math.isfinite(s.contact_erp) and 0.0 <= s.contact_erp <= 1.0):
+        raise ValueError(f"contact_erp must be in [0, 1], got {s.contact_erp!r}")
+    cbt = s.contact_breaking_threshold
+    if cbt is not None and not (math.isfinite(cbt) and cbt > 0.0):
+        raise ValueError(f"contact_breaking_threshold must be None or > 0 m, got {cbt!r}")
+    if not (math.isfinite(s.out_of_plane_limit) and s.out_of_plane_limit > 0.0):
+        raise ValueError(f"out_of_plane_limit must be > 0, got {s.out_of_plane_limit!r}")
+    if scene.mu == 0.0 and scene.has_pendulum:
+        raise ValueError("mu must be > 0 when gamma > 0: the pendulum hangs on the lintel "
+                         "and a massless lintel cannot exist in PyBullet")
+    need = required_friction(scene, excitation)
+    friction = s.friction
+    if not (isinstance(friction, (int, float)) and math.isfinite(friction) and friction >= need
+            and friction > 0.0):
+        raise ValueError(f"friction must be >= {need:.4g} (min(peak |xg_ddot|, a_up)/g: the "
+                         f"trilith at rest must not slide), got {friction!r}")
+    return float(friction)
+
+
+class _World:
+    """One PyBullet client with the scene built; steps it and reads its state."""
+
+    def __init__(self, scene, excitation, s: Settings, friction: float, mode: int = pb.DIRECT):
+        self.scene, self.excitation, self.s = scene, excitation, s
+        self.client = pb.connect(mode)
+        c = self.client
+        cbt = s.contact_breaking_threshold or 0.01 * scene.b
+        # Every parameter set explicitly: some are process-global in Bullet.
+        pb.resetSimulation(physicsClientId=c)
+        pb.setPhysicsEngineParameter(
+            fixedTimeStep=s.dt, numSubSteps=0, numSolverIterations=s.solver_iterations,
+            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=s.contact_erp,
+            useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
+            contactBreakingThreshold=cbt, restitutionVelocityThreshold=0.2,
+            contactSlop=s.contact_slop, enableConeFriction=0, deterministicOverlappingPairs=1,
+            globalCFM=0.0,
+            solverResidualThreshold=1e-7, warmStartingFactor=0.85,
+            physicsClientId=c)
+
+        self.moving = s.base_motion == "ground"
+        pb.setGravity(0.0, 0.0, -scene.g, physicsClientId=c)
+        self.bodies = ps.build_scene(c, scene, s.theta0, s.psi0, math.sqrt(friction), self.moving,
+                                     s.friction_anchor)
+        self.size = max(scene.lintel_length, scene.h)
+        self.start = {bid: self._pose(bid)[0] for bid in self.bodies.dynamic}
+        # Bottom corners of the upright columns (the scene's geometry, not the
+        # possibly tilted start).
+        b, d = scene.b, scene.d
+        self.pivots0 = [(0.0, b), (b + d, 2.0 * b + d)]
+        self.diag = dict(lintel_rotation_max=0.0, pivot_sliding_max=0.0, penetration_max=0.0,
+                         out_of_plane_max=0.0, out_of_plane_rotation_max=0.0)
+        self.step_index = 0
+        if self.moving:
+            self._set_ground(0)
+
+    def close(self) -> None:
+        pb.disconnect(physicsClientId=self.client)
+
+    # ---------------------------------------------------------------- stepping
+    def _set_ground(self, n: int) -> None:
+        """Reset the ground link to x_g(t_n), moving at the mean velocity of step n."""
+        dt, ex = self.s.dt, self.excitation
+        x0, x1 = ex.displacement(n * dt), ex.displacement((n + 1) * dt)
+        pb.resetJointState(self.bodies.ground, 0, x0, (x1 - x0) / dt, physicsClientId=self.client)
+
+    def step(self) -> None:
+        n, dt = self.step_index, self.s.dt
+        if self.moving:
+            self._set_ground(n)
+        else:
+            # Mid-step load: the step's velocity change is then second-order accurate.
+            a = self.excitation.acceleration((n + 0.5) * dt)
+            pb.setGravity(-a, 0.0, -self.scene.g, physicsClientId=self.client)
+        pb.stepSimulation(physicsClientId=self.client)
+        self.step_index = n + 1
+
+    # ----------------------------------------------------------------- reading
+    def _pose(self, body: int) -> tuple[tuple, tuple, tuple]:
+        if body == self.bodies.lintel:
+            return ps.lintel_state(self.client, self.bodies)[:3]
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        return pos, quat, pb.getBaseVelocity(body, physicsClientId=self.client)[0]
+
+    def _bottom_corners(self, body: int) -> tuple[float, float]:
+        """World x of a column's bottom-left and bottom-right edge midpoints."""
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        hb, hh = 0.5 * self.scene.b, 0.5 * self.scene.h
+        out = []
+        for dx in (-hb, hb):
+            out.append(pb.multiplyTransforms(pos, quat, (dx, 0.0, -hh), (0, 0, 0, 1))[0][0])
+        return out[0], out[1]
+
+    def ground_x(self) -> float:
+        if not self.moving:
+            return 0.0
+        return pb.getJointState(self.bodies.ground, 0, physicsClientId=self.client)[0]
+
+    def sample(self) -> tuple[float, float, float, float, float, str | None]:
+        """Column angles, mean rate, pendulum state; updates the diagnostics.
+
+        Returns ``(theta_left, theta_right, theta_dot, psi, psi_dot, problem)``
+        where ``problem`` names a blow-up, or None.  The rocking diagnostics
+        (sliding, penetration, lintel rotation, out-of-plane motion) are taken
+        while both columns stand (``|theta| < alpha``): a collapse, with the
+        lintel falling off, is beyond the model and not a numerical problem.
+        """
+        c, bodies, scene, diag = self.client, self.bodies, self.scene, self.diag
+        cols = [ps.column_angle(c, body) for body in bodies.columns]
+        theta_l, theta_r = cols[0][0], cols[1][0]
+        standing = max(abs(theta_l), abs(theta_r)) < scene.alpha
+        psi = psi_dot = 0.0
+        if bodies.pendulum_joint is not None:
+            psi, psi_dot = ps.pendulum_state(c, bodies)
+        problem = None
+        gx = self.ground_x()
+        v_bound = 20.0 * math.sqrt(2.0 * scene.g * self.size) + 10.0 * abs(
+            self.excitation.velocity(self.step_index * self.s.dt))
+        for body in bodies.dynamic:
+            pos, quat, vel = self._pose(body)
+            if not all(math.isfinite(v) for v in pos + vel + quat):
+                return theta_l, theta_r, 0.0, psi, psi_dot, "non-finite body state"
+            drift = math.dist(pos, self.start[body]) - abs(gx)
+            speed = math.hypot(*vel)
+            if drift > 10.0 * self.size or speed > v_bound:
+                problem = f"body {body} flew away (drift {drift:.3g} m, speed {speed:.3g} m/s)"
+            if standing:
+                roll, pitch, yaw = pb.getEulerFromQuaternion(quat)
+                diag["out_of_plane_max"] = max(diag["out_of_plane_max"],
+                                               abs(pos[1] - self.start[body][1]))
+                diag["out_of_plane_rotation_max"] = max(diag["out_of_plane_rotation_max"],
+                                                        abs(roll), abs(yaw))
+                if body == bodies.lintel:
+                    diag["lintel_rotation_max"] = max(diag["lintel_rotation_max"], abs(pitch))
+        if abs(psi_dot) * bodies.length > v_bound:
+            problem = f"pendulum speed {abs(psi_dot) * bodies.length:.3g} m/s"
+        if standing:
+            for k, body in enumerate(bodies.columns):
+                corners = self._bottom_corners(body)
+                theta = cols[k][0]
+                # The pivot corner while rocking; both corners while at rest.
+                idx = ((0 if theta > 0 else 1,) if abs(theta) > self.s.monitor.uplift_angle
+                       else (0, 1))
+                slide = max(abs(corners[i] - self.pivots0[k][i] - gx) for i in idx)
+                diag["pivot_sliding_max"] = max(diag["pivot_sliding_max"], slide)
+            for point in pb.getContactPoints(physicsClientId=c):
+                diag["penetration_max"] = max(diag["penetration_max"], -point[8])
+            if diag["out_of_plane_max"] > self.s.out_of_plane_limit * self.size:
+                problem = f"out-of-plane drift {diag['out_of_plane_max']:.3g} m"
+        return theta_l, theta_r, 0.5 * (cols[0][1] + cols[1][1]), psi, psi_dot, problem
+
+
+def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
+    """Run ``scene`` under ``excitation`` in PyBullet; returns a :class:`Trajectory`.
+
+    Raises ``ValueError`` for bad settings before any stepping.  A blow-up (NaN,
+    bodies flying away, out-of-plane drift) gives the verdict ``'unstable'``.
+    """
+    s = settings if settings is not None else Settings()
+    friction = _validate(scene, excitation, s)
+    wall0 = time.perf_counter()
+    monitor = RunMonitor(scene, excitation, s.criterion, s.t_max, s.monitor)
+    world = _World(scene, excitation, s, friction)
+    try:
+        decided = monitor.record(0.0, *world.sample()[:5])
+        while not decided:
+            for _ in range(s.sample_every):
+                world.step()
+            t = world.step_index * s.dt
+            *state, problem = world.sample()
+            if problem is not None:
+                monitor.mark_unstable(t, problem)
+                break
+            decided = monitor.record(t, *state)
+        diagnostics = dict(world.diag, steps=world.step_index, friction=friction)
+    finally:
+        world.close()
+    wall = time.perf_counter() - wall0
+    diagnostics["wall_time"] = wall
+    info = s.describe()
+    info["friction_used"] = friction
+    info["engine_version"] = version()
+    return monitor.finish(NAME, info, diagnostics, wall)
+
+
+def render_frames(scene, excitation, times, settings: Settings | None = None,
+                  width: int = 320, height: int = 240) -> list[np.ndarray]:
+    """RGB ``uint8`` frames ``(height, width, 3)`` of a run at the requested
+    ``times`` [s] (headless, ``ER_TINY_RENDERER``).  The run stops at the last time."""
+    s = settings if settings is not None else Settings()
+    friction = _validate(scene, excitation, s)
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(times < 0.0) or np.any(
+            np.diff(times) < 0.0):
+        raise ValueError("times must be a 1-D non-decreasing sequence of finite values >= 0 s")
+    if not (isinstance(width, int) and isinstance(height, int) and 8 <= width <= 4096
+            and 8 <= height <= 4096):
+        raise ValueError(f"width and height must be integers in [8, 4096], got {width}, {height}")
+    world = _World(scene, excitation, s, friction)
+    frames = []
+    try:
+        span = scene.lintel_length
+        view_m = pb.computeViewMatrix((0.5 * span, -3.0 * max(span, scene.h), 0.6 * scene.h),
+                                      (0.5 * span, 0.0, 0.6 * scene.h), (0.0, 0.0, 1.0))
+        proj = pb.computeProjectionMatrixFOV(40.0, width / height, 0.1, 100.0 * max(span, scene.h))
+        for t in times:
+            while world.step_index * s.dt < t - 0.5 * s.dt:
+                world.step()
+            img = pb.getCameraImage(width, height, view_m, proj, renderer=pb.ER_TINY_RENDERER,
+                                    physicsClientId=world.client)
+            rgba = np.reshape(np.asarray(img[2], dtype=np.uint8), (height, width, 4))
+            frames.append(rgba[:, :, :3].copy())
+    finally:
+        world.close()
+    return frames
+
+
+def view(scene, excitation, settings: Settings | None = None, duration: float = 10.0) -> None:
+    """Open a PyBullet GUI window and run ``scene`` in real time (needs a display)."""
+    s = settings if settings is not None else Settings()
+    friction = _validate(scene, excitation, s)
+    world = _World(scene, excitation, s, friction, mode=pb.GUI)
+    try:
+        span = scene.lintel_length
+        pb.resetDebugVisualizerCamera(2.0 * max(span, scene.h), 0.0, -5.0,
+                                      (0.5 * span, 0.0, 0.5 * scene.h),
+                                      physicsClientId=world.client)
+        wall0 = time.perf_counter()
+        while world.step_index * s.dt < duration:
+            world.step()
+            lag = world.step_index * s.dt - (time.perf_counter() - wall0)
+            if lag > 0.0:
+                time.sleep(lag)
+    finally:
+        world.close()

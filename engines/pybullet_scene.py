@@ -1,0 +1,255 @@
+"""Building the trilith in a PyBullet world, and reading its state back.
+
+The analytic plane (x right, y up) is PyBullet's x-z plane (z up); the depth
+``scene.depth`` runs along y.  A counter-clockwise rotation in the analytic plane
+(``theta > 0``, x towards up) is a rotation about PyBullet's **-y** axis, so
+``theta = -pitch`` and ``theta_dot = -omega_y``.
+
+Bodies (all from the :class:`~analytic.parameters.Scene`, nothing typed twice):
+
+* ground: a static box whose top face is ``z = 0`` ("gravity" base motion), or a
+  very heavy box on a prismatic joint along x whose state is reset to the
+  ground's motion before every step ("ground" base motion);
+* two columns ``b x depth x h``, mass ``m1``, inertia ``J_G`` about y, the left
+  one's left bottom corner at ``x = 0``, clear gap ``d``;
+* the lintel (``mu > 0`` only), ``lintel_length x depth x lintel_thickness``,
+  mass ``m3``, resting on both column tops;
+* the pendulum (``gamma > 0`` only): a revolute link of the lintel multibody,
+  hinge on the lintel's underside at ``hinge_x`` from its middle, the point mass
+  ``m4`` at distance ``l`` (the link's centre of mass), negligible own inertia,
+  no collision shape and collision filter mask 0, joint motor disabled.
+
+With ``mu = 0`` there is no lintel (a zero-mass PyBullet body is static): the
+columns rock independently, which is the ``mu = 0`` rocking frame of Eq. 8.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import pybullet as pb
+
+__all__ = ["Bodies", "build_scene", "initial_poses", "column_angle", "pendulum_state"]
+
+# Own inertia of the pendulum bob relative to m4 l^2: negligible (the analytic
+# bob is a point; 1e-6 relative error) but non-zero so the link's inertia is regular.
+NEGLIGIBLE_MASS_FRACTION = 1e-6
+# The heavy moving ground ("ground" base motion) weighs this many trilith masses,
+# so contact impulses change its reset velocity by < 1e-6 within a step.
+GROUND_MASS_FACTOR = 1e6
+
+
+@dataclass
+class Bodies:
+    """PyBullet ids of one built scene, and the numbers needed to read it."""
+
+    client: int
+    ground: int
+    ground_link: int  # -1: static box base; 0: the prismatic link of a moving ground
+    columns: tuple[int, int]
+    lintel: int | None
+    lintel_link: int  # -1: the lintel is a multibody base
+    pendulum_joint: int | None  # joint (= link) index on the lintel, or None
+    hinge_local: tuple[float, float, float]  # hinge in the lintel's frame
+    length: float  # pendulum length l
+
+    @property
+    def dynamic(self) -> tuple[int, ...]:
+        return self.columns + ((self.lintel,) if self.lintel is not None else ())
+
+
+def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
+    """Principal inertia of a uniform box with full side lengths sx, sy, sz."""
+    return (mass * (sy * sy + sz * sz) / 12.0, mass * (sx * sx + sz * sz) / 12.0,
+            mass * (sx * sx + sy * sy) / 12.0)
+
+
+def _quat_theta(theta: float) -> tuple[float, float, float, float]:
+    """Quaternion of an analytic CCW rotation ``theta``: a rotation about -y."""
+    return pb.getQuaternionFromEuler((0.0, -theta, 0.0))
+
+
+def initial_poses(scene, theta0: float, psi0: float) -> dict:
+    """World poses of the columns, lintel and pendulum bob for a trilith tilted by
+    ``theta0`` (about the left corners if > 0, the right ones if < 0), at rest.
+
+    The columns rotate rigidly about their pivot corners; the lintel translates
+    with the column tops (the parallelogram of Eq. 5-6); the bob hangs at
+    ``psi0`` from the hinge.
+    """
+    b, h, d = scene.b, scene.h, scene.d
+    c, s = math.cos(theta0), math.sin(theta0)
+
+    def rotate_about(px: float, pz: float, x: float, z: float) -> tuple[float, float]:
+        rx, rz = x - px, z - pz  # analytic CCW rotation in the x-z plane
+        return px + c * rx - s * rz, pz + s * rx + c * rz
+
+    centres = []
+    for x_left in (0.0, b + d):
+        pivot_x = x_left if theta0 >= 0.0 else x_left + b
+        centres.append(rotate_about(pivot_x, 0.0, x_left + 0.5 * b, 0.5 * h))
+    # The lintel rests on the top corner diagonally opposite the pivot (it rises
+    # the most) and translates with it (the parallelogram of Eq. 5-6).
+    pivot, top = (0.0, b) if theta0 >= 0.0 else (b, 0.0)
+    top_x, top_z = rotate_about(pivot, 0.0, top, h)
+    shift = (top_x - top, top_z - h)
+    lintel = (0.5 * scene.lintel_length + shift[0], h + 0.5 * scene.lintel_thickness + shift[1])
+    return {"columns": centres, "lintel": lintel, "quat": _quat_theta(theta0)}
+
+
+def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
+                moving_ground: bool, friction_anchor: bool = True) -> Bodies:
+    """Create every body of ``scene`` in ``client`` (see the module docstring)."""
+    b, h, depth = scene.b, scene.h, scene.depth
+    span = scene.lintel_length
+    poses = initial_poses(scene, theta0, psi0)
+
+    # Ground: wide enough for columns lying on their sides, thick enough that a
+    # corner cannot tunnel through it; a box, not a GEOM_PLANE (DESIGN.md: the
+    # plane makes top and bottom impacts resolve one step apart).
+    g_half = (span + 2.5 * h, depth + h, max(0.5 * b, 0.1))
+    g_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=g_half, physicsClientId=client)
+    g_pos = (0.5 * span, 0.0, -g_half[2])
+    if moving_ground:
+        total = scene.m1 * (2.0 + scene.mu + scene.gamma)
+        ground = pb.createMultiBody(
+            baseMass=0.0, basePosition=(0.0, 0.0, 0.0),
+            linkMasses=[GROUND_MASS_FACTOR * total], linkCollisionShapeIndices=[g_shape],
+            linkVisualShapeIndices=[-1], linkPositions=[g_pos], linkOrientations=[(0, 0, 0, 1)],
+            linkInertialFramePositions=[(0, 0, 0)], linkInertialFrameOrientations=[(0, 0, 0, 1)],
+            linkParentIndices=[0], linkJointTypes=[pb.JOINT_PRISMATIC],
+            linkJointAxis=[(1.0, 0.0, 0.0)], physicsClientId=client)
+        pb.setJointMotorControl2(ground, 0, pb.VELOCITY_CONTROL, force=0.0,
+                                 physicsClientId=client)
+        ground_link = 0
+    else:
+        ground = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=g_shape,
+                                    basePosition=g_pos, physicsClientId=client)
+        ground_link = -1
+
+    col_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * b, 0.5 * depth, 0.5 * h),
+                                        physicsClientId=client)
+    col_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * b, 0.5 * depth, 0.5 * h),
+                                   rgbaColor=(0.75, 0.7, 0.6, 1.0), physicsClientId=client)
+    columns = []
+    for (x, z) in poses["columns"]:
+        body = pb.createMultiBody(baseMass=scene.m1, baseCollisionShapeIndex=col_shape,
+                                  baseVisualShapeIndex=col_vis, basePosition=(x, 0.0, z),
+                                  baseOrientation=poses["quat"], physicsClientId=client)
+        ix, _, iz = _box_inertia(scene.m1, b, depth, h)
+        # J_G comes from the scene (it may differ from the uniform box's value).
+        pb.changeDynamics(body, -1, mass=scene.m1, localInertiaDiagonal=(ix, scene.inertia_J_G, iz),
+                          physicsClientId=client)
+        columns.append(body)
+
+    lintel = None
+    lintel_link = -1
+    joint = None
+    t_lin = scene.lintel_thickness
+    hinge_local = (scene.hinge_x, 0.0, -0.5 * t_lin)
+    if scene.mu > 0.0:
+        half = (0.5 * span, 0.5 * depth, 0.5 * t_lin)
+        l_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=client)
+        l_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half,
+                                     rgbaColor=(0.6, 0.55, 0.5, 1.0), physicsClientId=client)
+        lx, lz = poses["lintel"]
+        links: list[dict] = []
+        if scene.has_pendulum:
+            l = scene.pendulum_length
+            bob_vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=max(0.05 * b, 0.01),
+                                           rgbaColor=(0.8, 0.1, 0.1, 1.0), physicsClientId=client)
+            # Link frame at the hinge; its centre of mass (the bob) l below it.
+            # Axis -y: a positive joint angle is a CCW (analytic) swing.
+            links.append(dict(mass=scene.m4, col=-1, vis=bob_vis, pos=hinge_local,
+                              com=(0.0, 0.0, -l), parent=lintel_link + 1,
+                              type=pb.JOINT_REVOLUTE, axis=(0.0, -1.0, 0.0)))
+            joint = len(links) - 1
+        link_kw = {}
+        if links:
+            link_kw = dict(
+                linkMasses=[k["mass"] for k in links],
+                linkCollisionShapeIndices=[k["col"] for k in links],
+                linkVisualShapeIndices=[k["vis"] for k in links],
+                linkPositions=[k["pos"] for k in links],
+                linkOrientations=[(0, 0, 0, 1)] * len(links),
+                linkInertialFramePositions=[k["com"] for k in links],
+                linkInertialFrameOrientations=[(0, 0, 0, 1)] * len(links),
+                linkParentIndices=[k["parent"] for k in links],
+                linkJointTypes=[k["type"] for k in links],
+                linkJointAxis=[k["axis"] for k in links])
+        lintel = pb.createMultiBody(baseMass=scene.m3, baseCollisionShapeIndex=l_shape,
+                                    baseVisualShapeIndex=l_vis, basePosition=(lx, 0.0, lz),
+                                    physicsClientId=client, **link_kw)
+        pb.changeDynamics(lintel, lintel_link, mass=scene.m3,
+                          localInertiaDiagonal=_box_inertia(scene.m3, span, depth, t_lin),
+                          physicsClientId=client)
+        for k in range(len(links)):
+            # Joints are free: no default velocity motor (it would lock them).
+            pb.setJointMotorControl2(lintel, k, pb.VELOCITY_CONTROL, force=0.0,
+                                     physicsClientId=client)
+        if scene.has_pendulum:
+            bob_i = NEGLIGIBLE_MASS_FRACTION * scene.m4 * l * l
+            pb.changeDynamics(lintel, joint, mass=scene.m4,
+                              localInertiaDiagonal=(bob_i, bob_i, bob_i), physicsClientId=client)
+            # The analytic pendulum passes through everything.
+            pb.setCollisionFilterGroupMask(lintel, joint, 0, 0, physicsClientId=client)
+            # Joint angle = psi relative to the lintel, which starts unrotated.
+            pb.resetJointState(lintel, joint, psi0, 0.0, physicsClientId=client)
+
+    bodies = Bodies(client, ground, ground_link, (columns[0], columns[1]), lintel,
+                    lintel_link if lintel is not None else -1, joint, hinge_local,
+                    scene.pendulum_length)
+    for body in bodies.dynamic:
+        parts = [-1] if body != lintel else [bodies.lintel_link]
+        for link in parts:
+            # DESIGN.md: no damping (default 0.04 costs 0.8 % restitution),
+            # plastic contacts, friction anchors against creeping.
+            pb.changeDynamics(body, link, lateralFriction=friction, restitution=0.0,
+                              linearDamping=0.0, angularDamping=0.0,
+                              frictionAnchor=int(friction_anchor),
+                              rollingFriction=0.0, spinningFriction=0.0,
+                              physicsClientId=client)
+    pb.changeDynamics(ground, ground_link, lateralFriction=friction, restitution=0.0,
+                      frictionAnchor=int(friction_anchor), linearDamping=0.0, angularDamping=0.0,
+                      physicsClientId=client)
+    return bodies
+
+
+def column_angle(client: int, body: int) -> tuple[float, float, tuple, tuple]:
+    """``(theta, theta_dot, position, orientation)`` of a column (analytic signs)."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    _, omega = pb.getBaseVelocity(body, physicsClientId=client)
+    m = pb.getMatrixFromQuaternion(quat)
+    # The column's up axis is the third column of R: (m[2], m[5], m[8]).
+    theta = math.atan2(-m[2], m[8])
+    return theta, -omega[1], pos, quat
+
+
+def pendulum_state(client: int, bodies: Bodies) -> tuple[float, float]:
+    """``(psi, psi_dot)``: the bob's absolute angle from the downward vertical,
+    CCW positive (bob at hinge + l (sin psi, -cos psi)), from world positions."""
+    lintel, joint = bodies.lintel, bodies.pendulum_joint
+    state = pb.getLinkState(lintel, joint, computeLinkVelocity=1, computeForwardKinematics=1,
+                           physicsClientId=client)
+    bob, bob_v = state[0], state[6]
+    pos, quat, vel, omega = lintel_state(client, bodies)
+    hinge = pb.multiplyTransforms(pos, quat, bodies.hinge_local, (0, 0, 0, 1))[0]
+    r = [hinge[k] - pos[k] for k in range(3)]
+    # Hinge velocity = v + omega x r (rigid lintel).
+    hv = (vel[0] + omega[1] * r[2] - omega[2] * r[1], vel[2] + omega[0] * r[1] - omega[1] * r[0])
+    rx, rz = bob[0] - hinge[0], bob[2] - hinge[2]
+    vx, vz = bob_v[0] - hv[0], bob_v[2] - hv[1]
+    psi = math.atan2(rx, -rz)
+    psi_dot = (rx * vz - rz * vx) / (rx * rx + rz * rz)
+    return psi, psi_dot
+
+
+def lintel_state(client: int, bodies: Bodies) -> tuple[tuple, tuple, tuple, tuple]:
+    """World ``(position, orientation, velocity, angular velocity)`` of the lintel."""
+    if bodies.lintel_link < 0:
+        pos, quat = pb.getBasePositionAndOrientation(bodies.lintel, physicsClientId=client)
+        vel, omega = pb.getBaseVelocity(bodies.lintel, physicsClientId=client)
+        return pos, quat, vel, omega
+    st = pb.getLinkState(bodies.lintel, bodies.lintel_link, computeLinkVelocity=1,
+                         computeForwardKinematics=1, physicsClientId=client)
+    return st[0], st[1], st[6], st[7]
