@@ -32,6 +32,11 @@ __all__ = ["Provenance", "TrajectoryComparison", "ImpactRestitution", "Restituti
            "compare_trajectories", "restitution_from_trajectory", "engine_threshold",
            "engine_jump_frequency", "common_grid_values"]
 
+# |theta| [rad] that counts as uplifted when comparing uplift times: the engines'
+# run monitor uses it (contact compliance tilts a resting engine trilith ~1e-6 rad),
+# so both runs are timed at the same angle rather than at the model's exact root.
+UPLIFT_ANGLE = 1e-4
+
 # Grid step of the common time grid [s]: engines sample every ~1 ms and the
 # analytic path writes 1 ms samples; a finer grid only interpolates further.
 GRID_DT = 1e-3
@@ -128,9 +133,17 @@ def _first_impact(traj: Trajectory) -> float | None:
 
 
 def _first_past(traj: Trajectory, angle: float) -> float | None:
-    """First sample time with ``|theta| >= angle``, or None."""
-    idx = np.flatnonzero(np.abs(traj.theta) >= angle)
-    return float(traj.t[idx[0]]) if idx.size else None
+    """First time ``|theta|`` reaches ``angle`` (linear between samples), or None."""
+    t, theta = _monotone(traj.t, traj.theta)
+    mag = np.abs(theta)
+    idx = np.flatnonzero(mag >= angle)
+    if not idx.size:
+        return None
+    i = int(idx[0])
+    if i == 0 or mag[i] == mag[i - 1]:
+        return float(t[i])
+    frac = (angle - mag[i - 1]) / (mag[i] - mag[i - 1])
+    return float(t[i - 1] + frac * (t[i] - t[i - 1]))
 
 
 def _errors(ref: Trajectory, test: Trajectory, name: str, t0: float, t1: float,
@@ -164,7 +177,9 @@ class TrajectoryComparison:
     unstable and amplifies any difference), or the end of the common window;
     ``*_all``: over the common window,
     up to the earlier of the two end times / overturn times.  Time errors are
-    ``test - reference`` [s]; impacts are matched in order.
+    ``test - reference`` [s]; impacts are matched in order; uplift is timed in
+    both runs where ``|theta|`` first reaches ``UPLIFT_ANGLE`` (1e-4 rad), the
+    angle at which the engines' monitor declares it.
     """
 
     reference: Provenance
@@ -241,7 +256,7 @@ def compare_trajectories(reference: Trajectory, test: Trajectory,
     ps_rf, ps_mf = _errors(reference, test, "psi", t_start, t_fi, alpha)
     ps_ra, ps_ma = _errors(reference, test, "psi", t_begin, t_end, alpha)
 
-    up_ref, up_test = reference.uplift_time, test.uplift_time
+    up_ref, up_test = _first_past(reference, UPLIFT_ANGLE), _first_past(test, UPLIFT_ANGLE)
     up_err = (up_test - up_ref) if (up_ref is not None and up_test is not None) else math.nan
     ref_imp = [e.t for e in reference.impacts if e.t <= t_end]
     test_imp = [e.t for e in test.impacts if e.t <= t_end]
