@@ -1,9 +1,9 @@
 """Helpers of the event-driven simulator (:mod:`analytic.simulate`).
 
-Its ``Settings`` and pure helpers: the free-pendulum period used by the exact survival rule,
-the piecewise-smooth ground acceleration of one integration segment, and the
-collection of output samples.  Kept apart so ``simulate.py`` holds only the
-phase logic.
+Its ``Settings`` and pure helpers: the free-pendulum period used by the exact
+survival rule, the piecewise-smooth ground acceleration of one integration
+segment, the collection of output samples and the return-through-zero search of
+one step.  Kept apart so ``simulate.py`` holds only the phase logic.
 """
 from __future__ import annotations
 
