@@ -35,7 +35,7 @@ METRICS = {
                    "max |dtheta| / alpha"),
     "threshold": ("overturning threshold, Fig. 5 trilith, Omega = 4 rad/s",
                   "|A - A_ref| / A_ref"),
-    "restitution": ("engines: free-rocking restitution vs Eq. 20 (no pendulum)",
+    "restitution": ("engines: free-rocking restitution vs Eq. 20 (no pendulum, lam 5 and 3)",
                     "max |r / r_Eq20 - 1|"),
     "theta-rms": ("engines: RMS(theta - theta_analytic) before the 1st impact / alpha",
                   "RMS / alpha"),

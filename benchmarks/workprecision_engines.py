@@ -4,8 +4,10 @@ model versus wall time, swept over the time step and the main solver settings.
 Three errors, all dimensionless:
 
 * ``restitution``: ``max_k |measured_k / Eq.20 - 1|`` over the first two impacts of
-  free rocking (Fig. 5 trilith without pendulum released from ``alpha/2``;
-  :func:`engines.restitution.measure_restitution`);
+  free rocking released from ``alpha/2``, worst of two triliths without pendulum:
+  Fig. 5 (lam 5) and a squatter lam 3 (where Pymunk's solver iterations matter:
+  10 iterations give 3.4 % there and 0.06 % at lam 5);
+  :func:`engines.restitution.measure_restitution`;
 * ``theta-rms``: RMS of ``theta_engine - theta_analytic`` before the first impact,
   over ``alpha`` (Fig. 5 trilith with pendulum, one-sine 3 m/s^2 at 6 rad/s:
   uplift at 0.26 s, first impact at ~0.9 s);
@@ -39,6 +41,7 @@ __all__ = ["run_engines", "ENGINE_SWEEPS"]
 
 SCENE = Scene(name="fig5")
 SCENE_NOPEND = SCENE.without_pendulum()
+RESTITUTION_SCENES = (SCENE_NOPEND, SCENE_NOPEND.replace(lam=3.0, name="lam3"))
 RMS_CASE = {"amplitude": 3.0, "omega": 6.0}
 THR_CASE = {"omega": 4.0, "t_max": 6.0}
 THETA0_FRACTION = 0.5  # release from alpha/2: large, clean impacts
@@ -120,11 +123,15 @@ def _rms_error(backend, st, ref: _Reference) -> tuple[float, dict]:
 
 
 def _restitution_error(name: str, st) -> tuple[float, dict]:
-    res = measure_restitution(name, SCENE_NOPEND, THETA0_FRACTION * SCENE_NOPEND.alpha, st,
-                              n_impacts=2)
-    if not res.complete or not res.rel_errors or any(math.isnan(e) for e in res.rel_errors):
-        return math.inf, {"status": res.status, "n_impacts": res.n_impacts}
-    return res.max_rel_error, {"measured": list(res.measured), "predicted": list(res.predicted)}
+    worst, extra = 0.0, {}
+    for scene in RESTITUTION_SCENES:
+        res = measure_restitution(name, scene, THETA0_FRACTION * scene.alpha, st, n_impacts=2)
+        if not res.complete or not res.rel_errors or any(math.isnan(e) for e in res.rel_errors):
+            return math.inf, {"scene": scene.name, "status": res.status,
+                              "n_impacts": res.n_impacts}
+        extra[f"{scene.name}_max_rel_error"] = res.max_rel_error
+        worst = max(worst, res.max_rel_error)
+    return worst, extra
 
 
 def _threshold_error(backend, st, ref: _Reference) -> tuple[float, dict]:
