@@ -177,6 +177,8 @@ def _validate(scene, excitation, s: Settings) -> float:
                          f"got {s.solver_iterations!r}")
     if not (math.isfinite(s.contact_erp) and 0.0 <= s.contact_erp <= 1.0):
         raise ValueError(f"contact_erp must be in [0, 1], got {s.contact_erp!r}")
+    if not (math.isfinite(s.contact_slop) and 0.0 <= s.contact_slop <= 0.1):
+        raise ValueError(f"contact_slop must be in [0, 0.1] m, got {s.contact_slop!r}")
     cbt = s.contact_breaking_threshold
     if cbt is not None and not (math.isfinite(cbt) and cbt > 0.0):
         raise ValueError(f"contact_breaking_threshold must be None or > 0 m, got {cbt!r}")
