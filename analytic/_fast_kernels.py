@@ -347,13 +347,16 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             if hstep > 1e-12 * max(1.0, t):
                 hstep *= 0.125
                 continue
-            # No measurable excursion: the frame is back at rest (margin re-checked).
+            # No measurable excursion: the frame is back at rest.  The margin is
+            # not re-checked at once (it is still <= 0 for a few ns, which would
+            # loop uplift/rest without time advancing); the next uplift needs the
+            # margin to come from above again, as in the accurate path's recovery.
             events, ne = _push_event(events, ne, EV_REST, t, 0, y[1], 0.0, y[2], y[3],
                                      y[3], record)
             phase = 0
             y[0] = 0.0
             y[1] = 0.0
-            check_margin = True
+            check_margin = False
             need_k0 = True
             hstep = 1e-3 * quarter
             continue
@@ -367,10 +370,12 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
         ev_side = 0
         ev_x = 2.0
         if phase == 0:
+            xg0 = _xg(t, on, amp, omega, pkind)
             for side in (1, -1):
+                m0 = _margin(y[2], y[3], xg0, float(side), b, h, mu, gamma, l, g)
                 m1 = _margin(ynew[2], ynew[3], _xg(t1, on, amp, omega, pkind), float(side), b,
                              h, mu, gamma, l, g)
-                if m1 <= 0.0:
+                if m0 > 0.0 and m1 <= 0.0:
                     x = _locate(0, side, y, k, t, h_used, on, amp, omega, pkind, thr, b, h,
                                 mu, gamma, l, g, ytmp)
                     if x < ev_x:

@@ -218,3 +218,18 @@ def test_stale_numba_cache_is_dropped(tmp_path):
     assert _numba_cache.invalidate_if_stale(tmp_path)
     assert not any(p.exists() for p in stale) and kept.exists()
     assert not _numba_cache.invalidate_if_stale(tmp_path)  # stamp now current
+
+
+def test_cosine_pulse_exactly_at_uplift_is_decided():
+    """A one-cosine pulse with A exactly g/lam starts with a zero uplift margin: the
+    frame may lift by round-off and fall back within nanoseconds.  That must end at
+    rest and be decided, not loop uplift/rest at t = 0 until the step budget runs
+    out (which the spectrum scan start used to hit: 21 'undecided' runs per
+    one-cosine spectrum)."""
+    from analytic import Pulse
+    from analytic.fast import simulate as fast_simulate
+    from scenes import load_scene
+
+    scene = load_scene("fig5").without_pendulum()
+    traj = fast_simulate(scene, Pulse(scene.g / scene.lam, 7.0, "cosine"))
+    assert traj.verdict.status == "survived"
