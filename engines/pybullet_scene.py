@@ -1,4 +1,4 @@
-"""Building the trilith in a PyBullet world, and reading its state back.
+"""Building the trilith in a PyBullet world, stepping it and reading its state back.
 
 The analytic plane (x right, y up) is PyBullet's x-z plane (z up); the depth
 ``scene.depth`` runs along y.  A counter-clockwise rotation in the analytic plane
@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import pybullet as pb
 
-__all__ = ["Bodies", "build_scene", "initial_poses", "column_angle", "pendulum_state"]
+__all__ = ["Bodies", "World", "build_scene", "initial_poses", "column_angle",
+           "pendulum_state", "lintel_state"]
 
 # Own inertia of the pendulum bob relative to m4 l^2: negligible (the analytic
 # bob is a point; 1e-6 relative error) but non-zero so the link's inertia is regular.
@@ -156,8 +157,12 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
         links: list[dict] = []
         if scene.has_pendulum:
             l = scene.pendulum_length
-            bob_vis = pb.createVisualShape(pb.GEOM_SPHERE, radius=max(0.05 * b, 0.01),
-                                           rgbaColor=(0.8, 0.1, 0.1, 1.0), physicsClientId=client)
+            # Visual only (no collision shape, inertia set below): a rod and the
+            # bob, drawn in the link frame (hinge at its origin).
+            bob_vis = pb.createVisualShapeArray(
+                shapeTypes=[pb.GEOM_SPHERE, pb.GEOM_CYLINDER], radii=[0.15 * b, 0.02 * b],
+                lengths=[0.0, l], visualFramePositions=[(0.0, 0.0, -l), (0.0, 0.0, -0.5 * l)],
+                rgbaColors=[(0.8, 0.1, 0.1, 1.0), (0.3, 0.3, 0.3, 1.0)], physicsClientId=client)
             # Link frame at the hinge; its centre of mass (the bob) l below it.
             # Axis -y: a positive joint angle is a CCW (analytic) swing.
             links.append(dict(mass=scene.m4, col=-1, vis=bob_vis, pos=hinge_local,
@@ -253,3 +258,140 @@ def lintel_state(client: int, bodies: Bodies) -> tuple[tuple, tuple, tuple, tupl
     st = pb.getLinkState(bodies.lintel, bodies.lintel_link, computeLinkVelocity=1,
                          computeForwardKinematics=1, physicsClientId=client)
     return st[0], st[1], st[6], st[7]
+
+
+class World:
+    """One PyBullet client with the scene built; steps it and reads its state.
+
+    ``s`` is an :class:`engines.pybullet_engine.Settings` (validated by the
+    caller); ``friction`` the contact coefficient (each body gets its square
+    root: Bullet multiplies the two bodies' values).
+    """
+
+    def __init__(self, scene, excitation, s: Settings, friction: float, mode: int = pb.DIRECT):
+        self.scene, self.excitation, self.s = scene, excitation, s
+        self.client = pb.connect(mode)
+        c = self.client
+        cbt = s.contact_breaking_threshold or 0.01 * scene.b
+        # Every parameter set explicitly: some are process-global in Bullet.
+        pb.resetSimulation(physicsClientId=c)
+        pb.setPhysicsEngineParameter(
+            fixedTimeStep=s.dt, numSubSteps=0, numSolverIterations=s.solver_iterations,
+            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=s.contact_erp,
+            useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
+            contactBreakingThreshold=cbt, restitutionVelocityThreshold=0.2,
+            contactSlop=s.contact_slop, enableConeFriction=0, deterministicOverlappingPairs=1,
+            globalCFM=0.0,
+            solverResidualThreshold=1e-7, warmStartingFactor=0.85,
+            physicsClientId=c)
+
+        self.moving = s.base_motion == "ground"
+        pb.setGravity(0.0, 0.0, -scene.g, physicsClientId=c)
+        self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(friction), self.moving,
+                                     s.friction_anchor)
+        self.size = max(scene.lintel_length, scene.h)
+        self.start = {bid: self._pose(bid)[0] for bid in self.bodies.dynamic}
+        # Bottom corners of the upright columns (the scene's geometry, not the
+        # possibly tilted start).
+        b, d = scene.b, scene.d
+        self.pivots0 = [(0.0, b), (b + d, 2.0 * b + d)]
+        self.diag = dict(lintel_rotation_max=0.0, pivot_sliding_max=0.0, penetration_max=0.0,
+                         out_of_plane_max=0.0, out_of_plane_rotation_max=0.0)
+        self.step_index = 0
+        if self.moving:
+            self._set_ground(0)
+
+    def close(self) -> None:
+        pb.disconnect(physicsClientId=self.client)
+
+    # ---------------------------------------------------------------- stepping
+    def _set_ground(self, n: int) -> None:
+        """Reset the ground link to x_g(t_n), moving at the mean velocity of step n."""
+        dt, ex = self.s.dt, self.excitation
+        x0, x1 = ex.displacement(n * dt), ex.displacement((n + 1) * dt)
+        pb.resetJointState(self.bodies.ground, 0, x0, (x1 - x0) / dt, physicsClientId=self.client)
+
+    def step(self) -> None:
+        n, dt = self.step_index, self.s.dt
+        if self.moving:
+            self._set_ground(n)
+        else:
+            # Mid-step load: the step's velocity change is then second-order accurate.
+            a = self.excitation.acceleration((n + 0.5) * dt)
+            pb.setGravity(-a, 0.0, -self.scene.g, physicsClientId=self.client)
+        pb.stepSimulation(physicsClientId=self.client)
+        self.step_index = n + 1
+
+    # ----------------------------------------------------------------- reading
+    def _pose(self, body: int) -> tuple[tuple, tuple, tuple]:
+        if body == self.bodies.lintel:
+            return lintel_state(self.client, self.bodies)[:3]
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        return pos, quat, pb.getBaseVelocity(body, physicsClientId=self.client)[0]
+
+    def _bottom_corners(self, body: int) -> tuple[float, float]:
+        """World x of a column's bottom-left and bottom-right edge midpoints."""
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        hb, hh = 0.5 * self.scene.b, 0.5 * self.scene.h
+        out = []
+        for dx in (-hb, hb):
+            out.append(pb.multiplyTransforms(pos, quat, (dx, 0.0, -hh), (0, 0, 0, 1))[0][0])
+        return out[0], out[1]
+
+    def ground_x(self) -> float:
+        if not self.moving:
+            return 0.0
+        return pb.getJointState(self.bodies.ground, 0, physicsClientId=self.client)[0]
+
+    def sample(self) -> tuple[float, float, float, float, float, str | None]:
+        """Column angles, mean rate, pendulum state; updates the diagnostics.
+
+        Returns ``(theta_left, theta_right, theta_dot, psi, psi_dot, problem)``
+        where ``problem`` names a blow-up, or None.  The rocking diagnostics
+        (sliding, penetration, lintel rotation, out-of-plane motion) are taken
+        while both columns stand (``|theta| < alpha``): a collapse, with the
+        lintel falling off, is beyond the model and not a numerical problem.
+        """
+        c, bodies, scene, diag = self.client, self.bodies, self.scene, self.diag
+        cols = [column_angle(c, body) for body in bodies.columns]
+        theta_l, theta_r = cols[0][0], cols[1][0]
+        standing = max(abs(theta_l), abs(theta_r)) < scene.alpha
+        psi = psi_dot = 0.0
+        if bodies.pendulum_joint is not None:
+            psi, psi_dot = pendulum_state(c, bodies)
+        problem = None
+        gx = self.ground_x()
+        v_bound = 20.0 * math.sqrt(2.0 * scene.g * self.size) + 10.0 * abs(
+            self.excitation.velocity(self.step_index * self.s.dt))
+        for body in bodies.dynamic:
+            pos, quat, vel = self._pose(body)
+            if not all(math.isfinite(v) for v in pos + vel + quat):
+                return theta_l, theta_r, 0.0, psi, psi_dot, "non-finite body state"
+            drift = math.dist(pos, self.start[body]) - abs(gx)
+            speed = math.hypot(*vel)
+            if drift > 10.0 * self.size or speed > v_bound:
+                problem = f"body {body} flew away (drift {drift:.3g} m, speed {speed:.3g} m/s)"
+            if standing:
+                roll, pitch, yaw = pb.getEulerFromQuaternion(quat)
+                diag["out_of_plane_max"] = max(diag["out_of_plane_max"],
+                                               abs(pos[1] - self.start[body][1]))
+                diag["out_of_plane_rotation_max"] = max(diag["out_of_plane_rotation_max"],
+                                                        abs(roll), abs(yaw))
+                if body == bodies.lintel:
+                    diag["lintel_rotation_max"] = max(diag["lintel_rotation_max"], abs(pitch))
+        if abs(psi_dot) * bodies.length > v_bound:
+            problem = f"pendulum speed {abs(psi_dot) * bodies.length:.3g} m/s"
+        if standing:
+            for k, body in enumerate(bodies.columns):
+                corners = self._bottom_corners(body)
+                theta = cols[k][0]
+                # The pivot corner while rocking; both corners while at rest.
+                idx = ((0 if theta > 0 else 1,) if abs(theta) > self.s.monitor.uplift_angle
+                       else (0, 1))
+                slide = max(abs(corners[i] - self.pivots0[k][i] - gx) for i in idx)
+                diag["pivot_sliding_max"] = max(diag["pivot_sliding_max"], slide)
+            for point in pb.getContactPoints(physicsClientId=c):
+                diag["penetration_max"] = max(diag["penetration_max"], -point[8])
+            if diag["out_of_plane_max"] > self.s.out_of_plane_limit * self.size:
+                problem = f"out-of-plane drift {diag['out_of_plane_max']:.3g} m"
+        return theta_l, theta_r, 0.5 * (cols[0][1] + cols[1][1]), psi, psi_dot, problem
