@@ -227,9 +227,11 @@ def test_cosine_pulse_exactly_at_uplift_is_decided():
     out (which the spectrum scan start used to hit: 21 'undecided' runs per
     one-cosine spectrum)."""
     from analytic import Pulse
-    from analytic.fast import simulate as fast_simulate
+    from analytic.fast import simulate as fast_simulate, verdict_for
     from scenes import load_scene
 
-    scene = load_scene("fig5").without_pendulum()
-    traj = fast_simulate(scene, Pulse(scene.g / scene.lam, 7.0, "cosine"))
-    assert traj.verdict.status == "survived"
+    scene = load_scene("fig9_lam5_b0.4").without_pendulum()
+    for omega in (3.5, 7.0, 8.0):
+        pulse = Pulse(scene.g / scene.lam, omega, "cosine")
+        assert verdict_for(scene, pulse).status == "survived"
+        assert fast_simulate(scene, pulse).verdict.status == "survived"
