@@ -214,6 +214,10 @@ def overturn_energy_barrier(b: float, h: float, mu: float, gamma: float, g: floa
     ``g M (sqrt(b^2 + h^2) - h)`` (pendulum hanging, trilith at rest speed).
 
     After the pulse the energy never increases, so a run whose energy is below
-    this barrier can never reach ``alpha`` again: it has survived, exactly.
+    this barrier *while* ``|theta| < alpha`` can never reach ``alpha``: it has
+    survived, exactly.  Past ``alpha`` the rocking potential falls below the
+    barrier (it is negative beyond ``2 alpha``), so the rule says nothing there:
+    the paper's point D leans past ``alpha`` at the pulse end with less energy
+    than the barrier and still topples.
     """
     return g * (1.0 + mu + gamma) * (math.hypot(b, h) - h)
