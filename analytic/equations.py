@@ -26,8 +26,9 @@ an independent sympy derivation in ``tests/test_derivation.py``):
   in the numerator after the sign change below (the print carries Eq. 8's typo).
 * Eq. 19: the denominator's pendulum term is ``2 m4 (b cos(psi) + h sin(psi))^2``
   (the print drops the factor 2; Eq. 21 has it).
-* Eq. 15-16: the column's moment of momentum about its top corner carries
-  ``(m1 h^2/4 + J_G)``; the print's ``- J_G`` is an OCR/sign error.
+* Eq. 17 is OCR-damaged (``+ -l m4`` and a bracket ending in ``+ 1`` for ``+ l``).
+  Eqs. 15-16 are right as printed, ``- J_G`` included (moment of momentum about
+  the new top corner); Eq. 20's ``m_p + 2 m_t`` means ``m1 + 2 m3``.
 """
 from __future__ import annotations
 
