@@ -314,3 +314,58 @@ def impact_closed_form(new_side: int) -> tuple[sp.Expr, sp.Expr]:
     psi_plus = system["outputs"]["psi_dot_plus"].subs(zero).subs(sol)
     ratio = sp.trigsimp(sp.factor(w1 / W_MINUS))
     return ratio, sp.trigsimp(sp.factor(psi_plus))
+
+
+# ----------------------------------------------- forms to compare with (not derived)
+# The paper's printed equations (OCR text, per m1: m3 = mu, m4 = gamma, J_G = j) and
+# the corrected forms documented in ``analytic/equations.py``; used only as the
+# other side of a comparison with the derivation above.
+M = 1 + mu + gamma
+
+
+def corrected_eq8(side: int):
+    """The corrected Eq. 8 / A.1 as written in ``rocking_accelerations``'s docstring."""
+    sb = side * b
+    k = sb * sp.sin(th - ps) + h * sp.cos(th - ps)
+    kc = sb * sp.cos(th - ps) - h * sp.sin(th - ps)
+    inertia = ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
+    e1 = (inertia * thdd - gamma * l * k * psdd + gamma * l * kc * psd ** 2
+          + g * M * (sb * sp.cos(th) - h * sp.sin(th)) - M * xgdd * (h * sp.cos(th) + sb * sp.sin(th)))
+    e2 = -k * thdd + l * psdd - kc * thd ** 2 + g * sp.sin(ps) + xgdd * sp.cos(ps)
+    return e1, e2
+
+
+def printed_eq8():
+    """Eq. 8 exactly as printed (per m1: m3 = mu, m4 = gamma, J_G = j)."""
+    s, c = sp.sin(th - ps), sp.cos(th - ps)
+    e1 = (g * M * (b * sp.cos(th) + h * sp.sin(th)) + l * gamma * psd ** 2 * (b * c + h * s)
+          - M * xgdd * (h * sp.cos(th) + b * sp.sin(th))
+          + thdd * ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
+          - l * gamma * psdd * (b * s + h * c))
+    e2 = (-l * gamma * thdd * (b * s + h * c) + l * gamma * thd ** 2 * (-b * c + h * s)
+          + l * gamma * (g * sp.sin(ps) + l * psdd + sp.cos(ps) * xgdd))
+    return e1, e2
+
+
+def printed_a1():
+    """Eq. A.1 exactly as printed."""
+    s, c = sp.sin(th - ps), sp.cos(th - ps)
+    e1 = (-g * M * (b * sp.cos(th) + h * sp.sin(th)) - l * gamma * psd ** 2 * (b * c + h * s)
+          - M * xgdd * (h * sp.cos(th) - b * sp.sin(th))
+          + thdd * ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
+          + l * gamma * psdd * (b * s - h * c))
+    e2 = (l * gamma * thdd * (b * s - h * c) + l * gamma * thd ** 2 * (b * c + h * s)
+          + l * gamma * (g * sp.sin(ps) + l * psdd + sp.cos(ps) * xgdd))
+    return e1, e2
+
+
+def corrected_eq19_21():
+    """``(ratio, psi_dot+)`` for new_side = +1 as documented in ``impact_velocities``."""
+    c = b * sp.cos(ps) + h * sp.sin(ps)
+    dd = b * sp.cos(ps) - h * sp.sin(ps)
+    ratio = -(-4 * j + (b ** 2 - h ** 2) * (1 + 2 * mu) + 2 * gamma * c * dd) / (
+        4 * j + (b ** 2 + h ** 2) * (1 + 2 * mu) + 2 * gamma * c ** 2)
+    w_m, p_m = W_MINUS, PSI_DOT_MINUS
+    w_p = ratio * w_m
+    psi_p = p_m + (h * sp.cos(ps) * (w_p - w_m) - b * sp.sin(ps) * (w_p + w_m)) / l
+    return ratio, psi_p

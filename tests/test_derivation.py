@@ -92,54 +92,18 @@ def test_hinge_lintel_and_gap_drop_out(side):
         assert not expr.free_symbols & set(D.GEOMETRY_FREE)
 
 
-def corrected_eq8(side: int):
-    """The corrected Eq. 8 / A.1 as written in ``rocking_accelerations``'s docstring."""
-    sb = side * b
-    k = sb * sp.sin(th - ps) + h * sp.cos(th - ps)
-    kc = sb * sp.cos(th - ps) - h * sp.sin(th - ps)
-    inertia = ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
-    e1 = (inertia * thdd - gamma * l * k * psdd + gamma * l * kc * psd ** 2
-          + g * M * (sb * sp.cos(th) - h * sp.sin(th)) - M * xgdd * (h * sp.cos(th) + sb * sp.sin(th)))
-    e2 = -k * thdd + l * psdd - kc * thd ** 2 + g * sp.sin(ps) + xgdd * sp.cos(ps)
-    return e1, e2
-
-
 @pytest.mark.parametrize("side", SIDES)
 def test_lagrange_equals_documented_corrected_eq8(side):
     e_th, e_ps = D.lagrange(side)
-    e1, e2 = corrected_eq8(side)
+    e1, e2 = D.corrected_eq8(side)
     assert is_zero(e_th - e1)
     assert is_zero(e_ps - gamma * l * e2)  # Eq. 8b is m4 l times the documented form
-
-
-def printed_eq8():
-    """Eq. 8 exactly as printed (per m1: m3 = mu, m4 = gamma, J_G = j)."""
-    s, c = sp.sin(th - ps), sp.cos(th - ps)
-    e1 = (g * M * (b * sp.cos(th) + h * sp.sin(th)) + l * gamma * psd ** 2 * (b * c + h * s)
-          - M * xgdd * (h * sp.cos(th) + b * sp.sin(th))
-          + thdd * ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
-          - l * gamma * psdd * (b * s + h * c))
-    e2 = (-l * gamma * thdd * (b * s + h * c) + l * gamma * thd ** 2 * (-b * c + h * s)
-          + l * gamma * (g * sp.sin(ps) + l * psdd + sp.cos(ps) * xgdd))
-    return e1, e2
-
-
-def printed_a1():
-    """Eq. A.1 exactly as printed."""
-    s, c = sp.sin(th - ps), sp.cos(th - ps)
-    e1 = (-g * M * (b * sp.cos(th) + h * sp.sin(th)) - l * gamma * psd ** 2 * (b * c + h * s)
-          - M * xgdd * (h * sp.cos(th) - b * sp.sin(th))
-          + thdd * ((b ** 2 + h ** 2) * (1 + 2 * (mu + gamma)) + 4 * j) / 2
-          + l * gamma * psdd * (b * s - h * c))
-    e2 = (l * gamma * thdd * (b * s - h * c) + l * gamma * thd ** 2 * (b * c + h * s)
-          + l * gamma * (g * sp.sin(ps) + l * psdd + sp.cos(ps) * xgdd))
-    return e1, e2
 
 
 def test_printed_eq8_has_two_sign_typos_in_first_equation():
     """Printed minus derived is exactly the two ``+h sin`` terms (should be ``-h sin``)."""
     e_th, e_ps = D.lagrange(1)
-    p1, p2 = printed_eq8()
+    p1, p2 = D.printed_eq8()
     typo = 2 * g * M * h * sp.sin(th) + 2 * l * gamma * psd ** 2 * h * sp.sin(th - ps)
     assert is_zero(p1 - e_th - typo)
     assert is_zero(p2 - e_ps)
@@ -147,7 +111,7 @@ def test_printed_eq8_has_two_sign_typos_in_first_equation():
 
 def test_printed_a1_is_correct():
     e_th, e_ps = D.lagrange(-1)
-    p1, p2 = printed_a1()
+    p1, p2 = D.printed_a1()
     assert is_zero(p1 - e_th)
     assert is_zero(p2 - e_ps)
 
@@ -207,16 +171,18 @@ def test_uplift_margin_and_acceleration_match_multiplier(side):
     args = (b, h, mu, gamma, j, l, g, ps, psd, xgdd)
     f_q, f_free = (sp.lambdify(args, e, "math") for e in (q, free))
     f_a = sp.lambdify(args[:-1], a_up, "math")
+    mass = D.mass_matrix_rhs(side)[0].subs(th, 0)
+    f_schur = sp.lambdify(args[:-1], mass[0, 0] - mass[0, 1] ** 2 / mass[1, 1], "math")
     for cs in random_cases(seed=30 + side):
         vals = (cs["b"], cs["h"], cs["mu"], cs["gamma"], cs["j"], cs["l"], cs["g"], cs["psi"],
                 cs["psi_dot"])
         common = (side, cs["b"], cs["h"], cs["mu"], cs["gamma"])
         margin = eq.uplift_margin(cs["psi"], cs["psi_dot"], cs["xg_ddot"], *common, cs["l"], cs["g"])
-        scale = cs["h"] * (cs["g"] + abs(cs["xg_ddot"]) + cs["l"] * cs["psi_dot"] ** 2) * (1 + cs["mu"] + cs["gamma"])
+        scale = (cs["h"] * (1 + cs["mu"] + cs["gamma"])
+                 * (cs["g"] + abs(cs["xg_ddot"]) + cs["l"] * cs["psi_dot"] ** 2))
         assert close(margin, side * f_q(*vals, cs["xg_ddot"]), scale)
         # The margin has the sign of -side*theta_ddot of the free mechanism (Schur complement).
-        schur = 0.5 * ((cs["b"] ** 2 + cs["h"] ** 2) * (1 + 2 * cs["mu"] + 2 * cs["gamma"]) + 4 * cs["j"])
-        schur -= cs["gamma"] * (cs["h"] * math.cos(cs["psi"]) - side * cs["b"] * math.sin(cs["psi"])) ** 2
+        schur = f_schur(*vals)
         assert close(margin, -side * schur * f_free(*vals, cs["xg_ddot"]), scale)
         got = eq.uplift_acceleration(cs["psi"], cs["psi_dot"], *common, cs["l"], cs["g"])
         assert close(got, f_a(*vals), scale / cs["h"])
@@ -298,23 +264,11 @@ def test_impact_velocities_match_impulse_momentum(new_side):
     assert 0 < n_stop < N_STATES  # both branches were exercised (seeded: deterministic)
 
 
-def corrected_eq19_21():
-    """``(ratio, psi_dot+)`` for new_side = +1 as documented in ``impact_velocities``."""
-    c = b * sp.cos(ps) + h * sp.sin(ps)
-    dd = b * sp.cos(ps) - h * sp.sin(ps)
-    ratio = -(-4 * j + (b ** 2 - h ** 2) * (1 + 2 * mu) + 2 * gamma * c * dd) / (
-        4 * j + (b ** 2 + h ** 2) * (1 + 2 * mu) + 2 * gamma * c ** 2)
-    w_m, p_m = D.W_MINUS, D.PSI_DOT_MINUS
-    w_p = ratio * w_m
-    psi_p = p_m + (h * sp.cos(ps) * (w_p - w_m) - b * sp.sin(ps) * (w_p + w_m)) / l
-    return ratio, psi_p
-
-
 def test_impact_closed_form_eq19_21():
     """Exact solve (right -> left, Fig. 3): the corrected Eq. 19 and the printed
     Eq. 21 hold; the printed Eq. 19 lacks the factor 2 on ``m4 (b cos + h sin)^2``."""
     ratio, psi_p = D.impact_closed_form(1)
-    doc_ratio, doc_psi = corrected_eq19_21()
+    doc_ratio, doc_psi = D.corrected_eq19_21()
     assert is_zero(ratio - doc_ratio)
     assert is_zero(psi_p - doc_psi)
     c = b * sp.cos(ps) + h * sp.sin(ps)
