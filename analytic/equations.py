@@ -126,6 +126,8 @@ def uplift_acceleration(psi: float, psi_dot: float, side: float, b: float, h: fl
 
     With ``gamma = 0`` it is ``side * g / lam`` (Eq. 11); with the pendulum hanging
     still (``psi = psi_dot = 0``) it is ``side * g (1 + mu + gamma) / (lam (1 + mu))``.
+    The denominator vanishes only for a very heavy pendulum on a squat trilith
+    (e.g. ``lam = 1, mu = 0, gamma > 4.8`` at ``psi ~ 0.39``): then +-inf.
     """
     sb = side * b
     big_m = 1.0 + mu + gamma
@@ -134,6 +136,11 @@ def uplift_acceleration(psi: float, psi_dot: float, side: float, b: float, h: fl
     num = (g * big_m * sb + gamma * g * sp * (h * cp - sb * sp)
            + gamma * l * psi_dot * psi_dot * (sb * cp + h * sp))
     den = big_m * h - gamma * cp * (h * cp - sb * sp)
+    if den == 0.0:
+        # The base acceleration drops out of the margin (heavy pendulum on a squat
+        # trilith at one psi): no base acceleration uplifts if the margin is
+        # positive, any does otherwise.
+        return math.copysign(math.inf, side) if side * num > 0.0 else -math.copysign(math.inf, side)
     return num / den
 
 
