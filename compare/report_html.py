@@ -120,12 +120,21 @@ def _spectra_figure(result) -> str:
     fig, axes = plt.subplots(1, len(cases), figsize=(5.5 * len(cases), 4), squeeze=False)
     for ax, case in zip(axes[0], cases):
         spec = result.spectra[case]
-        ax.plot(spec["omega"], spec["a"], "k-", lw=1, label=f"{spec['backend']} (reference)")
+        w = np.asarray(spec["omega"], float)
+        a = np.asarray([np.nan if v is None else v for v in spec["a"]], float)
+        for jp in spec.get("jumps", []):  # no line across a jump: the curve is discontinuous
+            i = int(np.searchsorted(w, jp["omega_hi"]))
+            w, a = np.insert(w, i, np.nan), np.insert(a, i, np.nan)
+        ax.plot(w, a, "k-", lw=1, label=f"{spec['backend']} (reference)")
         for name, pts in spec.get("engines", {}).items():
             ax.plot([p["omega"] for p in pts], [p["a_engine"] for p in pts], "o",
                     color=_COLORS.get(name), mfc="none", label=name)
         for jp in spec.get("jumps", []):
-            ax.axvline(jp["omega"], color="0.6", lw=0.6, ls=":")
+            ax.axvline(jp.get("omega_tip", jp["omega"]), color="0.6", lw=0.6, ls=":")
+        for name, j in spec.get("jump_shifts", {}).items():
+            if j.get("omega_engine") is not None and math.isfinite(j["omega_engine"]):
+                ax.axvline(j["omega_engine"], color=_COLORS.get(name), lw=0.8, ls="--",
+                           label=f"{name} jump")
         ax.set_title(case.replace("_", " "), fontsize=9)
         ax.set_xlabel("Ω [rad/s]")
         ax.set_ylabel("first overturning A [m/s²]")
