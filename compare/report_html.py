@@ -25,7 +25,7 @@ from .metrics import _plain  # noqa: E402
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict"]
 
-_COLORS = {"analytic": "k", "pybullet": "tab:blue", "pymunk": "tab:orange"}
+_COLORS = {"analytic": "k", "analytic-fast": "tab:green", "pybullet": "tab:blue", "pymunk": "tab:orange"}
 
 
 def summary_dict(result) -> dict:
