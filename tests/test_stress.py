@@ -334,12 +334,17 @@ def test_engine_invalid_step_raises(name):
 @pytest.mark.parametrize("name", ["pybullet", "pymunk"])
 @pytest.mark.parametrize("dt", [1e-3, 1e-4])
 def test_engine_reruns_bit_identical(name, dt):
-    """Same scene, pulse and settings: the same numbers, bit for bit (each run
-    builds a fresh world; nothing leaks between runs)."""
+    """Same scene, pulse and settings: the same numbers, bit for bit, even with a
+    run of other settings in between (each run builds a fresh world; PyBullet's
+    process-global contact breaking threshold must not leak between runs)."""
     scene = Scene()
     pulse = Pulse(3.0, 6.0)
     backend, st = _engine_settings(name, scene, pulse, dt=dt, t_max=1.2)
     first = backend.simulate(scene, pulse, st)
+    other = ({"contact_breaking_threshold": 0.05, "solver_iterations": 10}
+             if name == "pybullet" else {"iterations": 10, "slop_fraction": 1e-2})
+    _, st_other = _engine_settings(name, scene, pulse, dt=dt, t_max=0.5, **other)
+    backend.simulate(Scene(lam=3.0), pulse, st_other)
     second = backend.simulate(scene, pulse, st)
     assert first.verdict == second.verdict
     for field in ("t", "theta", "theta_dot", "psi", "psi_dot"):
