@@ -221,3 +221,21 @@ def test_uplift_timed_at_the_same_angle_in_both_runs():
     c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
     # Linear interpolation of a parabola between 1 ms samples: error << 1 ms.
     assert c.uplift_time_error == pytest.approx(0.05, abs=5e-4)
+
+
+def test_tongue_tip_is_where_the_spectrum_mode_changes():
+    """The jump located by compare.spectra sits where analytic.spectrum's first
+    overturning mode switches (an independent scan + bisection)."""
+    from compare.campaign import CampaignConfig
+    from compare.spectra import first_overturning_amplitude, reference_spectrum
+    from scenes import load_scene
+
+    scene = load_scene("no_pendulum")
+    cfg = CampaignConfig(omega_range=(17.0, 18.5), spectrum_step=0.5)
+    jump = reference_spectrum(scene, cfg)["jump"]
+    tip = jump["omega_tip"]
+    # The tip is bisected to d_omega = 0.02 rad/s; 0.05 on either side is clear of it.
+    assert first_overturning_amplitude(scene, tip - 0.05)[1] == "after-impact"
+    assert first_overturning_amplitude(scene, tip + 0.05)[1] == "no-impact"
+    # The probe lies between the two threshold levels of the jump.
+    assert jump["a_lo"] < jump["probe_amplitude"] < jump["a_hi"]
