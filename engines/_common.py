@@ -42,6 +42,10 @@ class MonitorSettings:
     rest_hold : s; how long it must stay at rest after the pulse (at least one free
         pendulum period is added when there is a pendulum).
     t_cap : s after the pulse end before an undecided run stops ('undecided').
+    max_mismatch : largest ``|theta_left - theta_right|`` [in units of alpha]
+        while ``|theta| < alpha``: the lintel ties the columns together (engines
+        keep them within ~1e-5 rad), so a larger mismatch means the engine broke
+        the linkage (columns creeping apart, lintel sliding off): 'unstable'.
     energy_rule : stop as 'survived' once the energy is below the overturning
         barrier after the pulse.  Free-rocking experiments (restitution) turn it
         off: they need the impacts, not the verdict.
@@ -53,6 +57,7 @@ class MonitorSettings:
     rest_rate: float = 1e-3
     rest_hold: float = 0.5
     t_cap: float = 60.0
+    max_mismatch: float = 0.25
     energy_rule: bool = True
 
 
@@ -134,7 +139,13 @@ class RunMonitor:
             self.mark_unstable(t, "non-finite state")
             return True
         self.samples.append(values)
-        self.mismatch = max(self.mismatch, abs(theta_left - theta_right))
+        mismatch = abs(theta_left - theta_right)
+        self.mismatch = max(self.mismatch, mismatch)
+        if (self.scene.mu > 0.0 and abs(theta) < self.scene.alpha
+                and mismatch > self.cfg.max_mismatch * self.scene.alpha):
+            self.mark_unstable(t, f"columns out of step by {mismatch:.3g} rad "
+                                  f"(> {self.cfg.max_mismatch:g} alpha): linkage broken")
+            return True
         cfg = self.cfg
         if abs(theta) > cfg.uplift_angle:
             sign = 1 if theta > 0 else -1

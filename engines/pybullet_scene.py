@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import pybullet as pb
 
 __all__ = ["Bodies", "World", "build_scene", "initial_poses", "column_angle",
-           "pendulum_state", "lintel_state"]
+           "pendulum_state", "lintel_state", "effective_slop"]
 
 # Own inertia of the pendulum bob relative to m4 l^2: negligible (the analytic
 # bob is a point; 1e-6 relative error) but non-zero so the link's inertia is regular.
@@ -38,6 +38,16 @@ NEGLIGIBLE_MASS_FRACTION = 1e-6
 # The heavy moving ground ("ground" base motion) weighs this many trilith masses,
 # so contact impulses change its reset velocity by < 1e-6 within a step.
 GROUND_MASS_FACTOR = 1e6
+
+
+def effective_slop(settings) -> float:
+    """Bullet's ``contactSlop`` [m] for ``settings``: the given value, else
+    ``min(1e-4, dt * 1 m/s)`` (calibrated 1e-4 m at the default step; a smaller
+    step needs a proportionally smaller slop, see ``pybullet_engine.Settings``)."""
+    if settings.contact_slop is not None:
+        return settings.contact_slop
+    return min(1e-4, settings.dt * 1.0)
+
 
 
 @dataclass
@@ -280,7 +290,7 @@ class World:
             contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=s.contact_erp,
             useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
             contactBreakingThreshold=cbt, restitutionVelocityThreshold=0.2,
-            contactSlop=s.contact_slop, enableConeFriction=0, deterministicOverlappingPairs=1,
+            contactSlop=effective_slop(s), enableConeFriction=0, deterministicOverlappingPairs=1,
             globalCFM=0.0,
             solverResidualThreshold=1e-7, warmStartingFactor=0.85,
             physicsClientId=c)

@@ -384,12 +384,9 @@ def test_pybullet_blowup_is_unstable():
 @pytest.mark.parametrize("name,dt", [
     ("pymunk", 1e-5),
     ("pybullet", 1e-4),
-    pytest.param("pybullet", 1e-5, marks=pytest.mark.xfail(strict=True, reason=(
-        "PyBullet at dt = 1e-5 s with the default contact_slop = 1e-4 m (calibrated at "
-        "dt = 1e-4 s): before uplift the columns creep (pivot sliding 0.2 m, theta 0.037 "
-        "rad by t = 0.1 s; 2.3 rad column mismatch by 0.66 s) and the run still ends "
-        "'survived', not 'unstable'; with contact_slop = 1e-5 m it is clean.  Reported "
-        "to the lead."))),
+    # Was a strict xfail: with a fixed 1e-4 m contact slop the columns crept apart
+    # at 1e-5 s; the slop now scales with dt (pybullet_scene.effective_slop).
+    ("pybullet", 1e-5),
 ])
 def test_engine_small_step_stays_at_rest_before_uplift(name, dt):
     """A smaller step must not make an engine worse than its default: under the
