@@ -80,13 +80,15 @@ def _quat_theta(theta: float) -> tuple[float, float, float, float]:
     return pb.getQuaternionFromEuler((0.0, -theta, 0.0))
 
 
-def initial_poses(scene, theta0: float, psi0: float) -> dict:
+def initial_poses(scene, theta0: float, psi0: float, sink: float = 0.0) -> dict:
     """World poses of the columns, lintel and pendulum bob for a trilith tilted by
     ``theta0`` (about the left corners if > 0, the right ones if < 0), at rest.
 
     The columns rotate rigidly about their pivot corners; the lintel translates
     with the column tops (the parallelogram of Eq. 5-6); the bob hangs at
-    ``psi0`` from the hinge.
+    ``psi0`` from the hinge.  ``sink`` [m] lowers the columns by ``sink`` and the
+    lintel by ``2 sink``: every contact then starts at that penetration (the
+    contact slop, where Bullet's resting contacts settle, see :func:`build_scene`).
     """
     b, h, d = scene.b, scene.h, scene.d
     c, s = math.cos(theta0), math.sin(theta0)
@@ -98,22 +100,33 @@ def initial_poses(scene, theta0: float, psi0: float) -> dict:
     centres = []
     for x_left in (0.0, b + d):
         pivot_x = x_left if theta0 >= 0.0 else x_left + b
-        centres.append(rotate_about(pivot_x, 0.0, x_left + 0.5 * b, 0.5 * h))
+        cx, cz = rotate_about(pivot_x, 0.0, x_left + 0.5 * b, 0.5 * h)
+        centres.append((cx, cz - sink))
     # The lintel rests on the top corner diagonally opposite the pivot (it rises
     # the most) and translates with it (the parallelogram of Eq. 5-6).
     pivot, top = (0.0, b) if theta0 >= 0.0 else (b, 0.0)
     top_x, top_z = rotate_about(pivot, 0.0, top, h)
     shift = (top_x - top, top_z - h)
-    lintel = (0.5 * scene.lintel_length + shift[0], h + 0.5 * scene.lintel_thickness + shift[1])
+    lintel = (0.5 * scene.lintel_length + shift[0],
+              h + 0.5 * scene.lintel_thickness + shift[1] - 2.0 * sink)
     return {"columns": centres, "lintel": lintel, "quat": _quat_theta(theta0)}
 
 
 def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
-                moving_ground: bool, friction_anchor: bool = True) -> Bodies:
-    """Create every body of ``scene`` in ``client`` (see the module docstring)."""
+                moving_ground: bool, friction_anchor: bool = True, slop: float = 0.0) -> Bodies:
+    """Create every body of ``scene`` in ``client`` (see the module docstring).
+
+    ``slop``: Bullet's ``contactSlop`` [m].  The bodies start sunk by it
+    (:func:`initial_poses`), where a resting contact settles: penetrations below
+    the slop are left to close freely, so bodies placed at zero gap fall through
+    ``slop`` without any contact force, ~4.5 ms for 1e-4 m.  Under a pulse starting
+    at t = 0 they slid frictionless meanwhile and landed with a sideways velocity
+    whose friction impulse kicked them into rocking: uplift 3-4 ms early at the
+    paper's points A and D (theta error ~1e-2 alpha before the first impact).
+    """
     b, h, depth = scene.b, scene.h, scene.depth
     span = scene.lintel_length
-    poses = initial_poses(scene, theta0, psi0)
+    poses = initial_poses(scene, theta0, psi0, sink=slop)
 
     # Ground: wide enough for columns lying on their sides, thick enough that a
     # corner cannot tunnel through it; a box, not a GEOM_PLANE (DESIGN.md: the
@@ -298,7 +311,7 @@ class World:
         self.moving = s.base_motion == "ground"
         pb.setGravity(0.0, 0.0, -scene.g, physicsClientId=c)
         self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(friction), self.moving,
-                                     s.friction_anchor)
+                                  s.friction_anchor, slop=effective_slop(s))
         self.size = max(scene.lintel_length, scene.h)
         self.start = {bid: self._pose(bid)[0] for bid in self.bodies.dynamic}
         # Bottom corners of the upright columns (the scene's geometry, not the
