@@ -58,6 +58,7 @@ from . import equations as eq
 from .events import (Settings, SampleBuffer, excitation_window, free_pendulum_period,
                      rest_rows, return_time, segment_acceleration)
 from .parameters import Scene
+from .reactions import validity_diagnostics
 from .trajectory import Event, Trajectory, Verdict
 
 __all__ = ["NAME", "Settings", "simulate", "version"]
@@ -398,7 +399,9 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         Samples on the ``sample_dt`` grid plus every event instant (an impact
         gives two samples at the same time, before and after), the events
         (uplift, impact, rest, overturn), the verdict and diagnostics
-        (``n_steps``, ``n_rhs_evals``, ``n_segments``).
+        (``n_steps``, ``n_rhs_evals``, ``n_segments``; and, from the samples, the
+        ground-reaction checks of :func:`~analytic.reactions.validity_diagnostics`:
+        ``min_vertical_reaction``, ``max_friction_demand``, ``model_valid``, ...).
     """
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
@@ -417,8 +420,15 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     run = _Run(scene, excitation, st)
     run.run()
     t, theta, theta_dot, psi, psi_dot = run.samples.arrays()
+    wall = time.perf_counter() - start  # the simulation proper, as before the checks below
+    diagnostics = dict(run.diag)
+    if all(np.all(np.isfinite(a)) for a in (theta, theta_dot, psi, psi_dot)):
+        # Diagnostics only (docs/model.md, "Ground reaction"): nothing above depends on them.
+        diagnostics.update(validity_diagnostics(t, theta, theta_dot, psi, psi_dot,
+                                                excitation.acceleration, scene.model_args(),
+                                                scene.alpha, run.verdict.overturned))
     return Trajectory(
         backend=NAME, t=t, theta=theta, theta_dot=theta_dot, psi=psi, psi_dot=psi_dot,
         events=tuple(run.events), verdict=run.verdict, criterion=st.criterion,
-        t_max=st.t_max, settings=dataclasses.asdict(st), diagnostics=dict(run.diag),
-        wall_time=time.perf_counter() - start, scene=scene, excitation=excitation)
+        t_max=st.t_max, settings=dataclasses.asdict(st), diagnostics=diagnostics,
+        wall_time=wall, scene=scene, excitation=excitation)

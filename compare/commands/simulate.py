@@ -102,6 +102,11 @@ def run(args: argparse.Namespace) -> int:
     print(f"uplift: {'none' if up is None else f'{up:.4f} s'}, impacts: {traj.n_impacts}, "
           f"max |theta| = {traj.max_abs_theta:.4g} rad (alpha = {scene.alpha:.4g}), "
           f"t_end = {traj.t[-1]:.3f} s, wall {traj.wall_time:.3f} s")
+    if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
+        d = traj.diagnostics
+        print(f"warning: the analytic model is not valid along this run: the ground would have "
+              f"to pull (min vertical reaction {d['min_vertical_reaction']:.3g} x weight), "
+              f"the columns would hop; engines may disagree for that reason")
     if args.csv:
         print(f"wrote {args.csv}")
     if args.plot:
