@@ -32,19 +32,56 @@ column tops under the lintel) is statically indeterminate in a rigid model.
 from __future__ import annotations
 
 import math
-from typing import Callable
 
 import numpy as np
 
 from . import equations as eq
 
-__all__ = ["system_mass", "ground_reaction", "sample_sides", "reaction_history",
-           "validity_diagnostics"]
+__all__ = ["system_mass", "reaction_from_accelerations", "ground_reaction", "sample_sides",
+           "reaction_history", "validity_diagnostics"]
 
 
 def system_mass(mu: float, gamma: float) -> float:
     """``(2 m1 + m3 + m4)/m1 = 2 + mu + gamma``: all four bodies (Eq. 10 ratios)."""
     return 2.0 + mu + gamma
+
+
+def reaction_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot, psi_ddot,
+                                xg_ddot, side, b: float, h: float, mu: float, gamma: float,
+                                l: float, g: float):
+    """``(R_x, R_y)`` per ``m1`` from a state and its accelerations (the momentum
+    balance of the module docstring); scalars or equal-shape arrays.
+
+    ``side = 0`` (rest) needs ``theta = theta_dot = theta_ddot = 0`` and then only
+    adds the bodies' weight, the base's inertial load and the bob's motion.
+    """
+    sb = side * b
+    st, ct = np.sin(theta), np.cos(theta)
+    px = sb * ct - h * st  # top corner relative to the pivot (Eq. 5)
+    py = sb * st + h * ct
+    w2 = theta_dot * theta_dot
+    big_m = eq.total_mass(mu, gamma)  # lintel + bob ride on r; two columns at r/2
+    m_s = system_mass(mu, gamma)
+    rx = m_s * xg_ddot + big_m * (-theta_ddot * py - w2 * px)
+    ry = m_s * g + big_m * (theta_ddot * px - w2 * py)
+    if gamma > 0.0:
+        sp, cp = np.sin(psi), np.cos(psi)
+        v2 = psi_dot * psi_dot
+        rx = rx + gamma * l * (psi_ddot * cp - v2 * sp)
+        ry = ry + gamma * l * (psi_ddot * sp + v2 * cp)
+    return rx, ry
+
+
+def _accelerations(theta: float, theta_dot: float, psi: float, psi_dot: float,
+                   xg_ddot: float, side: float, b: float, h: float, mu: float,
+                   gamma: float, j: float, l: float, g: float) -> tuple[float, float]:
+    """``(theta_ddot, psi_ddot)``: Eq. 8 / A.1 while rocking, Eq. 1 at rest."""
+    if side != 0.0:
+        return eq.rocking_accelerations(theta, theta_dot, psi, psi_dot, xg_ddot, side,
+                                        b, h, mu, gamma, j, l, g)
+    if gamma > 0.0:
+        return 0.0, eq.rest_pendulum_acceleration(psi, xg_ddot, l, g)
+    return 0.0, 0.0
 
 
 def ground_reaction(theta: float, theta_dot: float, psi: float, psi_dot: float,
@@ -71,29 +108,11 @@ def ground_reaction(theta: float, theta_dot: float, psi: float, psi_dot: float,
         Coulomb coefficient needed for no sliding.  At rest with the pendulum
         hanging still ``R = (M_s xg_ddot, M_s g)``, ``M_s = 2 + mu + gamma``.
     """
-    m_s = system_mass(mu, gamma)
-    rx = m_s * xg_ddot
-    ry = m_s * g
-    if side != 0.0:
-        theta_ddot, psi_ddot = eq.rocking_accelerations(theta, theta_dot, psi, psi_dot, xg_ddot,
-                                                        side, b, h, mu, gamma, j, l, g)
-        sb = side * b
-        st, ct = math.sin(theta), math.cos(theta)
-        px = sb * ct - h * st  # top corner relative to the pivot (Eq. 5)
-        py = sb * st + h * ct
-        big_m = eq.total_mass(mu, gamma)  # lintel + bob ride on r; two columns at r/2
-        rx += big_m * (-theta_ddot * py - theta_dot * theta_dot * px)
-        ry += big_m * (theta_ddot * px - theta_dot * theta_dot * py)
-    elif gamma > 0.0:
-        psi_ddot = eq.rest_pendulum_acceleration(psi, xg_ddot, l, g)
-    else:
-        psi_ddot = 0.0
-    if gamma > 0.0:
-        sp, cp = math.sin(psi), math.cos(psi)
-        w2 = psi_dot * psi_dot
-        rx += gamma * l * (psi_ddot * cp - w2 * sp)
-        ry += gamma * l * (psi_ddot * sp + w2 * cp)
-    return rx, ry
+    theta_ddot, psi_ddot = _accelerations(theta, theta_dot, psi, psi_dot, xg_ddot, side,
+                                          b, h, mu, gamma, j, l, g)
+    rx, ry = reaction_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot, psi_ddot,
+                                         xg_ddot, side, b, h, mu, gamma, l, g)
+    return float(rx), float(ry)
 
 
 def sample_sides(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray) -> np.ndarray:
@@ -121,21 +140,30 @@ def sample_sides(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray) -> np.
 
 
 def reaction_history(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
-                     psi: np.ndarray, psi_dot: np.ndarray, xg_ddot: Callable[[float], float],
+                     psi: np.ndarray, psi_dot: np.ndarray, excitation,
                      model_args: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(R_x, R_y, side)`` at every sample of a run (:func:`ground_reaction`).
 
-    ``xg_ddot(t)`` is the excitation's ``acceleration``; ``model_args`` is
-    ``Scene.model_args()``.
+    ``excitation`` is the run's Pulse or SampledRecord (its vectorised
+    ``acceleration_array`` is used when it has one, else ``acceleration(t)``);
+    ``model_args`` is ``Scene.model_args()``.  Only the accelerations are
+    evaluated sample by sample (the scalar Eq. 8 / Eq. 1): the rest is vectorised.
     """
+    t = np.asarray(t, dtype=float)
+    theta, theta_dot, psi, psi_dot = (np.asarray(a, dtype=float)
+                                      for a in (theta, theta_dot, psi, psi_dot))
     sides = sample_sides(t, theta, theta_dot)
-    n = len(sides)
-    rx = np.empty(n)
-    ry = np.empty(n)
-    for i in range(n):
-        rx[i], ry[i] = ground_reaction(float(theta[i]), float(theta_dot[i]), float(psi[i]),
-                                       float(psi_dot[i]), float(xg_ddot(float(t[i]))),
-                                       float(sides[i]), *model_args)
+    if hasattr(excitation, "acceleration_array"):
+        xg = np.asarray(excitation.acceleration_array(t), dtype=float)
+    else:
+        xg = np.array([excitation.acceleration(float(x)) for x in t])
+    b, h, mu, gamma, j, l, g = model_args
+    acc = [_accelerations(*row, b, h, mu, gamma, j, l, g)
+           for row in zip(theta.tolist(), theta_dot.tolist(), psi.tolist(), psi_dot.tolist(),
+                          xg.tolist(), sides.tolist())]
+    acc = np.array(acc, dtype=float).reshape(len(t), 2)
+    rx, ry = reaction_from_accelerations(theta, theta_dot, psi, psi_dot, acc[:, 0], acc[:, 1],
+                                         xg, sides, b, h, mu, gamma, l, g)
     return rx, ry, sides
 
 
@@ -153,9 +181,8 @@ def _extrema(rx: np.ndarray, ry: np.ndarray, sides: np.ndarray, weight: float
 
 
 def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
-                         psi: np.ndarray, psi_dot: np.ndarray,
-                         xg_ddot: Callable[[float], float], model_args: tuple,
-                         alpha: float, overturned: bool) -> dict:
+                         psi: np.ndarray, psi_dot: np.ndarray, excitation,
+                         model_args: tuple, alpha: float, overturned: bool) -> dict:
     """Whether the model's contact assumptions hold along a sampled run.
 
     The window is the part of the run that decides the verdict: all of it,
@@ -171,8 +198,8 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
     ----------
     t, theta, theta_dot, psi, psi_dot : ndarray
         The trajectory's samples (an impact is two samples at one instant).
-    xg_ddot : callable
-        The excitation's ``acceleration(t)``.
+    excitation : Pulse or SampledRecord
+        The run's excitation (anything with ``acceleration(t)``).
     model_args : tuple
         ``Scene.model_args()``.
     alpha : float
@@ -197,7 +224,7 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
     b, h, mu, gamma, j, l, g = model_args
     if len(t) == 0:
         raise ValueError("t must hold at least one sample, got an empty trajectory")
-    rx, ry, sides = reaction_history(t, theta, theta_dot, psi, psi_dot, xg_ddot, model_args)
+    rx, ry, sides = reaction_history(t, theta, theta_dot, psi, psi_dot, excitation, model_args)
     weight = system_mass(mu, gamma) * g
     end = len(t)
     if overturned:

@@ -425,7 +425,7 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     if all(np.all(np.isfinite(a)) for a in (theta, theta_dot, psi, psi_dot)):
         # Diagnostics only (docs/model.md, "Ground reaction"): nothing above depends on them.
         diagnostics.update(validity_diagnostics(t, theta, theta_dot, psi, psi_dot,
-                                                excitation.acceleration, scene.model_args(),
+                                                excitation, scene.model_args(),
                                                 scene.alpha, run.verdict.overturned))
     return Trajectory(
         backend=NAME, t=t, theta=theta, theta_dot=theta_dot, psi=psi, psi_dot=psi_dot,

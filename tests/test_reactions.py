@@ -84,7 +84,7 @@ def test_reaction_matches_finite_differences_of_eq5_positions(fig5, amplitude, o
     idx, r_fd = _fd_reactions(fig5, pulse, tr)
     assert len(idx) > 1000
     rx, ry, sides = reaction_history(tr.t, tr.theta, tr.theta_dot, tr.psi, tr.psi_dot,
-                                     pulse.acceleration, fig5.model_args())
+                                     pulse, fig5.model_args())
     weight = system_mass(fig5.mu, fig5.gamma) * fig5.g
     err = np.max(np.abs(np.vstack([rx[idx], ry[idx]]) - r_fd)) / weight
     # Central differences at 0.5 ms: truncation dt^2/12 * C'''' plus the dense
