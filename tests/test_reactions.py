@@ -97,6 +97,7 @@ def test_reaction_matches_finite_differences_of_eq5_positions(fig5, amplitude, o
         assert np.ptp(rx) > 0.1 * weight * amplitude / G  # the check is not vacuous
     else:
         assert np.count_nonzero(sides[idx]) > 500
+        assert {-1.0, 1.0} <= set(sides[idx].tolist())  # both mechanisms (Eq. 8 and A.1)
 
 
 def test_static_reaction_is_the_weight(fig5):
