@@ -43,9 +43,14 @@ class MonitorSettings:
         pendulum period is added when there is a pendulum).
     t_cap : s after the pulse end before an undecided run stops ('undecided').
     max_mismatch : largest ``|theta_left - theta_right|`` [in units of alpha]
-        while ``|theta| < alpha``: the lintel ties the columns together (engines
-        keep them within ~1e-5 rad), so a larger mismatch means the engine broke
-        the linkage (columns creeping apart, lintel sliding off): 'unstable'.
+        while ``|theta| < alpha``, until the trilith first passes ``alpha``: the
+        lintel ties the columns together (engines keep them within ~1e-5 rad),
+        so a larger mismatch means the engine broke the linkage (columns
+        creeping apart, lintel sliding off): 'unstable'.  Once past ``alpha``
+        the model's own vertical reaction turns negative during the fall
+        (``analytic.reactions``): real contacts let the columns hop and part,
+        which is the collapse, not a broken engine (a falling column may even
+        swing back below ``alpha`` while its neighbour falls on).
     energy_rule : stop as 'survived' once the energy is below the overturning
         barrier after the pulse.  Free-rocking experiments (restitution) turn it
         off: they need the impacts, not the verdict.
@@ -123,6 +128,8 @@ class RunMonitor:
         self.t_end_pulse = excitation.end_time
         self.samples: list[tuple[float, ...]] = []
         self.mismatch = 0.0
+        self._past_alpha = False
+        self._parted = False
         self.verdict: Verdict | None = None
         self._sign = 0
         self._impacts: list[float] = []
@@ -141,25 +148,34 @@ class RunMonitor:
         self.samples.append(values)
         mismatch = abs(theta_left - theta_right)
         self.mismatch = max(self.mismatch, mismatch)
-        if (self.scene.mu > 0.0 and abs(theta) < self.scene.alpha
-                and mismatch > self.cfg.max_mismatch * self.scene.alpha):
-            self.mark_unstable(t, f"columns out of step by {mismatch:.3g} rad "
-                                  f"(> {self.cfg.max_mismatch:g} alpha): linkage broken")
-            return True
+        steepest = max(abs(theta), abs(theta_left), abs(theta_right))
+        self._past_alpha = self._past_alpha or steepest >= self.scene.alpha
+        if self.scene.mu > 0.0 and mismatch > self.cfg.max_mismatch * self.scene.alpha:
+            if not self._past_alpha:
+                self.mark_unstable(t, f"columns out of step by {mismatch:.3g} rad "
+                                      f"(> {self.cfg.max_mismatch:g} alpha): linkage broken")
+                return True
+            # Parted while collapsing: the mean angle no longer describes the
+            # trilith, so the survival rules below must not read it.
+            self._parted = True
         cfg = self.cfg
-        if abs(theta) > cfg.uplift_angle:
+        # Parted columns: a sign change of their mean angle is no impact.
+        if abs(theta) > cfg.uplift_angle and not self._parted:
             sign = 1 if theta > 0 else -1
             if self._uplift is None:
                 self._uplift = t
             if self._sign and sign != self._sign:
                 self._impacts.append(t)
             self._sign = sign
-        if abs(theta) >= self.threshold:
+        # One toppled column is a collapsed trilith, even if the other (parted
+        # from it past alpha, see max_mismatch) keeps the mean below the threshold.
+        if steepest >= self.threshold:
             mode = "after-impact" if self._impacts else "no-impact"
+            what = "|theta|" if abs(theta) >= self.threshold else "a column's |theta|"
             self.verdict = Verdict("overturned", t, mode, len(self._impacts),
-                                   f"|theta| reached {self.threshold:.4g} rad ({self.criterion.kind})")
+                                   f"{what} reached {self.threshold:.4g} rad ({self.criterion.kind})")
             return True
-        if t >= self.t_end_pulse:
+        if t >= self.t_end_pulse and not self._parted:
             if cfg.energy_rule and self._survived_by_energy(theta, theta_dot, psi, psi_dot):
                 self.verdict = Verdict("survived", None, None, len(self._impacts),
                                        "energy below the overturning barrier after the pulse")
