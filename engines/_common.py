@@ -136,21 +136,27 @@ class RunMonitor:
         self._uplift: float | None = None
         self._rest_since: float | None = None
         self.t_stop = (t_max if t_max is not None else self.t_end_pulse + self.cfg.t_cap)
+        # Read once: record() runs every sample and Scene.alpha is a computed property.
+        self._alpha = scene.alpha
+        self._linked = scene.mu > 0.0
+        self._mismatch_limit = self.cfg.max_mismatch * self._alpha
 
     # ------------------------------------------------------------------ online
     def record(self, t: float, theta_left: float, theta_right: float, theta_dot: float,
                psi: float = 0.0, psi_dot: float = 0.0) -> bool:
         theta = 0.5 * (theta_left + theta_right)
-        values = (t, theta, theta_dot, psi, psi_dot)
-        if not all(math.isfinite(v) for v in values):
+        isfinite = math.isfinite
+        if not (isfinite(t) and isfinite(theta) and isfinite(theta_dot) and isfinite(psi)
+                and isfinite(psi_dot)):
             self.mark_unstable(t, "non-finite state")
             return True
-        self.samples.append(values)
+        self.samples.append((t, theta, theta_dot, psi, psi_dot))
         mismatch = abs(theta_left - theta_right)
-        self.mismatch = max(self.mismatch, mismatch)
+        if mismatch > self.mismatch:
+            self.mismatch = mismatch
         steepest = max(abs(theta), abs(theta_left), abs(theta_right))
-        self._past_alpha = self._past_alpha or steepest >= self.scene.alpha
-        if self.scene.mu > 0.0 and mismatch > self.cfg.max_mismatch * self.scene.alpha:
+        self._past_alpha = self._past_alpha or steepest >= self._alpha
+        if self._linked and mismatch > self._mismatch_limit:
             if not self._past_alpha:
                 self.mark_unstable(t, f"columns out of step by {mismatch:.3g} rad "
                                       f"(> {self.cfg.max_mismatch:g} alpha): linkage broken")

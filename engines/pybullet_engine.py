@@ -237,8 +237,7 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     try:
         decided = monitor.record(0.0, *world.sample()[:5])
         while not decided:
-            for _ in range(s.sample_every):
-                world.step()
+            world.advance(s.sample_every)
             t = world.step_index * s.dt
             *state, problem = world.sample()
             if problem is not None:

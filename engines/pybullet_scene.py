@@ -262,14 +262,17 @@ def column_angle(client: int, body: int) -> tuple[float, float, tuple, tuple]:
     return theta, -omega[1], pos, quat
 
 
-def pendulum_state(client: int, bodies: Bodies) -> tuple[float, float]:
+def pendulum_state(client: int, bodies: Bodies, lintel_read: tuple | None = None
+                   ) -> tuple[float, float]:
     """``(psi, psi_dot)``: the bob's absolute angle from the downward vertical,
-    CCW positive (bob at hinge + l (sin psi, -cos psi)), from world positions."""
+    CCW positive (bob at hinge + l (sin psi, -cos psi)), from world positions.
+    ``lintel_read``: the :func:`lintel_state` already read at this instant, if any."""
     lintel, joint = bodies.lintel, bodies.pendulum_joint
     state = pb.getLinkState(lintel, joint, computeLinkVelocity=1, computeForwardKinematics=1,
                            physicsClientId=client)
     bob, bob_v = state[0], state[6]
-    pos, quat, vel, omega = lintel_state(client, bodies)
+    pos, quat, vel, omega = (lintel_read if lintel_read is not None
+                             else lintel_state(client, bodies))
     hinge = pb.multiplyTransforms(pos, quat, bodies.hinge_local, (0, 0, 0, 1))[0]
     r = [hinge[k] - pos[k] for k in range(3)]
     # Hinge velocity = v + omega x r (rigid lintel).
@@ -345,15 +348,23 @@ class World:
         pb.resetJointState(self.bodies.ground, 0, x0, (x1 - x0) / dt, physicsClientId=self.client)
 
     def step(self) -> None:
-        n, dt = self.step_index, self.s.dt
-        if self.moving:
-            self._set_ground(n)
-        else:
-            # Mid-step load: the step's velocity change is then second-order accurate.
-            a = self.excitation.acceleration((n + 0.5) * dt)
-            pb.setGravity(-a, 0.0, -self.scene.g, physicsClientId=self.client)
-        pb.stepSimulation(physicsClientId=self.client)
-        self.step_index = n + 1
+        self.advance(1)
+
+    def advance(self, count: int) -> None:
+        """``count`` steps.  One loop with local names: stepping is the hot path
+        (a call through ``step`` per step costs ~3 % of the run,
+        ``benchmarks/bench_overhead.py``)."""
+        n, dt, c = self.step_index, self.s.dt, self.client
+        accel, minus_g = self.excitation.acceleration, -self.scene.g
+        set_gravity, step = pb.setGravity, pb.stepSimulation
+        for k in range(n, n + count):
+            if self.moving:
+                self._set_ground(k)
+            else:
+                # Mid-step load: the step's velocity change is then second-order accurate.
+                set_gravity(-accel((k + 0.5) * dt), 0.0, minus_g, physicsClientId=c)
+            step(physicsClientId=c)
+            self.step_index = k + 1
 
     # ----------------------------------------------------------------- reading
     def _pose(self, body: int) -> tuple[tuple, tuple, tuple]:
@@ -362,9 +373,11 @@ class World:
         pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
         return pos, quat, pb.getBaseVelocity(body, physicsClientId=self.client)[0]
 
-    def _bottom_corners(self, body: int) -> tuple[float, float]:
-        """World x of a column's bottom-left and bottom-right edge midpoints."""
-        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
+    def _bottom_corners(self, body: int, pos=None, quat=None) -> tuple[float, float]:
+        """World x of a column's bottom-left and bottom-right edge midpoints
+        (``pos``, ``quat``: its pose if already read at this instant)."""
+        if pos is None:
+            pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
         hb, hh = 0.5 * self.scene.b, 0.5 * self.scene.h
         out = []
         for dx in (-hb, hb):
@@ -395,15 +408,22 @@ class World:
         self.standing = self.standing and max(abs(theta_l), abs(theta_r)) < scene.alpha
         standing = self.standing
         psi = psi_dot = 0.0
+        # Each body is read once per sample: a sample's reads cost about two steps
+        # (benchmarks/bench_overhead.py), so re-reading would slow every run.
+        lintel = lintel_state(c, bodies) if bodies.lintel is not None else None
         if bodies.pendulum_joint is not None:
-            psi, psi_dot = pendulum_state(c, bodies)
+            psi, psi_dot = pendulum_state(c, bodies, lintel)
         problem = None
         gx = self.ground_x()
         v_bound = 20.0 * math.sqrt(2.0 * scene.g * self.size) + 10.0 * abs(
             self.excitation.velocity(self.step_index * self.s.dt))
+        poses = {body: (col[2], col[3], pb.getBaseVelocity(body, physicsClientId=c)[0])
+                 for body, col in zip(bodies.columns, cols)}
+        if lintel is not None:
+            poses[bodies.lintel] = lintel[:3]
         for body in bodies.dynamic:
-            pos, quat, vel = self._pose(body)
-            if not all(math.isfinite(v) for v in pos + vel + quat):
+            pos, quat, vel = poses[body]
+            if not all(map(math.isfinite, pos + vel + quat)):
                 return theta_l, theta_r, 0.0, psi, psi_dot, "non-finite body state"
             drift = math.dist(pos, self.start[body]) - abs(gx)
             speed = math.hypot(*vel)
@@ -421,15 +441,17 @@ class World:
             problem = f"pendulum speed {abs(psi_dot) * bodies.length:.3g} m/s"
         if standing:
             for k, body in enumerate(bodies.columns):
-                corners = self._bottom_corners(body)
+                corners = self._bottom_corners(body, cols[k][2], cols[k][3])
                 theta = cols[k][0]
                 # The pivot corner while rocking; both corners while at rest.
                 idx = ((0 if theta > 0 else 1,) if abs(theta) > self.s.monitor.uplift_angle
                        else (0, 1))
                 slide = max(abs(corners[i] - self.pivots0[k][i] - gx) for i in idx)
                 diag["pivot_sliding_max"] = max(diag["pivot_sliding_max"], slide)
-            for point in pb.getContactPoints(physicsClientId=c):
-                diag["penetration_max"] = max(diag["penetration_max"], -point[8])
+            points = pb.getContactPoints(physicsClientId=c)
+            if points:  # max of -distance = -(min distance), exactly
+                diag["penetration_max"] = max(diag["penetration_max"],
+                                              -min(point[8] for point in points))
             if diag["out_of_plane_max"] > self.s.out_of_plane_limit * self.size:
                 problem = f"out-of-plane drift {diag['out_of_plane_max']:.3g} m"
         return theta_l, theta_r, 0.5 * (cols[0][1] + cols[1][1]), psi, psi_dot, problem
