@@ -412,6 +412,7 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     i_bob = world.bodies.index(bob) if bob is not None else None
     hb, hh = 0.5 * b, 0.5 * h
     cos, sin, hypot = math.cos, math.sin, math.hypot
+    starts = [(6 * i, x0, y0) for i, (x0, y0) in enumerate(world.start)]
     while True:
         t = step * dt
         x_ground = 0.0 if gravity_mode else excitation.displacement(t)
@@ -433,23 +434,27 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
             pivot_x, x0 = ((left_x, corner_x0[k][0]) if angle >= 0.0
                            else (right_x, corner_x0[k][1]))
             sl = abs(pivot_x - x0 - x_ground)
-            pen = -min(left_y, right_y)
-            slide_all = max(slide_all, sl)
-            penetration_all = max(penetration_all, pen)
+            pen = -(right_y if right_y < left_y else left_y)  # = -min(left_y, right_y)
+            # Running maxima as comparisons (= max(), without a builtin call each).
+            if sl > slide_all:
+                slide_all = sl
+            if pen > penetration_all:
+                penetration_all = pen
             if in_well:
-                slide = max(slide, sl)
-                penetration = max(penetration, pen)
+                if sl > slide:
+                    slide = sl
+                if pen > penetration:
+                    penetration = pen
         if i_lintel is not None and in_well:
             lintel_rot = max(lintel_rot, abs(st[6 * i_lintel + 2]))
         if not done:
-            for i, (x0, y0) in enumerate(world.start):
-                px, py, _, vx, vy = st[6 * i:6 * i + 5]
-                if hypot(px - x0 - x_ground, py - y0) > max_dist:
+            for i, x0, y0 in starts:
+                if hypot(st[i] - x0 - x_ground, st[i + 1] - y0) > max_dist:
                     monitor.mark_unstable(t, "a body flew away (> "
                                           f"{s.blowup_distance:g} trilith sizes)")
                     done = True
                     break
-                if hypot(vx, vy) > max_speed:
+                if hypot(st[i + 3], st[i + 4]) > max_speed:
                     monitor.mark_unstable(t, f"a body exceeded {max_speed:.3g} m/s")
                     done = True
                     break
