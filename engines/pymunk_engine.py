@@ -76,9 +76,11 @@ class Settings:
     base_motion : {'gravity', 'ground'}
         How the base excitation is imposed (see module docstring).
     sample_every : int
-        Steps between two samples read into the monitor.  10 (1 ms at the default
-        ``dt``): impacts are measured by propagating away from them, so 1 ms is
-        ample, and reading state is the costliest part of a step in Python.
+        Steps between two samples read into the monitor.  20 (2 ms at the default
+        ``dt``): impacts are measured by propagating away from them, so 2 ms is
+        ample, and reading state is the costliest part of a step in Python (at 10
+        the harness ran at 0.77-0.80 of the bare step rate, at 20 at 0.87-0.89,
+        benchmarks/bench_overhead.py).
     monitor : MonitorSettings
         Shared stop/verdict thresholds.
     friction : float
@@ -121,7 +123,7 @@ class Settings:
     theta0: float = 0.0
     psi0: float = 0.0
     base_motion: str = "gravity"
-    sample_every: int = 10
+    sample_every: int = 20
     monitor: MonitorSettings = field(default_factory=MonitorSettings)
     friction: float = 10.0
     iterations: int = 30
