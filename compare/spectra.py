@@ -13,7 +13,8 @@ import math
 import numpy as np
 
 __all__ = ["reference_spectrum", "choose_frequencies", "find_jumps",
-           "first_overturning_amplitude", "monotone_above", "locate_tongue_tip"]
+           "first_overturning_amplitude", "monotone_above", "locate_tongue_tip",
+           "model_valid_at"]
 
 
 def _grid(config) -> np.ndarray:
@@ -93,6 +94,19 @@ def monotone_above(scene, omega: float, a_ref: float, span: float, n: int = 12) 
                for r in np.linspace(span / n, span, n))
 
 
+def model_valid_at(scene, omega: float, amplitude: float) -> bool:
+    """True when the analytic model's own assumptions hold for the pulse
+    ``(amplitude, omega)``: the ground's vertical reaction stays positive up to
+    the verdict (or to ``|theta| = alpha`` for an overturning run), see
+    :mod:`analytic.reactions`.  Where it turns negative the real columns hop,
+    the engines (which let them) are no longer comparable to the model, and an
+    engine-vs-model threshold error would blame the engine for the model."""
+    from analytic.excitation import Pulse
+    from analytic.simulate import simulate
+
+    return bool(simulate(scene, Pulse(amplitude, omega)).diagnostics.get("model_valid", True))
+
+
 def locate_tongue_tip(scene, jump: dict, d_omega: float = 0.02, rel_da: float = 0.01) -> dict:
     """Refine a mode jump on the model: where the lower branch's overturning
     "tongue" closes.
@@ -145,7 +159,8 @@ def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, floa
     """``n_frequencies`` grid points ``(omega, a_ref, mode)`` spread over the
     range, each at least ``jump_margin`` from every mode jump and, when ``scene``
     is given, with a monotone model verdict over twice the bisection bracket
-    above the threshold (:func:`monotone_above`)."""
+    above the threshold (:func:`monotone_above`) and a valid model there (no
+    negative ground reaction, :func:`model_valid_at`)."""
     n = config.n_frequencies
     if n <= 0:
         return []
@@ -156,6 +171,9 @@ def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, floa
             and all(abs(w - wj) >= config.jump_margin for wj in jump_ws)]
     if scene is not None:
         cand = [c for c in cand if monotone_above(scene, c[0], c[1], 2.0 * config.rel_bracket)]
+        # The engines are judged only where the model itself is valid (no hop).
+        cand = [c for c in cand
+                if model_valid_at(scene, c[0], c[1] * (1.0 + 2.0 * config.rel_bracket))]
     if len(cand) <= n:
         return cand
     # Evenly spread over the candidates (deterministic), ends included.
