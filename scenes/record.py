@@ -26,6 +26,7 @@ from analytic.trajectory import Trajectory
 
 __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
            "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
+           "find_ffmpeg",
            "check_output", "record", "ALL_ENGINES", "FORMATS", "DEFAULT_AMPLITUDE",
            "DEFAULT_OMEGA"]
 
@@ -110,8 +111,9 @@ def check_output(path: str | Path) -> Path:
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise ValueError(f"--out must end in {' or '.join(FORMATS)}, got {str(path)!r}")
-    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
-        raise ValueError("--out .mp4 needs ffmpeg on PATH, which was not found; "
+    if suffix == ".mp4" and find_ffmpeg() is None:
+        raise ValueError("--out .mp4 needs ffmpeg (on PATH or from the imageio-ffmpeg "
+                         "package), which was not found; "
                          f"write a GIF instead: --out {path.with_suffix('.gif')}")
     if not path.parent.is_dir():
         raise ValueError(f"--out: folder {str(path.parent)!r} does not exist")
@@ -300,9 +302,26 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
                    duration=int(round(1000.0 / fps)), optimize=False)
 
 
+def find_ffmpeg() -> str | None:
+    """The ffmpeg executable: the one on PATH, else the binary shipped inside the
+    ``imageio-ffmpeg`` wheel (a project dependency, so MP4 works on a fresh
+    machine without a system ffmpeg); None if neither exists."""
+    exe = shutil.which("ffmpeg")
+    if exe is not None:
+        return exe
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        return None
+    try:
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError:  # the package is there but its binary is not
+        return None
+
+
 def write_mp4(frames: list[np.ndarray], path: Path, fps: float) -> None:
-    """H.264 MP4 by piping raw RGB frames to ffmpeg."""
-    ffmpeg = shutil.which("ffmpeg")
+    """H.264 MP4 by piping raw RGB frames to ffmpeg (:func:`find_ffmpeg`)."""
+    ffmpeg = find_ffmpeg()
     if ffmpeg is None:
         raise ValueError("writing .mp4 needs ffmpeg on PATH; use a .gif output instead")
     height, width = frames[0].shape[:2]
