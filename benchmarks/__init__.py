@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 import os
 import platform
+import statistics
+import time
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -36,3 +38,15 @@ def write(name: str, payload: dict) -> Path:
     path = OUT / f"{name}.json"
     path.write_text(json.dumps(payload, indent=1, allow_nan=False))
     return path
+
+
+def median_time(fn, repeats: int, warm_up: bool = False) -> tuple[object, float]:
+    """``(last result, median wall time [s])`` of ``repeats`` calls of ``fn``,
+    after one untimed call when ``warm_up``."""
+    out = fn() if warm_up else None
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return out, statistics.median(times)

@@ -8,9 +8,7 @@ sampled Trajectory) and ``analytic.simulate``; the verdicts must be identical.
 """
 from __future__ import annotations
 
-import statistics
 import sys
-import time
 
 from analytic import fast
 from analytic import simulate as accurate
@@ -18,20 +16,10 @@ from analytic.excitation import Pulse
 from analytic.trajectory import OverturnCriterion
 from scenes import load_scene
 
-from . import machine, write
+from . import machine, median_time, write
 
 POINT_A = (19.0, 15.0)
 TARGET_S = 1e-4
-
-
-def _median_time(fn, repeats: int) -> tuple[object, float]:
-    out = fn()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return out, statistics.median(times)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -43,10 +31,11 @@ def main(argv: list[str] | None = None) -> int:
         pulse = Pulse(*POINT_A)
         args = sc.model_args()
         thr = OverturnCriterion().threshold(sc.alpha)
-        (st, _r, _t, n_imp), t_verdict = _median_time(
-            lambda: fast.overturn_verdict(*args, POINT_A[0], POINT_A[1], 0, thr), 2000)
-        tr_fast, t_sim = _median_time(lambda: fast.simulate(sc, pulse), 300)
-        tr_acc, t_acc = _median_time(lambda: accurate.simulate(sc, pulse), 15)
+        (st, _r, _t, n_imp), t_verdict = median_time(
+            lambda: fast.overturn_verdict(*args, POINT_A[0], POINT_A[1], 0, thr), 2000,
+            warm_up=True)
+        tr_fast, t_sim = median_time(lambda: fast.simulate(sc, pulse), 300, warm_up=True)
+        tr_acc, t_acc = median_time(lambda: accurate.simulate(sc, pulse), 15, warm_up=True)
         same = ((fast.STATUS_NAMES[st], n_imp) == (tr_acc.verdict.status, tr_acc.n_impacts)
                 and (tr_fast.verdict.status, tr_fast.verdict.mode, tr_fast.n_impacts)
                 == (tr_acc.verdict.status, tr_acc.verdict.mode, tr_acc.n_impacts))

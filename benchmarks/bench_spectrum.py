@@ -13,7 +13,6 @@ campaign pays it once); the process pool start-up is included.
 """
 from __future__ import annotations
 
-import statistics
 import sys
 import time
 
@@ -23,7 +22,7 @@ from analytic import fast
 from analytic.spectrum import SpectrumSettings, overturning_spectrum
 from scenes import load_scene
 
-from . import machine, write
+from . import machine, median_time, write
 
 COARSE = np.arange(3.0, 31.0, 1.0)
 FINE = np.round(np.arange(30, 301) * 0.1, 10)
@@ -31,19 +30,10 @@ CHECK = np.array([3.0, 5.0, 7.0, 8.0, 10.0, 11.0, 17.0, 18.0])
 TARGET_COARSE_S, GOAL_COARSE_S, TARGET_FINE_S = 1.0, 0.5, 10.0
 
 
-def _timed(fn, repeats):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return out, statistics.median(times)
-
-
 def main(argv: list[str] | None = None) -> int:
     scene = load_scene("fig5")
     warm = fast.warm_up(record=False)
-    coarse, t_coarse = _timed(lambda: overturning_spectrum(scene, COARSE, workers=2), 3)
+    coarse, t_coarse = median_time(lambda: overturning_spectrum(scene, COARSE, workers=2), 3)
     print(f"coarse spectrum (28 freqs, both curves, tol 0.01, 2 workers): {t_coarse:.3f} s "
           f"median of 3, {coarse.n_runs} runs (target <= {TARGET_COARSE_S:g} s: "
           f"{'met' if t_coarse <= TARGET_COARSE_S else 'MISSED'}; goal {GOAL_COARSE_S:g} s: "
@@ -55,11 +45,11 @@ def main(argv: list[str] | None = None) -> int:
     cpu_coarse = time.process_time() - c0
     print(f"  same spectrum in one process: {cpu_coarse:.3f} CPU s "
           f"(load average {machine()['loadavg']})")
-    fine, t_fine = _timed(lambda: overturning_spectrum(scene, FINE, workers=2), 1)
+    fine, t_fine = median_time(lambda: overturning_spectrum(scene, FINE, workers=2), 1)
     print(f"fine spectrum (271 freqs, step 0.1): {t_fine:.3f} s, {fine.n_runs} runs "
           f"(target <= {TARGET_FINE_S:g} s: {'met' if t_fine <= TARGET_FINE_S else 'MISSED'})")
     ref_settings = SpectrumSettings(scan_step=0.01, scan_rel_step=0.0, tol=0.005)
-    ref, t_ref = _timed(lambda: overturning_spectrum(scene, CHECK, ref_settings, workers=2), 1)
+    ref, t_ref = median_time(lambda: overturning_spectrum(scene, CHECK, ref_settings, workers=2), 1)
     dflt = overturning_spectrum(scene, CHECK, workers=2)
     d_np = dflt.a_no_pendulum - ref.a_no_pendulum
     d_yp = dflt.a_pendulum - ref.a_pendulum
