@@ -1,5 +1,8 @@
 """Pymunk (Chipmunk2D) backend: the trilith as three rigid polygons on a ground box.
 
+The adapter (settings, validation, the stepping loop); the world itself is built
+in :mod:`engines.pymunk_scene`.
+
 The plane scene is built from the :class:`~analytic.parameters.Scene` only: two
 ``b x h`` columns at clear gap ``d`` (left column's bottom-left corner at ``x = 0``),
 a ``lintel_length x lintel_thickness`` lintel resting on both column tops, and a
@@ -43,6 +46,9 @@ from analytic import equations as eq
 from analytic.excitation import Pulse, SampledRecord
 from analytic.trajectory import OverturnCriterion, Trajectory
 from engines._common import MonitorSettings, RunMonitor
+# Scene building lives in engines.pymunk_scene; _World is re-exported because
+# tests and benchmarks/bench_overhead.py build bare worlds through this module.
+from engines.pymunk_scene import _World, _peak_ground_speed, _state_reader
 
 __all__ = ["NAME", "Settings", "simulate", "version", "required_friction", "BASE_MOTIONS"]
 
@@ -214,162 +220,6 @@ def _validate(scene, excitation, s: Settings) -> None:
         raise ValueError(f"pymunk settings: friction must be >= {need:.3g} for rocking without "
                          f"sliding in this scene and excitation (see required_friction), "
                          f"got {s.friction!r}")
-
-
-# ----------------------------------------------------------------------------- world
-def _rotate(v: tuple[float, float], angle: float) -> tuple[float, float]:
-    c, s = math.cos(angle), math.sin(angle)
-    return (c * v[0] - s * v[1], s * v[0] + c * v[1])
-
-
-def _column_com(x_left: float, theta: float, b: float, h: float) -> tuple[float, float]:
-    """Centre of a column tilted by ``theta`` about the base corner of its side."""
-    if theta >= 0.0:  # left corner at (x_left, 0) stays put
-        r = _rotate((0.5 * b, 0.5 * h), theta)
-        return (x_left + r[0], r[1])
-    r = _rotate((-0.5 * b, 0.5 * h), theta)
-    return (x_left + b + r[0], r[1])
-
-
-def _lintel_shift(theta: float, b: float, h: float) -> tuple[float, float]:
-    """Translation of the lintel: that of the column-top corner it rests on
-    (top-right corners for ``theta > 0``, top-left ones for ``theta < 0``)."""
-    corner = (b, h) if theta >= 0.0 else (-b, h)
-    r = _rotate(corner, theta)
-    return (r[0] - corner[0], r[1] - corner[1])
-
-
-class _World:
-    """A fresh Pymunk space holding one trilith; nothing is shared between runs."""
-
-    def __init__(self, scene, s: Settings) -> None:
-        b, h, d = scene.b, scene.h, scene.d
-        t_l = scene.lintel_thickness
-        self.size = max(scene.lintel_length, h + t_l)
-        space = pymunk.Space()
-        space.iterations = s.iterations
-        space.collision_slop = s.slop_fraction * b
-        if s.collision_bias is not None:
-            space.collision_bias = s.collision_bias
-        space.gravity = (0.0, -scene.g)
-        shape_friction = math.sqrt(s.friction)  # Pymunk multiplies the pair's values
-
-        def add_box(body, w, hh):
-            shape = pymunk.Poly.create_box(body, (w, hh), radius=0.0)
-            shape.friction = shape_friction
-            shape.elasticity = 0.0
-            space.add(shape)
-            return shape
-
-        kind = pymunk.Body.KINEMATIC if s.base_motion == "ground" else pymunk.Body.STATIC
-        self.ground = pymunk.Body(body_type=kind)
-        # A box, not a segment: its top face is one flat edge under both columns.
-        ground_w = scene.lintel_length + 2.0 * self.size
-        ground_t = max(b, 0.1 * self.size)
-        self.ground.position = (0.5 * scene.lintel_length, -0.5 * ground_t)
-        space.add(self.ground)
-        add_box(self.ground, ground_w, ground_t)
-
-        th = s.theta0
-        self.columns = []
-        self.x_left = (0.0, b + d)
-        for x_left in self.x_left:
-            body = pymunk.Body(scene.m1, scene.inertia_J_G)
-            body.position = _column_com(x_left, th, b, h)
-            body.angle = th
-            space.add(body)
-            add_box(body, b, h)
-            self.columns.append(body)
-
-        shift = _lintel_shift(th, b, h)
-        self.lintel = None
-        self.bob = None
-        if scene.mu > 0.0:
-            length = scene.lintel_length
-            lintel = pymunk.Body(scene.m3, scene.m3 * (length ** 2 + t_l ** 2) / 12.0)
-            lintel.position = (0.5 * length + shift[0], h + 0.5 * t_l + shift[1])
-            space.add(lintel)
-            add_box(lintel, length, t_l)
-            self.lintel = lintel
-        if scene.has_pendulum:
-            l = scene.pendulum_length
-            hinge = (0.5 * scene.lintel_length + scene.hinge_x + shift[0], h + shift[1])
-            radius = s.pendulum_radius_fraction * l
-            bob = pymunk.Body(scene.m4, scene.m4 * radius ** 2)
-            bob.position = (hinge[0] + l * math.sin(s.psi0), hinge[1] - l * math.cos(s.psi0))
-            space.add(bob)
-            dot = pymunk.Circle(bob, radius)
-            dot.filter = pymunk.ShapeFilter(categories=0, mask=0)  # collides with nothing
-            space.add(dot)
-            anchor_bob = (hinge[0] - bob.position.x, hinge[1] - bob.position.y)
-            # The bob's body is the rod: its rotation is the pendulum's (psi - psi0).
-            joint = pymunk.PivotJoint(self.lintel, bob, (scene.hinge_x, -0.5 * t_l), anchor_bob)
-            joint.collide_bodies = False
-            space.add(joint)
-            self.bob = bob
-        self.space = space
-        self.bodies = [c for c in self.columns] + [x for x in (self.lintel, self.bob) if x]
-        self.start = [(bd.position.x, bd.position.y) for bd in self.bodies]
-
-
-def _state_reader(world):
-    """A function returning ``[x, y, angle, vx, vy, omega]`` of every body of
-    ``world.bodies``, concatenated in that order.
-
-    One ``pymunk.batch`` call per sample instead of ~20 property reads (each a C
-    call plus a ``Vec2d``: ~1 us, a sixth of a step): the per-sample cost that
-    keeps the harness above 80 % of the bare step rate (``benchmarks/bench_overhead``).
-    ``pymunk.batch`` is marked experimental, so its output is checked against the
-    properties once, bit for bit, and the properties are used if it differs.
-    """
-    bodies = world.bodies
-
-    def by_property() -> list[float]:
-        out: list[float] = []
-        for body in bodies:
-            (x, y), (vx, vy) = body.position, body.velocity
-            out += (x, y, body.angle, vx, vy, body.angular_velocity)
-        return out
-
-    try:
-        from pymunk import batch
-        f = batch.BodyFields
-        flags = f.POSITION | f.ANGLE | f.VELOCITY | f.ANGULAR_VELOCITY
-        ids = batch.Buffer()
-        batch.get_space_bodies(world.space, f.BODY_ID, ids)
-        order = memoryview(ids.int_buf()).cast("P").tolist()
-        # Chipmunk keeps its bodies in insertion order; nothing is added or removed
-        # (and nothing sleeps) during a run, so the order found here holds.
-        index = [6 * order.index(body.id) for body in bodies]
-    except Exception:  # an experimental API that changed: fall back, never fail
-        return by_property
-    buf, space = batch.Buffer(), world.space
-    n = len(bodies)
-    contiguous = index == [6 * k for k in range(n)]
-
-    def batched() -> list[float]:
-        buf.clear()
-        batch.get_space_bodies(space, flags, buf)
-        flat = memoryview(buf.float_buf()).cast("d").tolist()
-        if contiguous:
-            return flat[:6 * n]
-        out: list[float] = []
-        for k in index:
-            out += flat[k:k + 6]
-        return out
-
-    try:
-        same = batched() == by_property()
-    except Exception:  # an experimental API that changed: fall back, never fail
-        same = False
-    return batched if same else by_property
-
-
-def _peak_ground_speed(excitation) -> float:
-    if excitation.end_time <= 0.0:
-        return 0.0
-    ts = [excitation.end_time * k / 400.0 for k in range(401)]
-    return max(abs(excitation.velocity(t)) for t in ts)
 
 
 # -------------------------------------------------------------------------- simulate
