@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
+from compare.commands._common import clean_nan
 from scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",
@@ -236,16 +237,6 @@ def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path) ->
 
 
 # --- the whole run --------------------------------------------------------------------
-def _clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    return obj
-
-
 def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
                  progress: bool = False) -> dict:
     """Compute every spectrum, write ``<fig>.png`` per figure and ``figures.json``.
@@ -289,7 +280,7 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     doc["n_runs"] = int(sum(s.n_runs for s in spectra.values()))
     doc["n_undecided"] = int(sum(s.n_undecided for s in spectra.values()))
     doc["wall_time"] = time.perf_counter() - t0
-    doc = _clean(doc)
+    doc = clean_nan(doc)
     with open(out / "figures.json", "w") as fh:
         json.dump(doc, fh, indent=1, allow_nan=False)
     return doc

@@ -23,9 +23,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from analytic import equations as eq
+from analytic.events import free_pendulum_period
+from analytic.excitation import Pulse, SampledRecord
 from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
 
-__all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero", "free_pendulum_period"]
+__all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero", "free_pendulum_period",
+           "required_friction", "peak_acceleration"]
 
 
 @dataclass(frozen=True)
@@ -66,19 +69,41 @@ class MonitorSettings:
     energy_rule: bool = True
 
 
-def free_pendulum_period(psi: float, psi_dot: float, l: float, g: float) -> float:
-    """Period [s] of the free pendulum through state ``(psi, psi_dot)``: libration
-    ``4 sqrt(l/g) K(k^2)`` with ``k = sin(psi_max/2)``; for a rotating pendulum the
-    time of one revolution (``2 sqrt(l/g) K(1/k^2)/k``)."""
-    from scipy.special import ellipk
+def required_friction(scene, excitation) -> float:
+    """Conservative Coulomb coefficient needed for rocking without sliding
+    (one rule for every engine; ``analytic.reactions`` gives the exact demand
+    along an analytic run, and this bound exceeded it at A-D).
 
-    w0 = math.sqrt(g / l)
-    k2 = math.sin(psi / 2.0) ** 2 + (psi_dot / (2.0 * w0)) ** 2
-    if k2 < 1e-300:
-        return 2.0 * math.pi / w0
-    if k2 < 1.0:
-        return 4.0 / w0 * float(ellipk(k2))
-    return 2.0 / (w0 * math.sqrt(k2)) * float(ellipk(1.0 / k2))
+    The largest of three ratios of horizontal to vertical ground reaction:
+
+    * at rest up to uplift the trilith moves with the ground: ``|a_up| / g``
+      (Eq. 9, pendulum hanging still) and, for a sampled or pulse excitation,
+      ``peak |xg_ddot| / g`` (the rigid-body bound if the trilith were carried
+      along for the whole pulse; it over-estimates the rocking phase, where the
+      columns' rotation absorbs most of the horizontal acceleration);
+    * at an impact, the plastic impulse at the new corners of every body in the
+      rocking mechanism has the ratio ``lam (1 - e) / (1 + e)`` with ``e`` the
+      velocity ratio of Eq. 20 (Eq. 19 at ``psi = 0`` with the pendulum): the
+      columns' centres and the lintel move on circles of the same shape.
+    """
+    b, h, mu, gamma, j, l, g = scene.model_args()
+    a_up = abs(eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g))
+    e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
+    impact = (h / b) * (1.0 - e) / (1.0 + e)
+    return max(a_up / g, peak_acceleration(excitation) / g, impact)
+
+
+def peak_acceleration(excitation) -> float:
+    """``max |xg_ddot|`` [m/s^2] of an excitation (0 for :class:`Still`)."""
+    if isinstance(excitation, Pulse):
+        return abs(excitation.amplitude)
+    if isinstance(excitation, SampledRecord):  # linear interpolation peaks at a sample
+        return max(abs(a) for a in excitation.accelerations)
+    if excitation.end_time > 0.0:
+        t = np.linspace(0.0, excitation.end_time, 20001)
+        return float(np.max(np.abs(excitation.acceleration_array(t))))
+    return 0.0
+
 
 
 def propagate_to_zero(scene, excitation, t0: float, state0, side: int,

@@ -41,10 +41,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pybullet as pb
 
-from analytic import equations as eq
-from analytic.excitation import Still
 from analytic.trajectory import OverturnCriterion, Trajectory
-from engines._common import MonitorSettings, RunMonitor
+from engines._common import MonitorSettings, RunMonitor, peak_acceleration, required_friction
 from engines import pybullet_scene as ps
 
 __all__ = ["NAME", "Settings", "simulate", "version", "render_frames", "view",
@@ -140,36 +138,9 @@ class Settings:
         return out
 
 
-def required_friction(scene, excitation) -> float:
-    """The friction coefficient the trilith needs while it rests on the ground.
-
-    At rest it follows the ground, so the base must supply ``M |xg_ddot|`` with
-    normal force ``M g``: it needs ``|xg_ddot|/g``, but only up to the uplift
-    acceleration (Eq. 9 with the pendulum hanging; ``g/lam`` without it, Eq. 11)
-    because beyond that it rocks instead.  Hence
-    ``min(peak |xg_ddot|, |a_up|) / g`` (zero for :class:`Still`).  This is
-    necessary, not sufficient: during rocking and impacts the demand is set by
-    the dynamics, hence the larger :func:`default_friction`, and PyBullet's
-    sliding is *measured* (the ``pivot_sliding_max`` diagnostic, tested to stay
-    below 0.1 mm for the paper's Fig. 5 points at the default friction).
-    """
-    peak = _peak(excitation)
-    b, h, mu, gamma, _, l, g = scene.model_args()
-    a_up = max(abs(eq.uplift_acceleration(0.0, 0.0, side, b, h, mu, gamma, l, g))
-               for side in (1.0, -1.0))
-    return min(peak, a_up) / g
-
-
-def _peak(excitation) -> float:
-    if isinstance(excitation, Still):
-        return 0.0
-    if hasattr(excitation, "amplitude"):
-        return abs(excitation.amplitude)
-    return float(np.max(np.abs(excitation.accelerations)))
-
-
 def default_friction(scene, excitation) -> float:
-    """``max(1, peak |xg_ddot| / g)``: 1 is the calibrated value (DESIGN.md and
+    """``max(1, required_friction)`` (in practice ``max(1, peak |xg_ddot| / g)``,
+    the shared bound's usual largest term): 1 is the calibrated value (DESIGN.md and
     the :class:`Settings` notes); stronger pulses need more while rocking: at
     the paper's point D (25 m/s^2 = 2.5 g, with the pendulum) friction 1 lets
     the pivots slide by 7 mm before the trilith passes alpha; the default 2.55
@@ -178,7 +149,7 @@ def default_friction(scene, excitation) -> float:
     fix the early landing made it slide 2.5-9 mm).  ``peak/g`` is what the
     trilith would need to follow the peak acceleration while resting, a simple
     bound on the rocking demand."""
-    return max(1.0, _peak(excitation) / scene.g)
+    return max(1.0, required_friction(scene, excitation))
 
 
 def _validate(scene, excitation, s: Settings) -> float:
@@ -218,8 +189,8 @@ def _validate(scene, excitation, s: Settings) -> float:
     friction = default_friction(scene, excitation) if s.friction is None else s.friction
     if not (isinstance(friction, (int, float)) and math.isfinite(friction) and friction >= need
             and friction > 0.0):
-        raise ValueError(f"friction must be >= {need:.4g} (min(peak |xg_ddot|, a_up)/g: the "
-                         f"trilith at rest must not slide), got {friction!r}")
+        raise ValueError(f"friction must be >= {need:.4g} for rocking without sliding in "
+                         f"this scene and excitation (see required_friction), got {friction!r}")
     return float(friction)
 
 

@@ -39,13 +39,10 @@ import math
 import time
 from dataclasses import dataclass, field
 
-import numpy as np
 import pymunk
 
-from analytic import equations as eq
-from analytic.excitation import Pulse, SampledRecord
 from analytic.trajectory import OverturnCriterion, Trajectory
-from engines._common import MonitorSettings, RunMonitor
+from engines._common import MonitorSettings, RunMonitor, required_friction
 # Scene building lives in engines.pymunk_scene; _World is re-exported because
 # tests and benchmarks/bench_overhead.py build bare worlds through this module.
 from engines.pymunk_scene import _World, _peak_ground_speed, _state_reader
@@ -143,37 +140,6 @@ class Settings:
         out = dataclasses.asdict(self)
         out["criterion"] = self.criterion.describe()
         return out
-
-
-def required_friction(scene, excitation) -> float:
-    """Conservative Coulomb coefficient needed for rocking without sliding.
-
-    The largest of three ratios of horizontal to vertical ground reaction:
-
-    * at rest up to uplift the trilith moves with the ground: ``|a_up| / g``
-      (Eq. 9, pendulum hanging still) and, for a sampled or pulse excitation,
-      ``peak |xg_ddot| / g`` (the rigid-body bound if the trilith were carried
-      along for the whole pulse; it over-estimates the rocking phase, where the
-      columns' rotation absorbs most of the horizontal acceleration);
-    * at an impact, the plastic impulse at the new corners of every body in the
-      rocking mechanism has the ratio ``lam (1 - e) / (1 + e)`` with ``e`` the
-      velocity ratio of Eq. 20 (Eq. 19 at ``psi = 0`` with the pendulum): the
-      columns' centres and the lintel move on circles of the same shape.
-    """
-    b, h, mu, gamma, j, l, g = scene.model_args()
-    a_up = abs(eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g))
-    e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
-    impact = (h / b) * (1.0 - e) / (1.0 + e)
-    if isinstance(excitation, Pulse):
-        peak = abs(excitation.amplitude)
-    elif isinstance(excitation, SampledRecord):  # linear interpolation peaks at a sample
-        peak = max(abs(a) for a in excitation.accelerations)
-    elif excitation.end_time > 0.0:
-        t = np.linspace(0.0, excitation.end_time, 20001)
-        peak = float(np.max(np.abs(excitation.acceleration_array(t))))
-    else:
-        peak = 0.0
-    return max(a_up / g, peak / g, impact)
 
 
 def _validate(scene, excitation, s: Settings) -> None:
