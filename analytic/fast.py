@@ -46,6 +46,7 @@ __all__ = ["NAME", "version", "Settings", "simulate", "overturn_verdict", "verdi
            "warm_up", "STATUS_NAMES"]
 
 NAME = "analytic-fast"
+CAPABILITIES = frozenset({"trajectory"})
 STATUS_NAMES = ("overturned", "survived", "unstable", "undecided")
 EVENT_NAMES = ("uplift", "impact", "rest", "overturn", "unstable")
 REASONS = ("overturned", "energy below the overturning barrier after the pulse",

@@ -64,6 +64,7 @@ from .trajectory import Event, Trajectory, Verdict
 __all__ = ["NAME", "Settings", "simulate", "version"]
 
 NAME = "analytic"
+CAPABILITIES = frozenset({"initial_tilt", "trajectory"})
 REASON_BARRIER = "energy below the overturning barrier after the pulse"
 REASON_REST = "at rest after the pulse without pendulum"
 REASON_PERIOD = "at rest after the pulse: no uplift during one free-pendulum period"
@@ -129,7 +130,7 @@ class _Run:
         """Record an exact survival rule; returns True when the run must stop."""
         if not self.decided:
             self.decided = reason
-        if self.st.t_max is None:
+        if self.st.t_max is None and self.st.early_stop:
             self.verdict = Verdict("survived", None, None, self.n_impacts, reason)
             return True
         return False
@@ -370,8 +371,9 @@ class _Run:
                 if self.check_barrier():
                     break
             if self.t >= self.t_stop:
-                if self.st.t_max is not None:
-                    reason = f"{self.decided}; ran to t_max" if self.decided else REASON_WINDOW
+                if self.st.t_max is not None or self.decided:
+                    until = "t_max" if self.st.t_max is not None else "t_cap (early_stop off)"
+                    reason = f"{self.decided}; ran to {until}" if self.decided else REASON_WINDOW
                     self.verdict = Verdict("survived", None, None, self.n_impacts, reason)
                 else:
                     self.verdict = Verdict("undecided", None, None, self.n_impacts, REASON_CAP)

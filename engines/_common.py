@@ -25,7 +25,8 @@ from scipy.integrate import solve_ivp
 from analytic import equations as eq
 from analytic.events import free_pendulum_period
 from analytic.excitation import Pulse, SampledRecord
-from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from analytic.options import check_real
+from analytic.trajectory import Event, Trajectory, Verdict
 
 __all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero", "free_pendulum_period",
            "required_friction", "peak_acceleration"]
@@ -54,9 +55,9 @@ class MonitorSettings:
         (``analytic.reactions``): real contacts let the columns hop and part,
         which is the collapse, not a broken engine (a falling column may even
         swing back below ``alpha`` while its neighbour falls on).
-    energy_rule : stop as 'survived' once the energy is below the overturning
-        barrier after the pulse.  Free-rocking experiments (restitution) turn it
-        off: they need the impacts, not the verdict.
+
+    Whether the run stops as soon as the verdict is certain is the run option
+    ``early_stop`` (:class:`analytic.options.RunOptions`), not a monitor setting.
     """
 
     uplift_angle: float = 1e-4
@@ -66,7 +67,13 @@ class MonitorSettings:
     rest_hold: float = 0.5
     t_cap: float = 60.0
     max_mismatch: float = 0.25
-    energy_rule: bool = True
+
+    def __post_init__(self) -> None:
+        for name, lo, hi in (("uplift_angle", 0.0, 0.1), ("impact_window", 0.0, 0.5),
+                             ("rest_angle", 0.0, 0.1), ("rest_rate", 0.0, 1.0),
+                             ("rest_hold", 0.0, 1e4), ("t_cap", 0.0, 1e5),
+                             ("max_mismatch", 0.0, 10.0)):
+            check_real("MonitorSettings", name, getattr(self, name), lo, hi)
 
 
 def required_friction(scene, excitation) -> float:
@@ -140,13 +147,15 @@ class RunMonitor:
     True when the verdict is decided.  Then call :meth:`finish`.
     """
 
-    def __init__(self, scene, excitation, criterion: OverturnCriterion,
-                 t_max: float | None, settings: MonitorSettings | None = None) -> None:
+    def __init__(self, scene, excitation, options) -> None:
+        """``options``: the run's settings (:class:`engines.base.EngineSettings`:
+        ``criterion``, ``t_max``, ``early_stop`` and ``monitor``)."""
         self.scene = scene
         self.excitation = excitation
-        self.criterion = criterion
-        self.t_max = t_max
-        self.cfg = settings or MonitorSettings()
+        self.criterion = criterion = options.criterion
+        self.t_max = t_max = options.t_max
+        self.early_stop = options.early_stop
+        self.cfg = options.monitor
         self.args = scene.model_args()
         self.threshold = criterion.threshold(scene.alpha)
         self.barrier = eq.overturn_energy_barrier(*self.args[:4], self.args[6])
@@ -207,7 +216,7 @@ class RunMonitor:
                                    f"{what} reached {self.threshold:.4g} rad ({self.criterion.kind})")
             return True
         if t >= self.t_end_pulse and not self._parted:
-            if cfg.energy_rule and self._survived_by_energy(theta, theta_dot, psi, psi_dot):
+            if self.early_stop and self._survived_by_energy(theta, theta_dot, psi, psi_dot):
                 self.verdict = Verdict("survived", None, None, len(self._impacts),
                                        "energy below the overturning barrier after the pulse")
                 return True

@@ -33,23 +33,25 @@ overturning time there is not comparable.
 """
 from __future__ import annotations
 
-import math
 import operator
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 import pybullet as pb
 
-from analytic.trajectory import OverturnCriterion, Trajectory
-from engines._common import MonitorSettings, RunMonitor, peak_acceleration, required_friction
+from analytic.options import check_real
+from analytic.trajectory import Trajectory
+from engines._common import required_friction
 from engines import pybullet_scene as ps
+from engines.base import BASE_MOTIONS, EngineSettings, simulate_world
 
 __all__ = ["NAME", "Settings", "simulate", "version", "render_frames", "view",
-           "required_friction", "default_friction", "BASE_MOTIONS"]
+           "required_friction", "default_friction", "BASE_MOTIONS", "CAPABILITIES"]
 
 NAME = "pybullet"
-BASE_MOTIONS = ("gravity", "ground")
+CAPABILITIES = frozenset({"time_step", "solver_iterations", "render", "gui", "moving_ground",
+                          "initial_tilt", "trajectory"})
 
 
 def version() -> str:
@@ -60,19 +62,16 @@ def version() -> str:
 
 
 @dataclass(frozen=True)
-class Settings:
+class Settings(EngineSettings):
     """Numerical settings of a PyBullet run; defaults are the calibrated ones.
+
+    The run options and engine fields (``criterion``, ``t_max``, ``theta0``,
+    ``psi0``, ``early_stop``, ``dt``, ``base_motion``, ``sample_every``,
+    ``monitor``) are :class:`engines.base.EngineSettings`; the defaults hold
+    here (``dt`` 1e-4 s: 5e-5 measured no better at twice the cost).
 
     Parameters
     ----------
-    criterion : shared overturning criterion (same as the analytic model).
-    t_max : run length cap [s]; None: decided by the monitor (rest / energy rules).
-    dt : time step [s].
-    theta0, psi0 : initial tilt and pendulum angle [rad], released at rest
-        (``theta0 > 0`` leans left, on the left corners).
-    base_motion : "gravity" (d'Alembert load) or "ground" (moving ground body).
-    sample_every : steps between state reads (and overturn/instability checks).
-    monitor : shared stop rules (:class:`engines._common.MonitorSettings`).
     friction : Coulomb coefficient of every contact; None: :func:`default_friction`.
         Bullet combines the two bodies' values by product, so each body gets
         ``sqrt(friction)``.  Must be >= :func:`required_friction`.
@@ -115,15 +114,7 @@ class Settings:
       setting tried: the calibration holds for the paper's 0.2-0.8 m.
     """
 
-    criterion: OverturnCriterion = OverturnCriterion()
-    t_max: float | None = None
-    dt: float = 1e-4  # DESIGN.md; 5e-5 measured no better at twice the cost
-    theta0: float = 0.0  # start upright unless a free-rocking run asks otherwise
-    psi0: float = 0.0  # pendulum hanging
-    base_motion: str = "gravity"  # exact for a rigid base, cheapest
-    sample_every: int = 20  # 2 ms; 1 ms vs every step: ratios within 0.015 %; harness overhead
-    monitor: MonitorSettings = MonitorSettings()
-    friction: float | None = None  # auto: max(1, peak/g), see default_friction
+    friction: float | None = None  # auto: max(1, required_friction), see default_friction
     solver_iterations: int = 50  # PyBullet default; 10 or 200 measured no better
     contact_erp: float = 0.2  # PyBullet default; acts only beyond the slop
     contact_slop: float | None = None  # m; auto: min(1e-4, dt * 1 m/s), see pybullet_scene.effective_slop
@@ -131,9 +122,27 @@ class Settings:
     friction_anchor: bool = True  # DESIGN.md; without anchors errors reach 9 %
     out_of_plane_limit: float = 0.1  # fraction of the size: far beyond the 1e-5 m noise
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        o = "pybullet Settings"
+        if self.friction is not None:
+            check_real(o, "friction", self.friction, 0.0, 1e3)
+        if (isinstance(self.solver_iterations, bool) or not isinstance(self.solver_iterations, int)
+                or not 1 <= self.solver_iterations <= 10_000):
+            raise ValueError(f"{o}: solver_iterations must be an integer in [1, 10000], "
+                             f"got {self.solver_iterations!r}")
+        check_real(o, "contact_erp", self.contact_erp, 0.0, 1.0, lo_open=False)
+        if self.contact_slop is not None:
+            check_real(o, "contact_slop", self.contact_slop, 0.0, 0.1, lo_open=False)
+        if self.contact_breaking_threshold is not None:
+            check_real(o, "contact_breaking_threshold", self.contact_breaking_threshold, 0.0, 1.0)
+        if not isinstance(self.friction_anchor, bool):
+            raise TypeError(f"{o}: friction_anchor must be True or False, "
+                            f"got {self.friction_anchor!r}")
+        check_real(o, "out_of_plane_limit", self.out_of_plane_limit, 0.0, 10.0)
+
     def describe(self) -> dict:
-        out = asdict(self)
-        out["criterion"] = self.criterion.describe()
+        out = super().describe()
         out["contact_slop_effective"] = ps.effective_slop(self)
         return out
 
@@ -153,45 +162,15 @@ def default_friction(scene, excitation) -> float:
 
 
 def _validate(scene, excitation, s: Settings) -> float:
-    """Check settings before any stepping; return the friction coefficient to use."""
+    """Checks that need the scene, before any stepping; returns the friction to use."""
     if not isinstance(s, Settings):
-        raise ValueError(f"settings must be a pybullet_engine.Settings, got {type(s).__name__}")
-    if not (isinstance(s.dt, (int, float)) and math.isfinite(s.dt) and 0.0 < s.dt <= 0.1):
-        raise ValueError(f"dt must be in (0, 0.1] s, got {s.dt!r}")
-    if s.base_motion not in BASE_MOTIONS:
-        raise ValueError(f"base_motion must be one of {BASE_MOTIONS}, got {s.base_motion!r}")
-    if not (isinstance(s.sample_every, int) and s.sample_every >= 1):
-        raise ValueError(f"sample_every must be an integer >= 1, got {s.sample_every!r}")
-    if s.t_max is not None and not (math.isfinite(s.t_max) and s.t_max > 0.0):
-        raise ValueError(f"t_max must be None or in (0, inf) s, got {s.t_max!r}")
-    limit = min(s.criterion.threshold(scene.alpha), 0.5 * math.pi)
-    if not (math.isfinite(s.theta0) and abs(s.theta0) < limit):
-        raise ValueError(f"theta0 must be in (-{limit:.4g}, {limit:.4g}) rad, got {s.theta0!r}")
-    if not (math.isfinite(s.psi0) and abs(s.psi0) <= math.pi):
-        raise ValueError(f"psi0 must be in [-pi, pi] rad, got {s.psi0!r}")
-    if not (isinstance(s.solver_iterations, int) and 1 <= s.solver_iterations <= 10000):
-        raise ValueError(f"solver_iterations must be an integer in [1, 10000], "
-                         f"got {s.solver_iterations!r}")
-    if not (math.isfinite(s.contact_erp) and 0.0 <= s.contact_erp <= 1.0):
-        raise ValueError(f"contact_erp must be in [0, 1], got {s.contact_erp!r}")
-    if s.contact_slop is not None and not (math.isfinite(s.contact_slop)
-                                           and 0.0 <= s.contact_slop <= 0.1):
-        raise ValueError(f"contact_slop must be None or in [0, 0.1] m, got {s.contact_slop!r}")
-    cbt = s.contact_breaking_threshold
-    if cbt is not None and not (math.isfinite(cbt) and cbt > 0.0):
-        raise ValueError(f"contact_breaking_threshold must be None or > 0 m, got {cbt!r}")
-    if not (math.isfinite(s.out_of_plane_limit) and s.out_of_plane_limit > 0.0):
-        raise ValueError(f"out_of_plane_limit must be > 0, got {s.out_of_plane_limit!r}")
+        raise TypeError(f"settings must be a pybullet_engine.Settings, got {type(s).__name__}")
+    s.check_scene(scene)
     if scene.mu == 0.0 and scene.has_pendulum:
         raise ValueError("mu must be > 0 when gamma > 0: the pendulum hangs on the lintel "
                          "and a massless lintel cannot exist in PyBullet")
-    need = required_friction(scene, excitation)
     friction = default_friction(scene, excitation) if s.friction is None else s.friction
-    if not (isinstance(friction, (int, float)) and math.isfinite(friction) and friction >= need
-            and friction > 0.0):
-        raise ValueError(f"friction must be >= {need:.4g} for rocking without sliding in "
-                         f"this scene and excitation (see required_friction), got {friction!r}")
-    return float(friction)
+    return s.check_friction(friction, scene, excitation)
 
 
 def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
@@ -202,28 +181,11 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     """
     s = settings if settings is not None else Settings()
     friction = _validate(scene, excitation, s)
-    wall0 = time.perf_counter()
-    monitor = RunMonitor(scene, excitation, s.criterion, s.t_max, s.monitor)
-    world = ps.World(scene, excitation, s, friction)
-    try:
-        decided = monitor.record(0.0, *world.sample()[:5])
-        while not decided:
-            world.advance(s.sample_every)
-            t = world.step_index * s.dt
-            *state, problem = world.sample()
-            if problem is not None:
-                monitor.mark_unstable(t, problem)
-                break
-            decided = monitor.record(t, *state)
-        diagnostics = dict(world.diag, steps=world.step_index, friction=friction)
-    finally:
-        world.close()
-    wall = time.perf_counter() - wall0
-    diagnostics["wall_time"] = wall
     info = s.describe()
     info["friction_used"] = friction
     info["engine_version"] = version()
-    return monitor.finish(NAME, info, diagnostics, wall)
+    return simulate_world(NAME, lambda: ps.World(scene, excitation, s, friction), scene,
+                          excitation, s, info)
 
 
 def render_frames(scene, excitation, times, settings: Settings | None = None,

@@ -127,7 +127,7 @@ class World:
         b, d = scene.b, scene.d
         self.pivots0 = [(0.0, b), (b + d, 2.0 * b + d)]
         self.diag = dict(lintel_rotation_max=0.0, pivot_sliding_max=0.0, penetration_max=0.0,
-                         out_of_plane_max=0.0, out_of_plane_rotation_max=0.0)
+                         out_of_plane_max=0.0, out_of_plane_rotation_max=0.0, friction=friction)
         self.step_index = 0
         self.standing = True  # see sample()
         if self.moving:

@@ -17,7 +17,7 @@ import pymunk
 if TYPE_CHECKING:  # annotation only: the adapter imports this module
     from engines.pymunk_engine import Settings
 
-__all__ = ["_World", "_state_reader", "_peak_ground_speed"]
+__all__ = ["World", "_World", "_state_reader", "_peak_ground_speed"]
 
 def _rotate(v: tuple[float, float], angle: float) -> tuple[float, float]:
     c, s = math.cos(angle), math.sin(angle)
@@ -41,10 +41,16 @@ def _lintel_shift(theta: float, b: float, h: float) -> tuple[float, float]:
     return (r[0] - corner[0], r[1] - corner[1])
 
 
-class _World:
-    """A fresh Pymunk space holding one trilith; nothing is shared between runs."""
+class World:
+    """A fresh Pymunk space holding one trilith; nothing is shared between runs.
 
-    def __init__(self, scene, s: Settings) -> None:
+    The engine side of the contract (:class:`engines.base.World`): ``advance``
+    steps the space, ``sample`` reads every body once and updates the contact
+    diagnostics in ``diag`` (over the rocking regime ``|theta| < alpha`` that the
+    analytic model describes, and ``*_all`` over the whole run).
+    """
+
+    def __init__(self, scene, s: Settings, excitation=None) -> None:
         b, h, d = scene.b, scene.h, scene.d
         t_l = scene.lintel_thickness
         self.size = max(scene.lintel_length, h + t_l)
@@ -112,6 +118,104 @@ class _World:
         self.space = space
         self.bodies = [c for c in self.columns] + [x for x in (self.lintel, self.bob) if x]
         self.start = [(bd.position.x, bd.position.y) for bd in self.bodies]
+        self.scene, self.s, self.excitation = scene, s, excitation
+        self.step_index = 0
+        self.diag = dict(lintel_rotation_max=0.0, pivot_sliding_max=0.0, penetration_max=0.0,
+                         pivot_sliding_max_all=0.0, penetration_max_all=0.0)
+        if excitation is not None:
+            self._prepare_run(excitation)
+
+    # ------------------------------------------------------------ the run loop
+    def _prepare_run(self, excitation) -> None:
+        """Constants of the per-sample reads (the hot path reads them once)."""
+        scene, s = self.scene, self.s
+        self._read_state = _state_reader(self)
+        self._i_lintel = self.bodies.index(self.lintel) if self.lintel is not None else None
+        self._i_bob = self.bodies.index(self.bob) if self.bob is not None else None
+        self._corner_x0 = [(x, x + scene.b) for x in self.x_left]
+        self._starts = [(6 * i, x0, y0) for i, (x0, y0) in enumerate(self.start)]
+        self._max_dist = s.blowup_distance * self.size
+        self._max_speed = s.blowup_speed * (math.sqrt(scene.g * self.size)
+                                            + _peak_ground_speed(excitation))
+        # After the pulse gravity stays (0, -g): stop setting it (a C call per step).
+        self._t_gravity_off = excitation.end_time + s.dt
+
+    def close(self) -> None:
+        """Nothing to release (the space is garbage-collected)."""
+
+    def advance(self, count: int) -> None:
+        """``count`` steps; the base motion is imposed before each (mid-step load)."""
+        space, dt, step_space = self.space, self.s.dt, self.space.step
+        excitation, step = self.excitation, self.step_index
+        if self.s.base_motion == "gravity":  # the step loop is the hot path
+            accel, g, t_off = excitation.acceleration, self.scene.g, self._t_gravity_off
+            for _ in range(count):
+                t = step * dt
+                if t <= t_off:
+                    space.gravity = (-accel(t + 0.5 * dt), -g)
+                step_space(dt)
+                step += 1
+        else:
+            for _ in range(count):
+                t = step * dt
+                # Mean ground velocity over the step: the position follows exactly.
+                vx = (excitation.displacement(t + dt) - excitation.displacement(t)) / dt
+                self.ground.velocity = (vx, 0.0)
+                step_space(dt)
+                step += 1
+        self.step_index = step
+
+    def sample(self) -> tuple[float, float, float, float, float, str | None]:
+        """``(theta_left, theta_right, theta_dot, psi, psi_dot, problem)``; updates ``diag``."""
+        s, diag = self.s, self.diag
+        t = self.step_index * s.dt
+        x_ground = 0.0 if s.base_motion == "gravity" else self.excitation.displacement(t)
+        st = self._read_state()  # per body: x, y, angle, vx, vy, omega (columns first)
+        angles = (st[2], st[8])
+        i_bob = self._i_bob
+        psi = s.psi0 + st[6 * i_bob + 2] if i_bob is not None else 0.0
+        psi_dot = st[6 * i_bob + 5] if i_bob is not None else 0.0
+        theta_dot = 0.5 * (st[5] + st[11])
+        in_well = abs(angles[0] + angles[1]) < 2.0 * self.scene.alpha
+        hb, hh = 0.5 * self.scene.b, 0.5 * self.scene.h
+        cos, sin = math.cos, math.sin
+        for k in (0, 1):
+            # Bottom corners (-+b/2, -h/2) in the world, as Body.local_to_world
+            # (Chipmunk's rigid transform of the centred box: rotate, then add p).
+            px, py, angle = st[6 * k], st[6 * k + 1], angles[k]
+            ca, sa = cos(angle), sin(angle)
+            left_x, left_y = ca * -hb + -sa * -hh + px, sa * -hb + ca * -hh + py
+            right_x, right_y = ca * hb + -sa * -hh + px, sa * hb + ca * -hh + py
+            # The pivot is the corner on the side the column leans to.
+            pivot_x, x0 = ((left_x, self._corner_x0[k][0]) if angle >= 0.0
+                           else (right_x, self._corner_x0[k][1]))
+            sl = abs(pivot_x - x0 - x_ground)
+            pen = -(right_y if right_y < left_y else left_y)  # = -min(left_y, right_y)
+            if sl > diag["pivot_sliding_max_all"]:
+                diag["pivot_sliding_max_all"] = sl
+            if pen > diag["penetration_max_all"]:
+                diag["penetration_max_all"] = pen
+            if in_well:
+                if sl > diag["pivot_sliding_max"]:
+                    diag["pivot_sliding_max"] = sl
+                if pen > diag["penetration_max"]:
+                    diag["penetration_max"] = pen
+        if self._i_lintel is not None and in_well:
+            diag["lintel_rotation_max"] = max(diag["lintel_rotation_max"],
+                                              abs(st[6 * self._i_lintel + 2]))
+        problem = None
+        hypot = math.hypot
+        for i, x0, y0 in self._starts:
+            if hypot(st[i] - x0 - x_ground, st[i + 1] - y0) > self._max_dist:
+                problem = f"a body flew away (> {s.blowup_distance:g} trilith sizes)"
+                break
+            if hypot(st[i + 3], st[i + 4]) > self._max_speed:
+                problem = f"a body exceeded {self._max_speed:.3g} m/s"
+                break
+        return angles[0], angles[1], theta_dot, psi, psi_dot, problem
+
+
+_World = World  # the name tests and benchmarks/bench_overhead.py used
 
 
 def _state_reader(world):

@@ -1,0 +1,176 @@
+"""The backend contract, written once (in the spirit of scipy's ``OdeSolver`` base).
+
+A *backend* is a module registered in :data:`engines.BACKENDS` that satisfies
+:class:`Backend`: a ``NAME``, a frozen ``Settings`` dataclass derived from
+:class:`analytic.options.RunOptions` (engines: from :class:`EngineSettings`),
+``simulate(scene, excitation, settings) -> Trajectory``, ``version()`` and the set
+``CAPABILITIES`` of optional features it declares (never probed at run time).
+
+An *engine* adapter is the same short loop for every engine,
+:func:`simulate_world`: build a :class:`World` (the engine's bodies from the
+:class:`~analytic.parameters.Scene`), then alternately ``advance`` it by
+``sample_every`` steps and ``sample`` its state into the shared
+:class:`~engines._common.RunMonitor`, which decides when the verdict is certain.
+A new engine is one module (its ``Settings``, ``World`` and ``version``) and one
+line in :data:`engines.BACKENDS`; see ``docs/adding-an-engine.md``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Protocol, runtime_checkable
+
+from analytic.options import RunOptions, check_real
+from analytic.trajectory import Trajectory
+
+from ._common import MonitorSettings, RunMonitor, required_friction
+
+__all__ = ["Backend", "World", "EngineSettings", "simulate_world", "CAPABILITIES",
+           "BASE_MOTIONS"]
+
+# Optional features a backend may declare in its CAPABILITIES.
+CAPABILITIES = {
+    "time_step": "Settings has a fixed step 'dt' [s] (engines; convergence studies halve it)",
+    "solver_iterations": "Settings has 'solver_iterations' (convergence studies double it)",
+    "render": "render_frames(scene, excitation, times, settings, width, height) -> RGB frames",
+    "gui": "view(scene, excitation, settings, duration) opens a live window",
+    "moving_ground": "base_motion='ground' moves a ground body (besides the gravity trick)",
+    "initial_tilt": "theta0/psi0 releases (free-rocking restitution)",
+    "trajectory": "simulate() samples theta(t) (every backend does)",
+}
+BASE_MOTIONS = ("gravity", "ground")
+
+
+@runtime_checkable
+class Backend(Protocol):
+    """What :func:`engines.get_backend` returns (a module, checked structurally)."""
+
+    NAME: str
+    Settings: type
+    CAPABILITIES: frozenset
+
+    def simulate(self, scene, excitation, settings=None) -> Trajectory: ...
+
+    def version(self) -> str: ...
+
+
+class World(Protocol):
+    """One engine's bodies, built fresh for one run (nothing shared between runs).
+
+    ``sample()`` returns ``(theta_left, theta_right, theta_dot, psi, psi_dot,
+    problem)`` in the analytic model's signs (``theta > 0``: rocking on the left
+    corners; ``psi`` from the downward vertical, counter-clockwise) and updates the
+    contact diagnostics in ``diag``; ``problem`` names a blow-up (non-finite state,
+    a body flown away) or is None.
+    """
+
+    step_index: int
+    diag: dict
+
+    def advance(self, count: int) -> None: ...
+
+    def sample(self) -> tuple[float, float, float, float, float, str | None]: ...
+
+    def close(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class EngineSettings(RunOptions):
+    """What every engine's ``Settings`` adds to :class:`~analytic.options.RunOptions`.
+
+    Parameters
+    ----------
+    dt : float
+        Time step [s] in (0, 0.1].  1e-4 s for every engine: their restitution
+        error grows about linearly with the step (``docs/benchmarks.md``).
+    base_motion : {'gravity', 'ground'}
+        ``'gravity'`` (default) imposes ``-xg_ddot(t)`` as a horizontal gravity
+        component in the base frame (d'Alembert, exact for a rigid translating
+        base); ``'ground'`` moves a ground body (engines declaring
+        ``'moving_ground'``).
+    sample_every : int
+        Steps between two samples read into the monitor, in [1, 10000].  20 (2 ms
+        at the default step): impacts are measured by propagating away from them,
+        and reading state is the costliest part of a step in Python
+        (``benchmarks/bench_overhead.py``).
+    monitor : MonitorSettings
+        The shared stop and verdict thresholds.
+    """
+
+    dt: float = 1e-4
+    base_motion: str = "gravity"
+    sample_every: int = 20
+    monitor: MonitorSettings = field(default_factory=MonitorSettings)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        owner = type(self).__name__
+        check_real(owner, "dt", self.dt, 0.0, 0.1)
+        if self.base_motion not in BASE_MOTIONS:
+            raise ValueError(f"{owner}: base_motion must be one of {BASE_MOTIONS}, "
+                             f"got {self.base_motion!r}")
+        if (isinstance(self.sample_every, bool) or not isinstance(self.sample_every, int)
+                or not 1 <= self.sample_every <= 10_000):
+            raise ValueError(f"{owner}: sample_every must be an integer in [1, 10000], "
+                             f"got {self.sample_every!r}")
+        if not isinstance(self.monitor, MonitorSettings):
+            raise TypeError(f"{owner}: monitor must be a MonitorSettings, "
+                            f"got {type(self.monitor).__name__}")
+
+    def check_friction(self, friction: float, scene, excitation) -> float:
+        """``friction`` if it is at least :func:`~engines._common.required_friction`
+        for rocking without sliding under ``excitation``, else ``ValueError``."""
+        need = required_friction(scene, excitation)
+        value = check_real(type(self).__name__, "friction", friction, 0.0, 1e3)
+        if value < need:
+            raise ValueError(f"{type(self).__name__}: friction must be >= {need:.4g} for rocking "
+                             f"without sliding in this scene and excitation (see "
+                             f"required_friction), got {friction!r}")
+        return value
+
+
+def simulate_world(name: str, make_world: Callable[[], World], scene, excitation,
+                   settings: EngineSettings, info: dict) -> Trajectory:
+    """The adapter loop every engine shares: build, then advance/sample until decided.
+
+    Parameters
+    ----------
+    name : str
+        The backend's registry name (``Trajectory.backend``).
+    make_world : callable
+        Builds the engine's :class:`World` (called once, timed with the run).
+    scene, excitation
+        What is simulated (the monitor judges the run with the analytic rules).
+    settings : EngineSettings
+        Validated settings (``dt``, ``sample_every``, the run options).
+    info : dict
+        The settings as the result should carry them (``describe()`` plus what
+        the engine resolved, e.g. the friction used and its version).
+
+    Returns
+    -------
+    Trajectory
+        Samples every ``sample_every`` steps, events, the verdict and the world's
+        diagnostics (plus ``steps`` and ``wall_time``).
+    """
+    wall0 = time.perf_counter()
+    monitor = RunMonitor(scene, excitation, settings)
+    world = make_world()
+    try:
+        t = 0.0
+        *state, problem = world.sample()
+        decided = monitor.record(t, *state)
+        while not decided:
+            world.advance(settings.sample_every)
+            t = world.step_index * settings.dt
+            *state, problem = world.sample()
+            if problem is not None:
+                monitor.mark_unstable(t, problem)
+                break
+            decided = monitor.record(t, *state)
+        diagnostics = dict(world.diag, steps=world.step_index)
+    finally:
+        world.close()
+    wall = time.perf_counter() - wall0
+    diagnostics["wall_time"] = wall
+    return monitor.finish(name, info, diagnostics, wall)
