@@ -18,7 +18,6 @@ import math
 import numpy as np
 from numba import njit
 
-from . import _numba_cache
 from . import equations as _eq
 from ._fast_numerics import (_A, _B, _C, _E, _MAX_FACTOR, _MIN_FACTOR, _ROOT_ITER,
                              _ROOT_XTOL, _SAFETY, _dense, _ellipk, _push, _push_event,

@@ -35,7 +35,6 @@ import time
 from dataclasses import asdict, dataclass, field
 
 import numba
-import numpy as np
 
 from . import _fast_kernels as _k
 from .excitation import Pulse, SampledRecord

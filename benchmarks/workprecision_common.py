@@ -17,7 +17,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
+
+from compare.jsonable import plain
 
 __all__ = ["Point", "timed", "pareto_front", "mark_front", "bisect_threshold", "machine_info",
            "write_json", "plot_work_precision", "OUT_DIR"]
@@ -173,15 +174,8 @@ def machine_info() -> dict:
 def write_json(path: Path, machine: dict, points: list[Point], meta: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"machine": machine, "meta": meta, "points": [p.to_dict() for p in points]}
-    path.write_text(json.dumps(payload, indent=1, allow_nan=False, default=_default))
+    path.write_text(json.dumps(plain(payload), indent=1, allow_nan=False))
 
-
-def _default(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    if hasattr(value, "describe"):
-        return value.describe()
-    return str(value)
 
 
 def plot_work_precision(points: list[Point], metric: str, path: Path, title: str,

@@ -15,27 +15,25 @@ the numbers do not depend on scheduling).  Progress bar on a terminal only.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import multiprocessing as mp
 import sys
 import time
 from dataclasses import dataclass, field
 
-from analytic.excitation import Pulse, Still
-from engines import ENGINES, get_backend
-from scenes import load_scene
+from analytic.excitation import Pulse
+from engines import ENGINES, configure, get_backend
+from scenes import POINTS, load_scene
+
+from engines._common import required_friction
 
 from . import metrics
+from .restitution import RestitutionResult, measure_restitution
 from .spectra import choose_frequencies, reference_spectrum
 from .thresholds import engine_jump_frequency, engine_threshold
 
-__all__ = ["POINTS", "Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
+__all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
            "free_rocking_restitution"]
-
-# The paper's labelled cases (A_s [m/s^2], Omega [rad/s]): Fig. 6 (A, B), Fig. 7 (C, D).
-POINTS: dict[str, tuple[float, float]] = {"A": (19.0, 15.0), "B": (4.0, 9.0),
-                                          "C": (10.0, 9.0), "D": (25.0, 11.0)}
 
 
 @dataclass(frozen=True)
@@ -78,7 +76,7 @@ class CampaignConfig:
     restitution_mus: tuple[float, ...] = (0.5, 1.0, 2.0)  # issue's grid
     pendulum_lams: tuple[float, ...] = (3.0, 5.0, 7.0)  # Eq. 19 runs (scene's mu, gamma)
     theta0_fraction: float = 0.5  # release tilt / alpha: well inside the well, fast impacts
-    n_impacts: int = 4  # per free-rocking run: two of each side, as engines/restitution.py
+    n_impacts: int = 4  # per free-rocking run: two of each side, as compare/restitution.py
     spectrum_cases: tuple[str, ...] = ("pendulum", "no_pendulum")  # Fig. 5: both curves
     n_frequencies: int = 6  # engine threshold frequencies per case (away from jumps); 10-min budget
     omega_range: tuple[float, float] = (5.0, 26.0)  # rad/s: most of the Fig. 5 axis (3-30); the
@@ -128,29 +126,15 @@ class CampaignConfig:
         return metrics._plain(self)
 
 
-def backend_settings(name: str, config: CampaignConfig, **fields):
-    """``name``'s calibrated Settings with ``engine_dt`` and ``fields`` applied
-    (fields the backend does not have are ignored, e.g. ``dt`` for analytic)."""
-    module = get_backend(name)
-    settings = module.Settings()
-    known = {f.name for f in dataclasses.fields(settings)}
-    changes = {k: v for k, v in fields.items() if k in known}
-    if config.engine_dt is not None and name in ENGINES and "dt" in known:
-        changes["dt"] = config.engine_dt
-    return dataclasses.replace(settings, **changes) if changes else settings
+def backend_settings(name: str, config: CampaignConfig, **options):
+    """``name``'s calibrated settings (:func:`engines.configure`) with the
+    campaign's ``engine_dt`` applied to the engines, and ``options``."""
+    if config.engine_dt is not None and name in ENGINES:
+        options.setdefault("dt", config.engine_dt)
+    return configure(name, **options)
 
 
 # ----------------------------------------------------------------------- jobs
-def _free_rocking_settings(name: str, config: CampaignConfig, theta0: float):
-    settings = backend_settings(name, config, theta0=theta0)
-    monitor = getattr(settings, "monitor", None)
-    if monitor is not None and hasattr(monitor, "energy_rule"):
-        # Free rocking starts below the overturning barrier: keep running for the impacts.
-        settings = dataclasses.replace(settings, monitor=dataclasses.replace(
-            monitor, energy_rule=False))
-    return settings
-
-
 def _job_history(name, scene, point, config):
     amp, omega = POINTS[point]
     settings = backend_settings(name, config)
@@ -158,21 +142,12 @@ def _job_history(name, scene, point, config):
 
 
 def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = None
-                             ) -> metrics.RestitutionComparison:
+                             ) -> RestitutionResult:
     """Release ``scene`` at rest from ``theta0_fraction * alpha`` in backend ``name``
     (no base motion) and measure the first ``n_impacts`` impacts against Eq. 19/20."""
-    from engines.restitution import analytic_impact_times
-
     config = config or CampaignConfig()
-
-    theta0 = config.theta0_fraction * scene.alpha
-    # Run just past impact n (halfway to n + 1), timed by the analytic model.
-    times = analytic_impact_times(scene, theta0, 0.0, config.n_impacts + 1)
-    t_max = (0.5 * (times[-2] + times[-1]) if len(times) > config.n_impacts
-             else (times[-1] if times else 0.0) + 0.5)
-    settings = dataclasses.replace(_free_rocking_settings(name, config, theta0), t_max=t_max)
-    traj = get_backend(name).simulate(scene, Still(), settings)
-    return metrics.restitution_from_trajectory(traj, scene, config.n_impacts)
+    return measure_restitution(name, scene, config.theta0_fraction * scene.alpha,
+                               backend_settings(name, config), n_impacts=config.n_impacts)
 
 
 def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omega: float):
@@ -180,12 +155,11 @@ def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omeg
     the engine's own no-sliding bound for the largest pulse of the job (the
     high-frequency thresholds need peaks beyond the Fig. 5 points)."""
     settings = backend_settings(name, config)
-    module = get_backend(name)
-    friction = getattr(settings, "friction", None)
-    if friction is not None and hasattr(module, "required_friction"):
-        need = module.required_friction(scene, Pulse(a_max, omega))
-        if friction < 1.2 * need:  # 20 % above the bound, as the defaults keep
-            settings = dataclasses.replace(settings, friction=1.2 * need)
+    # Every engine has a friction (None: the engine's own default for each run).
+    if settings.friction is not None:
+        need = required_friction(scene, Pulse(a_max, omega))
+        if settings.friction < 1.2 * need:  # 20 % above the bound, as the defaults keep
+            settings = configure(name, settings, friction=1.2 * need)
     return settings
 
 

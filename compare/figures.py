@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
-from compare.commands._common import clean_nan
+from compare.jsonable import plain as clean_nan
 from scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",

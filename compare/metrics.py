@@ -1,19 +1,15 @@
 """Measurements between a backend and the analytic reference (no physics here).
 
-Three families, each returning a frozen dataclass with ``to_dict()`` that carries
+Trajectory comparison, returning a frozen dataclass with ``to_dict()`` that carries
 the provenance (backend, engine version, time step, settings, wall time):
 
 * :func:`compare_trajectories`: theta(t) and psi(t) of a backend against the
   reference on a common time grid; RMS and max errors normalised by ``alpha``
   (the static overturning angle) up to the first impact and over the whole
   common window; uplift, impact-time and peak-angle errors; verdict agreement.
-* :func:`restitution_from_trajectory`: per impact, the measured velocity ratio
-  against Eq. 20 (no pendulum) or Eq. 19 at the measured psi (with pendulum),
-  through :func:`analytic.equations.restitution_ratio`.
-* :func:`engine_threshold` / :func:`engine_jump_frequency`: an engine's first
-  overturning amplitude at one frequency, by a bisection bracketed with the
-  analytic threshold, and the frequency of a mode jump, by a bisection in Omega
-  at an amplitude between the two threshold levels of the jump.
+
+Restitution is measured in :mod:`compare.restitution` and overturning thresholds
+in :mod:`compare.thresholds` (both run backends).
 """
 from __future__ import annotations
 
@@ -24,13 +20,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from analytic import equations as eq
 from analytic.trajectory import Trajectory
 
-__all__ = ["Provenance", "TrajectoryComparison", "ImpactRestitution", "RestitutionComparison",
-           "ThresholdPoint", "JumpShift", "backend_version", "provenance_of", "settings_provenance",
-           "compare_trajectories", "restitution_from_trajectory", "engine_threshold",
-           "engine_jump_frequency", "common_grid_values"]
+from .jsonable import plain
+
+__all__ = ["Provenance", "TrajectoryComparison", "backend_version", "provenance_of",
+           "settings_provenance", "compare_trajectories", "common_grid_values"]
 
 # |theta| [rad] that counts as uplifted when comparing uplift times: the engines'
 # run monitor uses it (contact compliance tilts a resting engine trilith ~1e-6 rad),
@@ -43,18 +38,8 @@ GRID_DT = 1e-3
 
 
 def _plain(value):
-    """JSON-friendly copy of a settings value (dataclasses, tuples, numpy scalars)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return _plain(dataclasses.asdict(value))
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    if hasattr(value, "describe"):
-        return value.describe()
-    return value
+    """JSON-friendly copy of a settings value (see :func:`compare.jsonable.plain`)."""
+    return plain(value)
 
 
 @functools.lru_cache(maxsize=None)
@@ -274,82 +259,3 @@ def compare_trajectories(reference: Trajectory, test: Trajectory,
         peak_psi_reference=_peak(reference, "psi", t_end), peak_psi_test=_peak(test, "psi", t_end),
         status_reference=reference.verdict.status, status_test=test.verdict.status,
         mode_reference=reference.verdict.mode, mode_test=test.verdict.mode)
-
-
-# ---------------------------------------------------------------- restitution
-@dataclass(frozen=True)
-class ImpactRestitution:
-    """One impact: measured ``theta_dot+/theta_dot-`` against Eq. 19/20."""
-
-    t: float
-    side: int
-    psi: float
-    measured: float
-    predicted: float
-
-    @property
-    def rel_error(self) -> float:
-        return _rel(self.measured, self.predicted)
-
-    def to_dict(self) -> dict:
-        return {"t": self.t, "side": self.side, "psi": self.psi, "measured": self.measured,
-                "predicted": self.predicted, "rel_error": self.rel_error}
-
-
-@dataclass(frozen=True)
-class RestitutionComparison:
-    """Per-impact restitution of one free-rocking run and its worst relative error."""
-
-    lam: float
-    mu: float
-    gamma: float
-    equation: str
-    impacts: tuple[ImpactRestitution, ...]
-    provenance: Provenance
-
-    @property
-    def max_rel_error(self) -> float:
-        errs = [abs(i.rel_error) for i in self.impacts]
-        return max(errs) if errs else math.nan
-
-    def to_dict(self) -> dict:
-        return {"lam": self.lam, "mu": self.mu, "gamma": self.gamma, "equation": self.equation,
-                "impacts": [i.to_dict() for i in self.impacts],
-                "max_rel_error": self.max_rel_error, "provenance": self.provenance.to_dict()}
-
-
-def restitution_from_trajectory(traj: Trajectory, scene=None,
-                                n_impacts: int | None = None) -> RestitutionComparison:
-    """Measured velocity ratio at each impact event of ``traj`` against the model.
-
-    Eq. 20 without pendulum (``psi = 0``, ``gamma = 0``), Eq. 19 evaluated at the
-    impact's measured ``psi`` with it; the event ``side`` is the side entered.
-    """
-    scene = scene if scene is not None else traj.scene
-    if scene is None:
-        raise ValueError("scene must be given when the trajectory carries none")
-    if n_impacts is not None and n_impacts < 1:
-        raise ValueError(f"n_impacts must be >= 1, got {n_impacts!r}")
-    b, h, mu, gamma, j, _l, _g = scene.model_args()
-    rows = []
-    for ev in traj.impacts[:n_impacts]:
-        psi = ev.psi if (gamma > 0.0 and math.isfinite(ev.psi)) else 0.0
-        side = ev.side if ev.side in (-1, 1) else (1 if ev.theta_dot_after > 0 else -1)
-        rows.append(ImpactRestitution(float(ev.t), int(side), float(psi), float(ev.velocity_ratio),
-                                      eq.restitution_ratio(psi, side, b, h, mu, gamma, j)))
-    return RestitutionComparison(scene.lam, scene.mu, scene.gamma,
-                                 "Eq. 19" if gamma > 0.0 else "Eq. 20", tuple(rows),
-                                 provenance_of(traj))
-
-
-# ----------------------------------------------------------------- thresholds
-_THRESHOLD_NAMES = ("ThresholdPoint", "JumpShift", "engine_threshold", "engine_jump_frequency")
-
-
-def __getattr__(name: str):
-    """Overturning-threshold metrics live in :mod:`compare.thresholds` (they run
-    backends); re-exported here lazily to avoid a circular import."""
-    if name in _THRESHOLD_NAMES:
-        from . import thresholds
-        return getattr(thresholds, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -19,8 +19,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .campaign import POINTS  # noqa: E402
-from .commands._common import clean_nan  # noqa: E402
+from scenes import POINTS  # noqa: E402
+from .jsonable import plain as clean_nan  # noqa: E402
 from .metrics import _plain  # noqa: E402
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict"]

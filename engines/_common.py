@@ -215,8 +215,9 @@ class RunMonitor:
             self.verdict = Verdict("overturned", t, mode, len(self._impacts),
                                    f"{what} reached {self.threshold:.4g} rad ({self.criterion.kind})")
             return True
-        if t >= self.t_end_pulse and not self._parted:
-            if self.early_stop and self._survived_by_energy(theta, theta_dot, psi, psi_dot):
+        # The survival rules stop a run early; without early_stop it runs to t_max.
+        if self.early_stop and t >= self.t_end_pulse and not self._parted:
+            if self._survived_by_energy(theta, theta_dot, psi, psi_dot):
                 self.verdict = Verdict("survived", None, None, len(self._impacts),
                                        "energy below the overturning barrier after the pulse")
                 return True

@@ -95,12 +95,18 @@ class EngineSettings(RunOptions):
         (``benchmarks/bench_overhead.py``).
     monitor : MonitorSettings
         The shared stop and verdict thresholds.
+    friction : float or None
+        Coulomb coefficient at every contact, in (0, 1000]; None: the engine's
+        calibrated default (each engine documents its own and how it combines
+        two bodies' values).  Never below
+        :func:`~engines._common.required_friction` (rocking without sliding).
     """
 
     dt: float = 1e-4
     base_motion: str = "gravity"
     sample_every: int = 20
     monitor: MonitorSettings = field(default_factory=MonitorSettings)
+    friction: float | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -113,6 +119,8 @@ class EngineSettings(RunOptions):
                 or not 1 <= self.sample_every <= 10_000):
             raise ValueError(f"{owner}: sample_every must be an integer in [1, 10000], "
                              f"got {self.sample_every!r}")
+        if self.friction is not None:
+            check_real(owner, "friction", self.friction, 0.0, 1e3)
         if not isinstance(self.monitor, MonitorSettings):
             raise TypeError(f"{owner}: monitor must be a MonitorSettings, "
                             f"got {type(self.monitor).__name__}")

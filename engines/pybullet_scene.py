@@ -27,6 +27,7 @@ columns rock independently, which is the ``mu = 0`` rocking frame of Eq. 8.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import pybullet as pb
 
@@ -34,6 +35,9 @@ import pybullet as pb
 # the adapter, tests and benchmarks import it through this module.
 from engines.pybullet_bodies import (GROUND_MASS_FACTOR, NEGLIGIBLE_MASS_FRACTION,  # noqa: F401
                                      Bodies, build_scene, initial_poses)
+
+if TYPE_CHECKING:  # annotation only: the adapter imports this module
+    from engines.pybullet_engine import Settings
 
 __all__ = ["Bodies", "World", "build_scene", "initial_poses", "column_angle",
            "pendulum_state", "lintel_state", "effective_slop"]

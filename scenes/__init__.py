@@ -16,7 +16,10 @@ from pathlib import Path
 
 from analytic.parameters import Scene
 
-__all__ = ["load_scene", "scene_names", "scene_path", "SCENE_DIR"]
+from .points import PAPER_OUTCOMES, POINTS, point_pulse
+
+__all__ = ["load_scene", "scene_names", "scene_path", "SCENE_DIR", "POINTS", "PAPER_OUTCOMES",
+           "point_pulse"]
 
 SCENE_DIR = Path(__file__).resolve().parent / "data"
 

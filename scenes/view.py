@@ -56,15 +56,15 @@ def record_hint(scene_name: str, engine: str, amplitude: float, omega: float) ->
 
 
 def _pybullet_gui(scene: Scene, excitation, duration: float) -> bool:
-    """Run PyBullet in its own GUI window if its engine module provides
-    ``view(scene, excitation, settings, duration)``; return whether it did."""
+    """Run PyBullet in its own GUI window if it declares the ``'gui'`` capability;
+    return whether it did."""
+    from engines import supports
     from scenes.record import backend_settings, load_backend
 
-    module = load_backend("pybullet")
-    gui = getattr(module, "view", None)
-    if gui is None:
+    if not supports("pybullet", "gui"):
         return False
-    gui(scene, excitation, backend_settings(module, duration), duration=duration)
+    load_backend("pybullet").view(scene, excitation, backend_settings("pybullet", duration),
+                                  duration=duration)
     return True
 
 

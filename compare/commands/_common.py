@@ -10,6 +10,8 @@ from analytic.excitation import PULSE_KINDS, Pulse
 from analytic.parameters import Scene
 from scenes import load_scene
 
+from ..jsonable import plain
+
 SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel_height",
             "hinge_x", "depth", "g")
 
@@ -68,27 +70,9 @@ def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic") -
 
 
 def print_json(obj) -> None:
-    json.dump(obj, sys.stdout, indent=2, default=_json_default, allow_nan=False)
+    """``obj`` as strict JSON on stdout (:func:`compare.jsonable.plain`)."""
+    json.dump(plain(obj), sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")
 
 
-def _json_default(value):
-    import numpy as np
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if hasattr(value, "describe"):
-        return value.describe()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
-
-def clean_nan(obj):
-    """Replace non-finite floats by None so the JSON is strict."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: clean_nan(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [clean_nan(v) for v in obj]
-    return obj
+clean_nan = plain  # the one JSON cleaner (compare.jsonable); old name kept for callers

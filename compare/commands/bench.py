@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,11 +44,7 @@ def _engines(value: str) -> tuple[str, ...]:
 
 
 def _load_bench():
-    if not (ROOT / "benchmarks" / "bench_workprecision.py").is_file():
-        raise ValueError(f"benchmarks/ not found next to compare/ (looked in {ROOT}); "
-                         "trilith bench runs from a source checkout")
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
+    # benchmarks/ is a package of this project (pyproject), importable like compare/.
     return importlib.import_module("benchmarks.bench_workprecision")
 
 

@@ -33,7 +33,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from engines.restitution import DEFAULT_N_IMPACTS, measure_restitution
+    from compare.restitution import DEFAULT_N_IMPACTS, measure_restitution
 
     scene = scene_from_args(args)
     theta0 = args.theta0 if args.theta0 is not None else DEFAULT_THETA0_FRACTION * scene.alpha
@@ -47,10 +47,9 @@ def run(args: argparse.Namespace) -> int:
           f"mu={scene.mu:g} gamma={scene.gamma:g}, theta0={theta0:.4g} rad")
     print(f"{'#':>3} {'t [s]':>8} {'side':>4} {'psi [rad]':>10} {'measured':>10} "
           f"{'predicted':>10} {'rel.err':>9}   ({eq_name})")
-    for k in range(result.n_impacts):
-        print(f"{k + 1:>3} {result.times[k]:8.4f} {result.sides[k]:+4d} {result.psi[k]:10.4f} "
-              f"{result.measured[k]:10.6f} {result.predicted[k]:10.6f} "
-              f"{100 * result.rel_errors[k]:+8.3f}%")
+    for k, imp in enumerate(result.impacts):
+        print(f"{k + 1:>3} {imp.t:8.4f} {imp.side:+4d} {imp.psi:10.4f} "
+              f"{imp.measured:10.6f} {imp.predicted:10.6f} {100 * imp.rel_error:+8.3f}%")
     worst = result.max_rel_error
     print(f"max |rel. error| = {100 * worst:.3f} %" if math.isfinite(worst) else
           "no impacts measured")

@@ -34,19 +34,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
-def _settings(backend, criterion: str | None, t_max: float | None):
-    """The backend's default settings with ``criterion`` and ``t_max`` replaced
-    (every backend's Settings has both fields)."""
-    from analytic.trajectory import OverturnCriterion
+def _settings(name: str, criterion: str | None, t_max: float | None):
+    """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied."""
+    from engines import configure
     if t_max is not None and not (math.isfinite(t_max) and t_max > 0.0):
         raise ValueError(f"--t-max must be a finite time > 0 s, got {t_max!r}")
-    settings = backend.Settings()
-    changes = {}
-    if criterion is not None:  # keep the backend's topple angle
-        changes["criterion"] = OverturnCriterion(criterion, settings.criterion.topple_angle)
+    options = {}
+    if criterion is not None:  # configure keeps the backend's topple angle
+        options["criterion"] = criterion
     if t_max is not None:
-        changes["t_max"] = t_max
-    return dataclasses.replace(settings, **changes) if changes else settings
+        options["t_max"] = t_max
+    return configure(name, **options)
 
 
 def _plot(traj, scene, path: str) -> None:
@@ -81,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     pulse = pulse_from_args(args)
     backend = get_backend(args.engine)
-    settings = _settings(backend, args.criterion, args.t_max)
+    settings = _settings(args.engine, args.criterion, args.t_max)
     traj = backend.simulate(scene, pulse, settings)
     if args.csv:
         traj.to_csv(args.csv)
