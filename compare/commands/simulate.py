@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import math
 
 from ._common import (add_engine_arg, add_pulse_args, add_scene_args, clean_nan, print_json,
