@@ -32,14 +32,15 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 
 import numba
 
 from . import _fast_kernels as _k
 from .excitation import Pulse, SampledRecord
+from .options import RunOptions
 from .parameters import Scene
-from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from .trajectory import Event, Trajectory, Verdict
 
 __all__ = ["NAME", "version", "Settings", "simulate", "overturn_verdict", "verdict_for",
            "warm_up", "STATUS_NAMES"]
@@ -61,13 +62,14 @@ def version() -> str:
 
 
 @dataclass(frozen=True)
-class Settings:
-    """Numerical settings of the fast path."""
+class Settings(RunOptions):
+    """Numerical settings of the fast path.
 
-    # The shared overturning rule; 'topple' (1.5 rad) unless told otherwise.
-    criterion: OverturnCriterion = field(default_factory=OverturnCriterion)
-    # None = exact survival rules (see module docstring); a number = fixed horizon [s].
-    t_max: float | None = None
+    The shared run options are :class:`analytic.options.RunOptions`; the fast
+    path starts at rest and decides the verdict exactly, so ``theta0``, ``psi0``
+    must be 0 and ``early_stop`` True (use the ``analytic`` backend otherwise).
+    """
+
     # Undecided after pulse end + t_cap [s]: far longer than any decaying rocking.
     t_cap: float = 120.0
     # DP5 tolerances: overturning thresholds agree with the rtol 1e-10 accurate
@@ -85,12 +87,11 @@ class Settings:
     rest_step_fraction: float = 0.01
 
     def __post_init__(self) -> None:
-        if not isinstance(self.criterion, OverturnCriterion):
-            raise ValueError("criterion must be an OverturnCriterion")
-        if self.t_max is not None and not (isinstance(self.t_max, (int, float))
-                                           and math.isfinite(self.t_max)
-                                           and 0.0 < self.t_max <= 1e5):
-            raise ValueError(f"t_max must be None or a time in (0, 1e5] s, got {self.t_max!r}")
+        super().__post_init__()
+        if self.theta0 != 0.0 or self.psi0 != 0.0 or not self.early_stop:
+            raise ValueError("analytic-fast starts at rest and stops when decided: theta0 and "
+                             "psi0 must be 0 and early_stop True (the 'analytic' backend "
+                             "takes any initial state)")
         for name, lo, hi in (("t_cap", 0.0, 1e5), ("rtol", 1e-14, 1e-2),
                              ("atol", 1e-16, 1e-2), ("rest_velocity", 0.0, 1.0),
                              ("sample_dt", 1e-6, 10.0), ("rest_step_fraction", 0.0, 0.25)):
@@ -99,11 +100,6 @@ class Settings:
                 raise ValueError(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps >= 100):
             raise ValueError(f"max_steps must be an integer >= 100, got {self.max_steps!r}")
-
-    def describe(self) -> dict:
-        out = asdict(self)
-        out["criterion"] = self.criterion.describe()
-        return out
 
 
 def _kernel_args(scene: Scene, pulse: Pulse, settings: Settings) -> tuple:

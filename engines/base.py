@@ -165,17 +165,15 @@ def simulate_world(name: str, make_world: Callable[[], World], scene, excitation
     monitor = RunMonitor(scene, excitation, settings)
     world = make_world()
     try:
-        t = 0.0
-        *state, problem = world.sample()
-        decided = monitor.record(t, *state)
-        while not decided:
-            world.advance(settings.sample_every)
+        while True:
             t = world.step_index * settings.dt
             *state, problem = world.sample()
             if problem is not None:
                 monitor.mark_unstable(t, problem)
                 break
-            decided = monitor.record(t, *state)
+            if monitor.record(t, *state):
+                break
+            world.advance(settings.sample_every)
         diagnostics = dict(world.diag, steps=world.step_index)
     finally:
         world.close()

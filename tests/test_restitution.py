@@ -21,9 +21,7 @@ from analytic.parameters import Scene
 from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
 from compare.cli import main
 from engines import BACKENDS
-from engines._common import MonitorSettings
-from engines.restitution import (analytic_impact_times,
-                                 measure_restitution)
+from compare.restitution import analytic_impact_times, measure_restitution
 
 
 # ------------------------------------------------------ analytic run length
@@ -58,19 +56,15 @@ def test_analytic_impact_times_match_energy_quadrature():
 
 
 # ---------------------------------------------------------- fake backend
-def _fake_backend(monkeypatch, impacts, with_theta0=True, with_monitor=True, with_psi0=True):
-    """Register a backend 'fake' that records the settings it receives and returns
+def _fake_backend(monkeypatch, impacts, tilt=True):
+    """Register a backend 'fake' (the contract: NAME, CAPABILITIES, a RunOptions
+    Settings, simulate, version) that records the settings it receives and returns
     ``impacts`` (a list of Events) as its measured impacts."""
-    fields = [("t_max", float | None, None)]
-    if with_theta0:
-        fields.append(("theta0", float, 0.0))
-    if with_psi0:
-        fields.append(("psi0", float, 0.0))
-    if with_monitor:
-        fields.append(("monitor", MonitorSettings, MonitorSettings()))
-    settings_cls = dataclasses.make_dataclass("Settings", fields, frozen=True)
+    from analytic.options import RunOptions
+    settings_cls = dataclasses.make_dataclass("Settings", [], bases=(RunOptions,), frozen=True)
     module = types.ModuleType("fake_backend")
     module.NAME = "fake"
+    module.CAPABILITIES = frozenset({"trajectory"} | ({"initial_tilt"} if tilt else set()))
     module.Settings = settings_cls
     module.calls = []
 
@@ -102,16 +96,16 @@ def test_plumbing_with_fake_backend(monkeypatch, fig5):
     res = measure_restitution("fake", fig5, theta0, n_impacts=2, psi0=0.1)
     ((scene, excitation, settings),) = fake.calls
     assert settings.theta0 == theta0 and settings.psi0 == 0.1
-    assert settings.monitor.energy_rule is False  # free rocking must run through impacts
+    assert settings.early_stop is False  # free rocking must run through impacts
     times = analytic_impact_times(fig5, theta0, 0.1, 3)
     assert times[1] < settings.t_max < times[2]  # stops between impacts 2 and 3
     assert excitation.end_time == 0.0 and excitation.acceleration(0.3) == 0.0
     # Only the requested impacts; Eq. 19 at each impact's own psi and side.
     assert res.n_impacts == 2 and res.complete
-    assert res.measured == pytest.approx([0.9, 0.9])
+    assert [i.measured for i in res.impacts] == pytest.approx([0.9, 0.9])
     expected = [eq.restitution_ratio(p, s, b, h, mu, gamma, j) for p, s in zip(psis, (-1, 1))]
-    assert res.predicted == pytest.approx(expected, rel=1e-14)
-    assert res.rel_errors == pytest.approx([0.9 / x - 1 for x in expected])
+    assert [i.predicted for i in res.impacts] == pytest.approx(expected, rel=1e-14)
+    assert [i.rel_error for i in res.impacts] == pytest.approx([0.9 / x - 1 for x in expected])
     assert res.max_rel_error == pytest.approx(max(abs(0.9 / x - 1) for x in expected))
     assert res.engine == "fake" and res.version == "fake 1.0"
 
@@ -120,7 +114,7 @@ def test_no_pendulum_uses_eq20_whatever_psi_the_backend_reports(monkeypatch, fig
     impacts = [Event("impact", 0.5, -1, theta_dot_before=0.3, theta_dot_after=0.27, psi=0.7)]
     _fake_backend(monkeypatch, impacts)
     res = measure_restitution("fake", fig5_bare, 0.1, n_impacts=1)
-    assert res.predicted == (eq.restitution_ratio(0.0, -1, *fig5_bare.model_args()[:5]),)
+    assert res.impacts[0].predicted == eq.restitution_ratio(0.0, -1, *fig5_bare.model_args()[:5])
 
 
 def test_incomplete_and_empty_results(monkeypatch, fig5):
@@ -129,22 +123,14 @@ def test_incomplete_and_empty_results(monkeypatch, fig5):
     assert not res.complete and res.n_impacts == 0
     assert math.isnan(res.max_rel_error)
     d = res.to_dict()
-    assert d["n_impacts"] == 0 and d["measured"] == [] and d["complete"] is False
+    assert d["n_impacts"] == 0 and d["impacts"] == [] and d["complete"] is False
 
 
-def test_backend_without_free_rocking_settings(monkeypatch, fig5):
-    fake = _fake_backend(monkeypatch, [], with_theta0=False)
-    with pytest.raises(ValueError, match="theta0"):
+def test_backend_without_initial_tilt_is_refused(monkeypatch, fig5):
+    fake = _fake_backend(monkeypatch, [], tilt=False)
+    with pytest.raises(ValueError, match="initial_tilt"):
         measure_restitution("fake", fig5, 0.1)
     assert fake.calls == []
-
-
-def test_psi0_needs_a_psi0_setting(monkeypatch, fig5):
-    fake = _fake_backend(monkeypatch, [], with_psi0=False)
-    with pytest.raises(ValueError, match="psi0"):
-        measure_restitution("fake", fig5, 0.1, psi0=0.2)
-    measure_restitution("fake", fig5, 0.1)  # psi0 = 0 is fine without the field
-    assert len(fake.calls) == 1
 
 
 @pytest.mark.parametrize("theta0, kwargs, match", [
@@ -155,7 +141,7 @@ def test_psi0_needs_a_psi0_setting(monkeypatch, fig5):
 ])
 def test_bad_input_raises_before_simulating(monkeypatch, fig5, theta0, kwargs, match):
     fake = _fake_backend(monkeypatch, [])
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((ValueError, TypeError), match=match):
         measure_restitution("fake", fig5, theta0, **kwargs)
     assert fake.calls == []
 
@@ -170,9 +156,9 @@ def test_analytic_backend_reproduces_eq19(fig5):
     # The accurate analytic path applies Eq. 19/21 itself: ratio errors are at
     # the level of its event location (impact at theta = 0 to ~1e-12).
     res = measure_restitution("analytic", fig5, 0.5 * fig5.alpha, n_impacts=4)
-    assert res.n_impacts == 4 and res.sides == (-1, 1, -1, 1)
+    assert res.n_impacts == 4 and [i.side for i in res.impacts] == [-1, 1, -1, 1]
     assert res.max_rel_error < 1e-9
-    assert res.times == pytest.approx(analytic_impact_times(fig5, 0.5 * fig5.alpha, 0.0, 4),
+    assert [i.t for i in res.impacts] == pytest.approx(analytic_impact_times(fig5, 0.5 * fig5.alpha, 0.0, 4),
                                       abs=1e-6)
 
 
@@ -181,9 +167,9 @@ def test_cli_json(capsys):
                  "--n-impacts", "1", "--json"])
     assert code == 0
     out = json.loads(capsys.readouterr().out)
-    for key in ("predicted", "measured", "max_rel_error", "engine", "version", "settings"):
+    for key in ("impacts", "equation", "max_rel_error", "engine", "version", "settings"):
         assert key in out
-    assert out["engine"] == "pymunk" and len(out["measured"]) == 1
+    assert out["engine"] == "pymunk" and len(out["impacts"]) == 1
     assert out["settings"]["theta0"] == pytest.approx(0.5 * math.atan(1 / 4))
     # the engine contract's 0.5 % (see tests/test_pymunk_engine.py)
     assert out["max_rel_error"] < 5e-3
