@@ -55,6 +55,13 @@ class RunOptions:
         needs only the verdict).  False keeps running (until ``t_max``, rest or
         the backend's cap): free-rocking experiments need the impacts after the
         energy has fallen below the overturning barrier.
+    verdict_only : bool
+        Also stop as soon as an overturn is certain (default False): after the
+        pulse, past ``alpha`` with the energy below the overturning barrier the
+        trilith can never return (the same exact rule as the analytic survival
+        rule, mirrored).  The verdict's time is then when it became certain, not
+        when the columns topple, and the trajectory ends there: for threshold
+        probes, which need only the verdict.
 
     Examples
     --------
@@ -72,6 +79,7 @@ class RunOptions:
     theta0: float = 0.0
     psi0: float = 0.0
     early_stop: bool = True
+    verdict_only: bool = False
 
     def __post_init__(self) -> None:
         owner = type(self).__name__
@@ -83,8 +91,10 @@ class RunOptions:
         check_real(owner, "theta0", self.theta0, -0.5 * math.pi, 0.5 * math.pi, lo_open=True,
                    hi_open=True)
         check_real(owner, "psi0", self.psi0, -math.pi, math.pi, lo_open=False)
-        if not isinstance(self.early_stop, bool):
-            raise TypeError(f"{owner}: early_stop must be True or False, got {self.early_stop!r}")
+        for name in ("early_stop", "verdict_only"):
+            if not isinstance(getattr(self, name), bool):
+                raise TypeError(f"{owner}: {name} must be True or False, "
+                                f"got {getattr(self, name)!r}")
 
     def check_scene(self, scene) -> None:
         """Checks that need the scene (before any stepping): ``|theta0| < alpha``."""

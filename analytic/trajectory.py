@@ -16,9 +16,9 @@ __all__ = ["Event", "Verdict", "Trajectory", "OverturnCriterion", "CRITERIA",
            "STATUSES", "MODES"]
 
 CRITERIA = ("topple", "alpha")
-STATUSES = ("overturned", "survived", "unstable", "undecided")
+STATUSES = ("overturned", "survived", "collapsed", "unstable", "undecided")
 MODES = ("no-impact", "after-impact")
-EVENT_KINDS = ("uplift", "impact", "rest", "overturn", "unstable")
+EVENT_KINDS = ("uplift", "impact", "rest", "overturn", "collapse", "unstable")
 
 # Default topple angle: just short of pi/2, where a column lies on its side.
 # Engines with compliant contacts cannot reach pi/2 exactly; 1.5 rad (86 deg) is
@@ -94,8 +94,12 @@ class Event:
 class Verdict:
     """Outcome of a run.
 
-    ``status``: 'overturned', 'survived', 'unstable' (the numerics blew up) or
-    'undecided' (``t_max`` reached before the outcome was certain).
+    ``status``: 'overturned', 'survived', 'collapsed' (an engine's bodies stopped
+    being the model's mechanism before the outcome was certain: columns out of
+    step, a pivot sliding, the lintel rotating on the columns; ``reason`` names
+    the diagnostic and its value), 'unstable' (the numerics blew up) or
+    'undecided' (``t_max`` reached before the outcome was certain).  Only
+    'overturned' counts as overturning.
     ``mode``: 'no-impact' or 'after-impact' when overturned, else None.
     """
 

@@ -131,6 +131,9 @@ def restitution_from_trajectory(traj: Trajectory, scene=None,
     scene = scene if scene is not None else traj.scene
     if scene is None:
         raise ValueError("scene must be given when the trajectory carries none")
+    if n_impacts is not None and (isinstance(n_impacts, bool) or not isinstance(n_impacts, int)
+                                  or n_impacts < 1):
+        raise ValueError(f"n_impacts must be None or an integer >= 1, got {n_impacts!r}")
     b, h, mu, gamma, j, _l, _g = scene.model_args()
     rows = []
     for ev in traj.impacts[:n_impacts]:

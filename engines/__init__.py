@@ -54,7 +54,13 @@ def get_backend(name: str) -> ModuleType:
     """The backend module registered under ``name``; ``ValueError`` if unknown."""
     if not isinstance(name, str) or name not in BACKENDS:
         raise ValueError(f"unknown engine {name!r}; allowed: {', '.join(BACKENDS)}")
-    return importlib.import_module(BACKENDS[name])
+    try:
+        return importlib.import_module(BACKENDS[name])
+    except ModuleNotFoundError as exc:
+        if exc.name and BACKENDS[name].startswith(exc.name):
+            raise ValueError(f"backend {name!r} is not available in this checkout "
+                             f"(module {BACKENDS[name]} is missing)") from None
+        raise
 
 
 def supports(name: str, capability: str) -> bool:

@@ -47,14 +47,22 @@ class MonitorSettings:
         pendulum period is added when there is a pendulum).
     t_cap : s after the pulse end before an undecided run stops ('undecided').
     max_mismatch : largest ``|theta_left - theta_right|`` [in units of alpha]
-        while ``|theta| < alpha``, until the trilith first passes ``alpha``: the
-        lintel ties the columns together (engines keep them within ~1e-5 rad),
-        so a larger mismatch means the engine broke the linkage (columns
-        creeping apart, lintel sliding off): 'unstable'.  Once past ``alpha``
-        the model's own vertical reaction turns negative during the fall
-        (``analytic.reactions``): real contacts let the columns hop and part,
-        which is the collapse, not a broken engine (a falling column may even
-        swing back below ``alpha`` while its neighbour falls on).
+        before the outcome is certain.  0.25: the lintel ties the columns
+        together (engines keep them within ~1e-5 rad while the model is valid),
+        so a larger mismatch means the frame the model describes no longer
+        exists (columns parting, lintel thrown off): 'collapsed', never
+        'overturned' or 'survived'.  Once an overturn is certain (past
+        ``alpha`` after the pulse with the energy below the barrier) the
+        columns may part in the fall: that is the overturn.
+    max_sliding : largest pivot sliding [in units of the column width ``b``]
+        while both columns stand (``|theta| < alpha``).  0.01 (6 mm at fig5):
+        the engines' pivots slide < 1e-5 m at the paper's points A-D (docs/
+        engine-trust.md); a slide of 1 % of ``b`` changes the model's lever arm
+        by 1 %.  Beyond it: 'collapsed'.
+    max_lintel_rotation : largest lintel rotation [in units of alpha] while both
+        columns stand.  0.1: the model's lintel translates without rotating (it
+        rests on both column tops); engines keep it within ~1e-5 rad at A-D.
+        Beyond it the lintel rocks on the columns: 'collapsed'.
 
     Whether the run stops as soon as the verdict is certain is the run option
     ``early_stop`` (:class:`analytic.options.RunOptions`), not a monitor setting.
@@ -67,12 +75,15 @@ class MonitorSettings:
     rest_hold: float = 0.5
     t_cap: float = 60.0
     max_mismatch: float = 0.25
+    max_sliding: float = 0.01
+    max_lintel_rotation: float = 0.1
 
     def __post_init__(self) -> None:
         for name, lo, hi in (("uplift_angle", 0.0, 0.1), ("impact_window", 0.0, 0.5),
                              ("rest_angle", 0.0, 0.1), ("rest_rate", 0.0, 1.0),
                              ("rest_hold", 0.0, 1e4), ("t_cap", 0.0, 1e5),
-                             ("max_mismatch", 0.0, 10.0)):
+                             ("max_mismatch", 0.0, 10.0), ("max_sliding", 0.0, 10.0),
+                             ("max_lintel_rotation", 0.0, 10.0)):
             check_real("MonitorSettings", name, getattr(self, name), lo, hi)
 
 
@@ -155,6 +166,8 @@ class RunMonitor:
         self.criterion = criterion = options.criterion
         self.t_max = t_max = options.t_max
         self.early_stop = options.early_stop
+        self.verdict_only = options.verdict_only
+        self.certain_at: float | None = None  # when an overturn became certain
         self.cfg = options.monitor
         self.args = scene.model_args()
         self.threshold = criterion.threshold(scene.alpha)
@@ -191,12 +204,13 @@ class RunMonitor:
         steepest = max(abs(theta), abs(theta_left), abs(theta_right))
         self._past_alpha = self._past_alpha or steepest >= self._alpha
         if self._linked and mismatch > self._mismatch_limit:
-            if not self._past_alpha:
-                self.mark_unstable(t, f"columns out of step by {mismatch:.3g} rad "
-                                      f"(> {self.cfg.max_mismatch:g} alpha): linkage broken")
+            if self.certain_at is None:
+                self.mark_collapsed(t, f"columns out of step by {mismatch:.3g} rad "
+                                       f"(> {self.cfg.max_mismatch:g} alpha) before the outcome "
+                                       f"was certain: the frame of the model no longer exists")
                 return True
-            # Parted while collapsing: the mean angle no longer describes the
-            # trilith, so the survival rules below must not read it.
+            # Parted in a certain fall: the mean angle no longer describes the
+            # trilith, so the rules below must not read it.
             self._parted = True
         cfg = self.cfg
         # Parted columns: a sign change of their mean angle is no impact.
@@ -215,6 +229,15 @@ class RunMonitor:
             self.verdict = Verdict("overturned", t, mode, len(self._impacts),
                                    f"{what} reached {self.threshold:.4g} rad ({self.criterion.kind})")
             return True
+        if (self.certain_at is None and t >= self.t_end_pulse and not self._parted
+                and self._overturn_certain(theta, theta_dot, psi, psi_dot)):
+            self.certain_at = t
+            if self.verdict_only:
+                mode = "after-impact" if self._impacts else "no-impact"
+                self.verdict = Verdict("overturned", t, mode, len(self._impacts),
+                                       "certain: past alpha after the pulse with the energy "
+                                       "below the overturning barrier")
+                return True
         # The survival rules stop a run early; without early_stop it runs to t_max.
         if self.early_stop and t >= self.t_end_pulse and not self._parted:
             if self._survived_by_energy(theta, theta_dot, psi, psi_dot):
@@ -242,6 +265,40 @@ class RunMonitor:
 
     def mark_unstable(self, t: float, reason: str) -> None:
         self.verdict = Verdict("unstable", t, None, len(self._impacts), reason)
+
+    def mark_collapsed(self, t: float, reason: str) -> None:
+        self.verdict = Verdict("collapsed", t, None, len(self._impacts), reason)
+
+    def check_frame(self, t: float, diag: dict) -> bool:
+        """Read an engine world's contact diagnostics (taken while both columns
+        stand); True, with the verdict 'collapsed', when the bodies stopped being
+        the model's mechanism before the outcome was certain."""
+        if self.certain_at is not None or self.verdict is not None:
+            return False
+        cfg, b = self.cfg, self.scene.b
+        slide = diag.get("pivot_sliding_max", 0.0)
+        if slide > cfg.max_sliding * b:
+            self.mark_collapsed(t, f"a pivot slid {slide:.3g} m (> {cfg.max_sliding:g} b) "
+                                   f"while the columns stood: the model's pivots do not slide")
+            return True
+        rot = diag.get("lintel_rotation_max", 0.0)
+        if rot > cfg.max_lintel_rotation * self._alpha:
+            self.mark_collapsed(t, f"the lintel rotated {rot:.3g} rad "
+                                   f"(> {cfg.max_lintel_rotation:g} alpha) on the columns: the "
+                                   f"model's lintel translates")
+            return True
+        return False
+
+    def _overturn_certain(self, theta, theta_dot, psi, psi_dot) -> bool:
+        """After the pulse (inertial base, energy never increases): past ``alpha``
+        with the energy below the barrier the trilith cannot return across
+        ``alpha``, where the potential has its top: it falls."""
+        if abs(theta) <= self._alpha:
+            return False
+        b, h, mu, gamma, j, l, g = self.args
+        side = 1 if theta > 0 else -1
+        return eq.energy(theta, theta_dot, psi, psi_dot, side, b, h, mu, gamma, j, l, g) \
+            < self.barrier
 
     def _survived_by_energy(self, theta, theta_dot, psi, psi_dot) -> bool:
         # Only inside the potential well: past alpha the trilith falls with any energy.
@@ -294,9 +351,9 @@ class RunMonitor:
         if self.verdict.overturned:
             impacts = [e for e in impacts if e.t <= self.verdict.time]
         events.extend(impacts)
-        if self.verdict.status in ("overturned", "unstable"):
-            events.append(Event("overturn" if self.verdict.overturned else "unstable",
-                                self.verdict.time))
+        kinds = {"overturned": "overturn", "collapsed": "collapse", "unstable": "unstable"}
+        if self.verdict.status in kinds:
+            events.append(Event(kinds[self.verdict.status], self.verdict.time))
         events.sort(key=lambda e: e.t)
         diagnostics = dict(diagnostics)
         diagnostics.setdefault("column_mismatch_max", self.mismatch)

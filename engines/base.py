@@ -171,7 +171,7 @@ def simulate_world(name: str, make_world: Callable[[], World], scene, excitation
             if problem is not None:
                 monitor.mark_unstable(t, problem)
                 break
-            if monitor.record(t, *state):
+            if monitor.record(t, *state) or monitor.check_frame(t, world.diag):
                 break
             world.advance(settings.sample_every)
         diagnostics = dict(world.diag, steps=world.step_index)
