@@ -37,10 +37,13 @@ def overturns(backend: str, scene, omega: float, amplitude: float, settings=None
               kind: str = "sine") -> tuple[bool, str, str | None]:
     """One run: ``(overturned, status, mode)`` of ``backend`` under a pulse.
 
-    'unstable' and 'undecided' runs count as not overturned; their status is
-    returned so callers can flag them.
+    'collapsed', 'unstable' and 'undecided' runs count as not overturned; their
+    status is returned so callers can flag them.  The run stops as soon as the
+    verdict is certain (``verdict_only``).
     """
-    from engines import get_backend
+    from engines import configure, get_backend
+    # Only the verdict is needed: stop as soon as it is certain, overturning included.
+    settings = configure(backend, settings, verdict_only=True)
     traj = get_backend(backend).simulate(scene, Pulse(amplitude, omega, kind), settings)
     return traj.overturned, traj.verdict.status, traj.verdict.mode
 
@@ -65,6 +68,20 @@ class ThresholdPoint:
     irregular_runs: int
     rel_tol: float
     provenance: Provenance
+    probes: tuple = ()  # (amplitude, status, mode) of every run, in order
+
+    @property
+    def a_survives(self) -> float:
+        """Highest amplitude below ``a_engine`` seen to *survive* (NaN if none:
+        e.g. only collapsed runs below it)."""
+        below = [a for a, st, _ in self.probes if st == "survived" and a < self.a_engine]
+        return max(below) if below else math.nan
+
+    @property
+    def collapsed_below(self) -> bool:
+        """True when a run below ``a_engine`` ended 'collapsed': the engine's frame
+        broke before it overturned (the threshold is then that of a broken frame)."""
+        return any(st == "collapsed" and a < self.a_engine for a, st, _ in self.probes)
 
     @property
     def bracketed(self) -> bool:
@@ -78,7 +95,9 @@ class ThresholdPoint:
     def to_dict(self) -> dict:
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out.update(provenance=self.provenance.to_dict(), rel_error=self.rel_error,
-                   bracketed=self.bracketed)
+                   bracketed=self.bracketed, a_survives=self.a_survives,
+                   collapsed_below=self.collapsed_below,
+                   probes=[list(p) for p in self.probes])
         return out
 
 
@@ -108,6 +127,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     t0 = time.perf_counter()
     runs = irregular = 0
     modes: dict[float, str | None] = {}
+    probes: list[tuple[float, str, str | None]] = []
 
     def probe(a: float) -> bool:
         nonlocal runs, irregular
@@ -115,6 +135,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         over, status, mode = overturns(backend, scene, omega, a, settings, kind)
         irregular += status not in ("overturned", "survived")
         modes[a] = mode
+        probes.append((a, status, mode))
         return over
 
     lo, hi = a_ref * (1.0 - rel_bracket), a_ref * (1.0 + rel_bracket)
@@ -142,7 +163,8 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     return ThresholdPoint(omega, kind, a_ref, a_eng, lo, mode_reference,
                           modes.get(a_eng) if math.isfinite(a_eng) else None, runs, irregular,
                           rel_tol, settings_provenance(backend, settings,
-                                                       time.perf_counter() - t0))
+                                                       time.perf_counter() - t0),
+                          tuple(probes))
 
 
 @dataclass(frozen=True)
