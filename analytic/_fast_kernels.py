@@ -1,15 +1,12 @@
-"""Numba kernels of the fast analytic path: Dormand-Prince 5(4) with dense output
-and event location, over the phases REST / ROCK(+1) / ROCK(-1).
+"""Numba kernels of the fast analytic path: one run over the phases REST /
+ROCK(+1) / ROCK(-1) with Dormand-Prince 5(4), dense output and event location,
+and the verdict-only entry points (one amplitude, or many in one compiled loop).
 
-The physics is *not* re-typed here: the scalar functions of
-:mod:`analytic.equations` (Eq. 1, 8, A.1, 9, 19, 21 corrected) are compiled as they
-are with ``numba.njit``.  This module only holds the integrator, the event logic
-and the phase semantics, which are the same as the accurate path's
-(``analytic/simulate.py``, see ``analytic/fast.py`` for the list).
-
-Everything is compiled once per process (``cache=True`` also keeps the machine
-code on disk between processes).  The verdict-only entry point allocates a few
-small arrays per *call* and nothing per step.
+The step-level pieces (compiled equations, one DP step, event location) live in
+:mod:`analytic._fast_steps`; the phase semantics are the accurate path's
+(``analytic/simulate.py``, see ``analytic/fast.py`` for the list).  The
+verdict-only entry points allocate a few small arrays per *call* and nothing per
+step.
 """
 from __future__ import annotations
 
@@ -18,176 +15,57 @@ import math
 import numpy as np
 from numba import njit
 
-from . import equations as _eq
-from ._fast_numerics import (_A, _B, _C, _E, _MAX_FACTOR, _MIN_FACTOR, _ROOT_ITER,
-                             _ROOT_XTOL, _SAFETY, _dense, _ellipk, _push, _push_event,
-                             _samples_until)
-
-# --- the equations, compiled from the single source -------------------------------
-_rock = njit(cache=True)(_eq.rocking_accelerations)
-_rest_acc = njit(cache=True)(_eq.rest_pendulum_acceleration)
-_margin = njit(cache=True)(_eq.uplift_margin)
-_impact = njit(cache=True)(_eq.impact_velocities)
-_energy = njit(cache=True)(_eq.energy)
-_rest_energy = njit(cache=True)(_eq.rest_energy)
-_barrier = njit(cache=True)(_eq.overturn_energy_barrier)
+from ._fast_numerics import (_MAX_FACTOR, _MIN_FACTOR, _SAFETY, _dense, _ellipk,  # noqa: F401
+                             _push, _push_event, _samples_until)
+from ._fast_steps import (KIND_COSINE, KIND_SINE, _barrier, _deriv, _dp_step,  # noqa: F401
+                          _energy, _impact, _locate, _margin, _pendulum_period, _rest_energy,
+                          _xg)
 
 # --- codes shared with analytic/fast.py --------------------------------------------
 ST_OVERTURNED, ST_SURVIVED, ST_UNSTABLE, ST_UNDECIDED = 0, 1, 2, 3
 EV_UPLIFT, EV_IMPACT, EV_REST, EV_OVERTURN, EV_UNSTABLE = 0, 1, 2, 3, 4
 (R_OVERTURN, R_BARRIER, R_REST_NO_PENDULUM, R_PENDULUM_PERIOD, R_T_MAX, R_T_CAP,
- R_NONFINITE, R_STEP_UNDERFLOW, R_STEP_BUDGET) = range(9)
-KIND_SINE, KIND_COSINE = 0, 1
-
-@njit(cache=True)
-def _xg(t, on, amp, omega, kind):
-    """Pulse acceleration (Eq. 22/23); ``on`` is False after the pulse end."""
-    if not on:
-        return 0.0
-    if kind == KIND_COSINE:
-        return amp * math.cos(omega * t)
-    return amp * math.sin(omega * t)
+ R_NONFINITE, R_STEP_UNDERFLOW, R_STEP_BUDGET, R_CERTAIN) = range(10)
 
 
 @njit(cache=True)
-def _deriv(phase, y, xg, out, b, h, mu, gamma, j, l, g):
-    """Right-hand side in phase ``phase`` (0 = REST, +1/-1 = ROCK about that side)."""
-    if phase == 0:
-        out[0] = 0.0
-        out[1] = 0.0
-        if gamma == 0.0:
-            out[2] = 0.0
-            out[3] = 0.0
-        else:
-            out[2] = y[3]
-            out[3] = _rest_acc(y[2], xg, l, g)
-        return
-    tdd, pdd = _rock(y[0], y[1], y[2], y[3], xg, float(phase), b, h, mu, gamma, j, l, g)
-    out[0] = y[1]
-    out[1] = tdd
-    out[2] = y[3]
-    out[3] = pdd
+def overturn_certain(theta, theta_dot, energy, phase, barrier, alpha, b, h, mu, gamma, l, g):
+    """True when, after the pulse (inertial base), the run will reach any
+    threshold in ``(alpha, pi/2]`` whatever happens next (proof in
+    ``docs/overturn-maps.md``, "Early exit"):
 
-
-@njit(cache=True)
-def _dp_step(phase, t, t1, y, hstep, on, amp, omega, pkind, rtol, atol, k, ystage, ynew, f,
-             b, h, mu, gamma, j, l, g):
-    """One Dormand-Prince 5(4) step from ``(t, y)`` with ``k[0] = f(t, y)``; fills
-    ``k[1:7]`` (``k[6] = f(t1, ynew)``, first-same-as-last) and ``ynew``.  Returns
-    the RMS error norm (``<= 1`` accepts) and whether ``ynew`` is finite."""
-    for s in range(1, 6):
-        for c in range(4):
-            acc = 0.0
-            for i in range(s):
-                acc += _A[s, i] * k[i, c]
-            ystage[c] = y[c] + hstep * acc
-        _deriv(phase, ystage, _xg(t + _C[s] * hstep, on, amp, omega, pkind), f, b, h, mu,
-               gamma, j, l, g)
-        for c in range(4):
-            k[s, c] = f[c]
-    for c in range(4):
-        acc = 0.0
-        for i in range(6):
-            acc += _B[i] * k[i, c]
-        ynew[c] = y[c] + hstep * acc
-    _deriv(phase, ynew, _xg(t1, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
-    for c in range(4):
-        k[6, c] = f[c]
-    err = 0.0
-    finite = True
-    for c in range(4):
-        acc = 0.0
-        for i in range(7):
-            acc += _E[i] * k[i, c]
-        sc = atol + rtol * max(abs(y[c]), abs(ynew[c]))
-        e = hstep * acc / sc
-        err += e * e
-        if not math.isfinite(ynew[c]):
-            finite = False
-    return math.sqrt(err / 4.0), finite
-
-
-@njit(cache=True)
-def _event_value(kind, side, yx, t, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g):
-    """Event functions; an event happens where the value becomes <= 0.
-
-    kind 0: uplift margin about ``side`` (REST);  kind 1: ``side*theta`` (impact);
-    kind 2: ``thr - side*theta`` (overturn).
+    * past ``alpha`` (``s*theta > alpha``) with ``energy < barrier``: the frame
+      cannot come back through ``alpha`` (the potential there is >= barrier),
+      and it cannot stay in ``(alpha, pi/2]`` either: the momentum conjugate to
+      the common shift of ``theta`` and ``psi`` (the kinetic energy depends on
+      ``theta - psi`` only) grows at a rate bounded below while the velocities
+      stay bounded, provided ``M R >= 2 gamma l`` (checked here);
+    * without pendulum, past ``alpha`` moving outward: ``theta_ddot > 0`` there.
     """
-    if kind == 0:
-        xg = _xg(t, on, amp, omega, pkind)
-        return _margin(yx[2], yx[3], xg, float(side), b, h, mu, gamma, l, g)
-    if kind == 1:
-        return side * yx[0]
-    return thr - side * yx[0]
+    if phase == 0:
+        return False
+    st = phase * theta
+    if st <= alpha:
+        return False
+    if gamma == 0.0 and phase * theta_dot >= 0.0:
+        return True
+    big_m = 1.0 + mu + gamma
+    return energy < barrier and big_m * math.hypot(b, h) >= 2.0 * gamma * l
 
 
 @njit(cache=True)
-def _locate(kind, side, y0, k, t0, hstep, on, amp, omega, pkind, thr, b, h, mu, gamma,
-            l, g, ytmp):
-    """First root in (0, 1] of an event function on the dense output, given
-    value > 0 at x = 0 and <= 0 at x = 1.  Illinois regula falsi; returns the
-    right end of the final bracket (where the event condition holds)."""
-    xa = 0.0
-    _dense(y0, k, hstep, 0.0, ytmp)
-    fa = _event_value(kind, side, ytmp, t0, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g)
-    xb = 1.0
-    _dense(y0, k, hstep, 1.0, ytmp)
-    fb = _event_value(kind, side, ytmp, t0 + hstep, on, amp, omega, pkind, thr, b, h, mu,
-                      gamma, l, g)
-    last = 0
-    for _ in range(_ROOT_ITER):
-        if xb - xa <= _ROOT_XTOL:
-            break
-        if fa != fb:
-            xm = xb - fb * (xb - xa) / (fb - fa)
-        else:
-            xm = 0.5 * (xa + xb)
-        # keep the trial strictly inside; fall back to bisection on a bad secant
-        if not (xa < xm < xb):
-            xm = 0.5 * (xa + xb)
-        _dense(y0, k, hstep, xm, ytmp)
-        fm = _event_value(kind, side, ytmp, t0 + xm * hstep, on, amp, omega, pkind, thr, b,
-                          h, mu, gamma, l, g)
-        if fm <= 0.0:
-            xb = xm
-            fb = fm
-            if last == -1:
-                fa *= 0.5
-            last = -1
-        else:
-            xa = xm
-            fa = fm
-            if last == 1:
-                fb *= 0.5
-            last = 1
-    return xb
-
-
-@njit(cache=True)
-def _pendulum_period(psi, psi_dot, l, g):
-    """Free-pendulum period [s] through ``(psi, psi_dot)`` (same cases as
-    ``analytic.events.free_pendulum_period``): libration ``4 sqrt(l/g) K(m)``,
-    ``m = sin^2(psi_max/2) = e/(2 g l)``; rotation ``4 l K(2gl/e) / sqrt(2e)``
-    (one full turn); ``inf`` on the separatrix."""
-    e = 0.5 * l * l * psi_dot * psi_dot + g * l * (1.0 - math.cos(psi))
-    sep = 2.0 * g * l
-    if e < sep:
-        return 4.0 * math.sqrt(l / g) * _ellipk(e / sep)
-    if e > sep:
-        return 4.0 * l * _ellipk(sep / e) / math.sqrt(2.0 * e)
-    return math.inf
-
-
-@njit(cache=True)
-def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, atol,
-        rest_velocity, t_max, t_cap, max_steps, rest_frac, record, sample_dt):
+def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
+        rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit, record, sample_dt):
     """Integrate one run.  ``t_max <= 0`` means exact survival (no fixed horizon);
     ``rest_frac``: largest REST step over the pulse period (after the pulse, over
-    the small-swing pendulum period).
+    the small-swing pendulum period); ``certain_exit``: with exact survival, end
+    an overturn as soon as it is certain (:func:`overturn_certain`; status
+    overturned, reason ``R_CERTAIN``, time = that instant) instead of
+    integrating the fall to ``thr``.
 
     Returns ``(status, reason, t_verdict, n_impacts, samples, n_samples, events,
-    n_events, n_steps)``; ``samples`` rows are ``t, theta, theta_dot, psi, psi_dot``,
+    n_events, n_steps, e_end)`` (``e_end``: energy per m1 at the pulse end, NaN
+    when decided before it); ``samples`` rows are ``t, theta, theta_dot, psi, psi_dot``,
     ``events`` rows ``kind, t, side, td-, td+, psi, pd-, pd+``.  With ``record``
     False the two buffers stay 1-row placeholders (verdict only).
     """
@@ -196,6 +74,9 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
     # The exact survival rules also decide a fixed-window run ('survived' at t_max
     # follows from them); only a recorded trajectory must run on to t_max.
     early = exact or not record
+    # A certain overturn may end the run only where nobody reads the fall itself
+    # and no fixed window could still call a slow fall 'survived'.
+    certain = certain_exit and exact and not record
     # The barrier argument only holds on the stable side (|theta| < alpha): beyond
     # alpha an energy below the barrier means the frame can no longer come back.
     barrier = _barrier(b, h, mu, gamma, g)
@@ -236,6 +117,7 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
     reason = -1
     t_verdict = math.nan
     n_steps = 0
+    e_end = math.nan  # energy at the pulse end (NaN: decided before it)
 
     while True:
         # -- pulse end: the excitation stops, energy can only decrease from now on
@@ -247,8 +129,13 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
                 en = _rest_energy(y[2], y[3], gamma, l, g)
             else:
                 en = _energy(y[0], y[1], y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
+            e_end = en
             if early and en < barrier and abs(y[0]) < alpha:
                 status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
+                break
+            if certain and overturn_certain(y[0], y[1], en, phase, barrier, alpha, b, h, mu,
+                                            gamma, l, g):
+                status, reason, t_verdict = ST_OVERTURNED, R_CERTAIN, t
                 break
             if early and phase == 0:
                 if gamma == 0.0:
@@ -398,6 +285,13 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
                 y[c] = ynew[c]
                 k[0, c] = k[6, c]
             hstep = h_used * factor
+            # Without pendulum, past alpha moving outward is certain at any time
+            # after the pulse (the energy test needs only the pulse end: the energy
+            # is constant afterwards but for impacts, which happen inside alpha).
+            if certain and pulse_done and gamma == 0.0 and overturn_certain(
+                    y[0], y[1], barrier, phase, barrier, alpha, b, h, mu, gamma, l, g):
+                status, reason, t_verdict = ST_OVERTURNED, R_CERTAIN, t
+                break
             continue
         # -- an event at t_e: state from the dense output
         t_e = t + ev_x * h_used
@@ -476,15 +370,39 @@ def run(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, ato
             samples, ns = _push(samples, ns, row)
         if status >= 0:
             break
-    return status, reason, t_verdict, n_imp, samples, ns, events, ne, n_steps
+    return status, reason, t_verdict, n_imp, samples, ns, events, ne, n_steps, e_end
 
 
 @njit(cache=True)
-def verdict(b, h, mu, gamma, j, l, g, amp, omega, pkind, t_end_pulse, thr, rtol, atol,
-            rest_velocity, t_max, t_cap, max_steps, rest_frac):
+def verdict(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
+            rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit):
     """Verdict only: ``(status, reason, t_verdict, n_impacts)``."""
-    st, rs, tv, ni, _s, _ns, _e, _ne, _n = run(b, h, mu, gamma, j, l, g, amp, omega, pkind,
+    st, rs, tv, ni, _s, _ns, _e, _ne, _n, _en = run(amp, b, h, mu, gamma, j, l, g, omega, pkind,
                                               t_end_pulse, thr, rtol, atol, rest_velocity,
-                                              t_max, t_cap, max_steps, rest_frac, False,
-                                              1.0)
+                                              t_max, t_cap, max_steps, rest_frac,
+                                              certain_exit, False, 1.0)
     return st, rs, tv, ni
+
+
+@njit(cache=True)
+def verdicts(amps, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
+             rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit):
+    """:func:`verdict` for every amplitude of ``amps`` in one compiled loop (no
+    per-run dispatch): arrays ``(status, reason, t_verdict, n_impacts, e_end)``,
+    ``e_end`` the energy per m1 at the pulse end (see :func:`run`)."""
+    n = amps.shape[0]
+    st = np.empty(n, dtype=np.int64)
+    rs = np.empty(n, dtype=np.int64)
+    tv = np.empty(n)
+    ni = np.empty(n, dtype=np.int64)
+    en = np.empty(n)
+    for i in range(n):
+        out = run(amps[i], b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol,
+                  atol, rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit,
+                  False, 1.0)
+        st[i] = out[0]
+        rs[i] = out[1]
+        tv[i] = out[2]
+        ni[i] = out[3]
+        en[i] = out[9]
+    return st, rs, tv, ni, en

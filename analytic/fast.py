@@ -24,6 +24,14 @@ Phase semantics
   pendulum period (``4 sqrt(l/g) K(k^2)``).  Otherwise the run is 'undecided' at
   pulse end + ``t_cap``.  With ``t_max`` given the run stops there and a run
   that has not overturned is 'survived'.
+* Certain overturn (verdict-only entry points, ``t_max=None``): after the pulse,
+  past ``alpha`` with the energy below the barrier (and ``M R >= 2 gamma l``),
+  or without pendulum past ``alpha`` moving outward, the fall to the threshold
+  is certain (``_fast_kernels.overturn_certain``, proof in
+  ``docs/overturn-maps.md``).  The run ends there: the verdict's ``time`` is then
+  the instant the overturn became certain, not the instant ``|theta|`` reaches
+  the threshold, and its ``reason`` says so.  :func:`simulate` never exits
+  early: a trajectory always shows the whole fall.
 
 Sampled records are not compiled: :func:`simulate` hands them to the accurate
 path (``analytic.simulate``) and says so in the trajectory's diagnostics.
@@ -35,6 +43,7 @@ import time
 from dataclasses import dataclass
 
 import numba
+import numpy as np
 
 from . import _fast_kernels as _k
 from .excitation import Pulse, SampledRecord
@@ -43,7 +52,7 @@ from .parameters import Scene
 from .trajectory import Event, Trajectory, Verdict
 
 __all__ = ["NAME", "version", "Settings", "simulate", "overturn_verdict", "verdict_for",
-           "warm_up", "STATUS_NAMES"]
+           "kernel_args", "warm_up", "STATUS_NAMES", "PULSE_CODES"]
 
 NAME = "analytic-fast"
 CAPABILITIES = frozenset({"trajectory"})
@@ -53,8 +62,11 @@ REASONS = ("overturned", "energy below the overturning barrier after the pulse",
            "at rest after the pulse, no pendulum",
            "no uplift within one free-pendulum period after the pulse",
            "t_max reached", "t_cap after the pulse reached", "non-finite state",
-           "step size underflow", "step budget exhausted")
-_KINDS = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
+           "step size underflow", "step budget exhausted",
+           "overturn certain after the pulse (past alpha, cannot come back); "
+           "time = when it became certain")
+# The one map from pulse names to the kernels' codes.
+PULSE_CODES = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
 
 
 def version() -> str:
@@ -102,13 +114,27 @@ class Settings(RunOptions):
             raise ValueError(f"max_steps must be an integer >= 100, got {self.max_steps!r}")
 
 
-def _kernel_args(scene: Scene, pulse: Pulse, settings: Settings) -> tuple:
-    b, h, mu, gamma, j, l, g = scene.model_args()
-    thr = settings.criterion.threshold(scene.alpha)
-    t_max = -1.0 if settings.t_max is None else float(settings.t_max)
-    return (b, h, mu, gamma, j, l, g, pulse.amplitude, pulse.omega, _KINDS[pulse.kind],
-            pulse.end_time, thr, settings.rtol, settings.atol, settings.rest_velocity,
-            t_max, settings.t_cap, settings.max_steps, settings.rest_step_fraction)
+def _pack(model_args: tuple, omega: float, kind_code: int, threshold: float, rtol: float,
+          atol: float, rest_velocity: float, t_max: float | None, t_cap: float,
+          max_steps: int, rest_step_fraction: float, certain_exit: bool) -> tuple:
+    """The kernels' arguments after the amplitude, in their order (the one place
+    that knows it); ``t_max`` None or <= 0 = exact survival."""
+    t_max = -1.0 if t_max is None else float(t_max)
+    return (*model_args, float(omega), int(kind_code), 2.0 * math.pi / omega,
+            float(threshold), rtol, atol, rest_velocity, t_max, t_cap, int(max_steps),
+            rest_step_fraction, bool(certain_exit))
+
+
+def kernel_args(scene: Scene, omega: float, kind: str, settings: Settings,
+                certain_exit: bool = True) -> tuple:
+    """Arguments of the compiled kernels after the amplitude, for ``scene`` under a
+    ``kind`` pulse of frequency ``omega`` [rad/s]: call
+    ``_fast_kernels.verdict(amplitude, *args)`` or ``verdicts(amplitudes, *args)``.
+    No validation (callers validate once)."""
+    return _pack(scene.model_args(), omega, PULSE_CODES[kind],
+                 settings.criterion.threshold(scene.alpha), settings.rtol, settings.atol,
+                 settings.rest_velocity, settings.t_max, settings.t_cap, settings.max_steps,
+                 settings.rest_step_fraction, certain_exit)
 
 
 def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: float,
@@ -124,18 +150,22 @@ def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: f
     reason_code, time, n_impacts)``; ``STATUS_NAMES[status_code]``, ``REASONS``.
     With a fixed ``t_max`` the exact survival rules still stop the run early (the
     verdict at ``t_max`` follows from them), so ``n_impacts`` then counts the
-    impacts up to that decision only.
+    impacts up to that decision only.  With exact survival a certain overturn
+    ends the run early (module docstring): ``time`` is then when it became certain.
     """
-    return _k.verdict(b, h, mu, gamma, j, l, g, amplitude, omega, kind,
-                      2.0 * math.pi / omega, threshold, rtol, atol, rest_velocity, t_max,
-                      t_cap, max_steps, rest_step_fraction)
+    return _k.verdict(amplitude, *_pack((b, h, mu, gamma, j, l, g), omega, kind, threshold,
+                                        rtol, atol, rest_velocity, t_max, t_cap, max_steps,
+                                        rest_step_fraction, True))
 
 
 def verdict_for(scene: Scene, pulse: Pulse, settings: Settings | None = None) -> Verdict:
     """The :class:`Verdict` of ``scene`` under ``pulse`` without sampling the
-    trajectory (see :func:`overturn_verdict` for fixed-window runs)."""
+    trajectory (see :func:`overturn_verdict` for fixed-window runs).  A certain
+    overturn ends the run early: ``Verdict.time`` is then the instant it became
+    certain (``Verdict.reason`` says so); :func:`simulate` gives the fall itself."""
     settings = _check(scene, pulse, settings)
-    st, rs, tv, ni = _k.verdict(*_kernel_args(scene, pulse, settings))
+    st, rs, tv, ni = _k.verdict(pulse.amplitude,
+                                *kernel_args(scene, pulse.omega, pulse.kind, settings))
     return _make_verdict(st, rs, tv, ni)
 
 
@@ -165,10 +195,10 @@ def warm_up(record: bool = True) -> float:
     """Compile (or load from the on-disk cache) the kernels once per process;
     ``record=False`` only the verdict kernel (what spectra use).  Returns seconds."""
     t0 = time.perf_counter()
-    args = _kernel_args(Scene(), Pulse(10.0, 10.0), Settings())
-    _k.verdict(*args)
+    args = kernel_args(Scene(), 10.0, "sine", Settings())
+    _k.verdicts(np.array([10.0]), *args)
     if record:
-        _k.run(*args, True, 1e-2)
+        _k.run(10.0, *args[:-1], False, True, 1e-2)
     return time.perf_counter() - t0
 
 
@@ -187,8 +217,10 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         traj.diagnostics["fast_path_fallback"] = "sampled record: accurate path used"
         return traj
     t0 = time.perf_counter()
-    (st, rs, tv, ni, samples, ns, events, ne, n_steps) = _k.run(
-        *_kernel_args(scene, excitation, settings), True, settings.sample_dt)
+    # No early exit here: a trajectory shows the fall up to the threshold.
+    args = kernel_args(scene, excitation.omega, excitation.kind, settings, certain_exit=False)
+    (st, rs, tv, ni, samples, ns, events, ne, n_steps, _e_end) = _k.run(
+        excitation.amplitude, *args, True, settings.sample_dt)
     wall = time.perf_counter() - t0
     data = samples[:ns]
     evs = []

@@ -1,37 +1,47 @@
 """Overturning spectra (paper Section 5.2, Fig. 5): the first overturning amplitude
 per pulse frequency, with and without the pendulum, and the gain Delta.
 
-For each ``Omega`` the amplitude ``A`` is raised from ``A_start`` in scan steps
-until the first run that overturns, then the last safe / first overturning pair
-is bisected down to ``tol``.  The reported amplitude is the *first overturning
-amplitude found from below* (the paper's definition: "the amplitude ... which
-corresponds to the first overturning occurrence"); safe islands above it are
-not explored.
+The reported amplitude is the paper's "amplitude ... which corresponds to the
+first overturning occurrence": the *lowest* amplitude that overturns.  Above a
+first threshold the map has safe islands and, below it, overturning windows
+can be narrower than any affordable uniform step (Zhang & Makris 2001);
+``docs/overturn-maps.md`` shows them.
 
-What the scan guarantees
-------------------------
+The search (``method='windows'``, default)
+-------------------------------------------
+1. Coarse scan upward from ``A_start`` in steps ``max(scan_step, scan_rel_step A)``
+   until the first run that overturns (runs batched in one compiled loop,
+   :func:`analytic._fast_kernels.verdicts`).
+2. Window scan: every coarse interval below that hit is re-scanned in steps
+   ``w(A) = max(window_step, window_rel_step A)`` (``window_step`` defaults to
+   ``tol``), lowest interval first, up to the first overturning run, *unless*
+   both of its ends are quiet survivors: decided at the pulse end with an energy
+   below ``(1 - energy_margin)`` times the overturning barrier, inside ``alpha``.
+   An overturn needs the pulse-end energy at the barrier or the frame past
+   ``alpha`` (after the pulse the energy only drops); a window inside a quiet
+   interval would need that energy to climb by ``energy_margin`` x barrier and
+   fall back within one coarse step.
+3. Bisection of the last safe / first overturning pair down to ``tol``.
+
+Guarantee: every overturning window at least ``w(A)`` wide that lies in a
+re-scanned interval is found, so the reported amplitude is the lowest
+overturning amplitude within ``+-w(A)`` (``+-tol`` where ``w = tol``, i.e. below
+``window_step / window_rel_step``).  Limit: windows narrower than ``w(A)``, and
+windows inside quiet intervals, are not searched for; both are checked against
+an independent brute-force scan in ``tests/test_windows.py`` and
+``benchmarks/bench_spectrum.py``.
+
+``method='scan'`` is the previous search (coarse scan, then bisection, no
+window scan), kept for comparison: it misses windows narrower than its step.
+
 Nothing below ``A_start`` overturns: without a pendulum ``A_start = g/lam``, the
-uplift acceleration (Eq. 11), below which the frame never leaves the ground.
-With a pendulum the swinging mass can lower the uplift amplitude (measured on
-the Fig. 5 scene: uplift from ``0.85 g/lam`` for a one-cosine pulse at
-``Omega = 1``), so the scan starts at ``start_fraction * g/lam``.
+uplift acceleration (Eq. 11).  With a pendulum the swinging mass can lower the
+uplift amplitude (measured on the Fig. 5 scene: uplift from ``0.85 g/lam`` for a
+one-cosine pulse at ``Omega = 1``), so the scan starts at ``start_fraction * g/lam``.
 
-Between scan points nothing is known: an overturning window narrower than the
-scan step can be stepped over, and the reported amplitude is then the start of
-a later window.  The step is ``max(scan_step, scan_rel_step * A)``.  The
-default (0.1 m/s^2, 2 %) was chosen against scans at 0.01 m/s^2 (bisection to
-0.005) on the Fig. 5 scene, Omega = 3..30 step 1, both curves: it gives the
-same first amplitudes within 0.006 m/s^2 except at Omega = 7 with the pendulum,
-where the 0.01 scan finds a first window 0.04 m/s^2 below (a window narrower
-than 0.05 m/s^2; a 0.05 m/s^2 scan misses it too, at 6x the cost).  The
-narrowest overturning windows measured there are 0.01-0.05 m/s^2 wide, all at
-``A < 5`` m/s^2; above, the first window runs on to the largest amplitude
-scanned.  ``benchmarks/bench_spectrum.py`` repeats the comparison.  This
-was measured for the one-sine pulse only; one-cosine spectra use the same step
-unchecked.
-
-Every run is decided by the compiled fast path (:func:`analytic.fast.overturn_verdict`)
-with the criterion and ``t_max`` carried into the result.
+Every run is decided by the compiled fast path (:mod:`analytic.fast`, exact
+survival rules, a certain overturn ends the run) with the criterion and
+``t_max`` carried into the result.
 """
 from __future__ import annotations
 
@@ -45,44 +55,59 @@ import numpy as np
 
 from . import _fast_kernels as _k
 from . import fast
+from .equations import overturn_energy_barrier
 from .excitation import PULSE_KINDS
 from .parameters import Scene
 from .trajectory import OverturnCriterion
 
 __all__ = ["SpectrumSettings", "Spectrum", "first_overturn_amplitude", "overturning_spectrum",
-           "parse_omega_range"]
+           "METHODS"]
 
-_KIND = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
+METHODS = ("windows", "scan")
+_CHUNK = 16  # largest batch of coarse runs per compiled call (batches grow 2, 4, ... 16)
 
 
 @dataclass(frozen=True)
 class SpectrumSettings:
-    """How a spectrum is searched."""
+    """How a spectrum is searched (see the module docstring)."""
 
     # One-sine (Eq. 22) or one-cosine (Eq. 23) pulse.
     pulse: str = "sine"
     # Bisection resolution [m/s^2]: finer than the paper's plots can show.
     tol: float = 0.01
-    # Scan step floor [m/s^2]: as good as 0.05 against 0.01 scans (see module doc).
+    # Coarse scan step floor [m/s^2] and relative step.
     scan_step: float = 0.1
-    # Relative scan step: at high amplitude no narrow first window was measured.
     scan_rel_step: float = 0.02
     # Pendulum curve starts at this fraction of g/lam (measured uplift from 0.85 g/lam).
     start_fraction: float = 0.5
     # Largest amplitude tried [m/s^2] (NaN past it): one-cosine Fig. 5 needs ~650 at Omega=30.
     a_max: float = 1000.0
+    # 'windows' (coarse scan, window scan, bisection) or 'scan' (the previous search).
+    method: str = "windows"
+    # Window scan step floor [m/s^2] (None: tol) and relative step.
+    window_step: float | None = None
+    window_rel_step: float = 0.003
+    # Coarse intervals whose ends both end the pulse below (1 - margin) x barrier
+    # are not re-scanned.
+    energy_margin: float = 0.3
     # Integrator settings of every run (criterion, t_max, tolerances).
     fast: fast.Settings = field(default_factory=fast.Settings)
 
     def __post_init__(self) -> None:
         if self.pulse not in PULSE_KINDS:
             raise ValueError(f"pulse must be one of {PULSE_KINDS}, got {self.pulse!r}")
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
         for name, lo, hi in (("tol", 1e-6, 10.0), ("scan_step", 1e-4, 100.0),
                              ("scan_rel_step", 0.0, 1.0), ("start_fraction", 0.0, 1.0),
-                             ("a_max", 0.0, 1e4)):
+                             ("a_max", 0.0, 1e4), ("window_step", 1e-6, 10.0),
+                             ("window_rel_step", 0.0, 0.1), ("energy_margin", 0.0, 1.0)):
             v = getattr(self, name)
+            if name == "window_step" and v is None:
+                continue
+            inclusive = name in ("scan_rel_step", "window_rel_step", "energy_margin")
             ok = isinstance(v, (int, float)) and math.isfinite(v) and (
-                (v >= lo) if name == "scan_rel_step" else (v > lo)) and v <= hi
+                (v >= lo) if inclusive else (v > lo)) and v <= hi
             if not ok:
                 raise ValueError(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
         if self.tol > self.scan_step:
@@ -98,35 +123,15 @@ class SpectrumSettings:
     def t_max(self) -> float | None:
         return self.fast.t_max
 
+    def window_width(self, a: float) -> float:
+        """``w(A)`` [m/s^2]: the narrowest window the search is sure to find at ``A``."""
+        floor = self.tol if self.window_step is None else self.window_step
+        return max(floor, self.window_rel_step * a)
+
     def describe(self) -> dict:
         out = asdict(self)
         out["fast"] = self.fast.describe()
         return out
-
-
-def parse_omega_range(spec: str, option: str = "--omega") -> np.ndarray:
-    """``'START:STOP:STEP'`` (STOP included) or ``'W1,W2,...'`` -> frequencies [rad/s]."""
-    text = str(spec).strip()
-    try:
-        if ":" in text:
-            parts = [float(p) for p in text.split(":")]
-            if len(parts) != 3:
-                raise ValueError
-            start, stop, step = parts
-            if not all(math.isfinite(p) for p in parts) or step <= 0 or stop < start:
-                raise ValueError
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
-            values = np.round(start + step * np.arange(n), 12)
-        else:
-            values = np.array([float(p) for p in text.split(",")])
-    except ValueError:
-        raise ValueError(f"{option} expects START:STOP:STEP with 0 < START <= STOP, STEP > 0 "
-                         f"(or a comma list), got {spec!r}") from None
-    if values.size == 0 or values.size > 100_000:
-        raise ValueError(f"{option} must give 1 to 100000 frequencies, got {values.size}")
-    if not np.all(np.isfinite(values)) or np.any(values <= 0) or np.any(values > 1e4):
-        raise ValueError(f"{option}: every frequency must be in (0, 1e4] rad/s, got {spec!r}")
-    return values
 
 
 def _a_start(scene: Scene, ss: SpectrumSettings) -> float:
@@ -134,58 +139,103 @@ def _a_start(scene: Scene, ss: SpectrumSettings) -> float:
     return a_np if scene.gamma == 0.0 else ss.start_fraction * a_np
 
 
+class _Runner:
+    """Runs of one (scene, frequency): compiled verdicts plus counters."""
+
+    def __init__(self, scene: Scene, omega: float, ss: SpectrumSettings):
+        self.args = fast.kernel_args(scene, omega, ss.pulse, ss.fast)
+        self.quiet_energy = (1.0 - ss.energy_margin) * overturn_energy_barrier(
+            *scene.model_args()[:4], scene.g)
+        self.n_runs = 0
+        self.n_und = 0
+
+    def __call__(self, amps):
+        """``(overturned, n_impacts, quiet)`` arrays for amplitudes ``amps``."""
+        st, _rs, _tv, ni, e_end = _k.verdicts(np.asarray(amps, dtype=float), *self.args)
+        self.n_runs += len(st)
+        self.n_und += int(np.sum((st == _k.ST_UNDECIDED) | (st == _k.ST_UNSTABLE)))
+        quiet = (st == _k.ST_SURVIVED) & (e_end < self.quiet_energy)
+        return st == _k.ST_OVERTURNED, ni, quiet
+
+
+def _coarse_grid(a_lo: float, ss: SpectrumSettings, n: int) -> list[float]:
+    out = []
+    a = a_lo
+    for _ in range(n):
+        a = a + max(ss.scan_step, ss.scan_rel_step * a)
+        if a > ss.a_max:
+            break
+        out.append(a)
+    return out
+
+
 def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
                              ) -> tuple[float, float, str | None, int, int]:
-    """Scan and bisect one frequency.
+    """Search one frequency (module docstring).
 
     Returns ``(a_overturn, a_safe, mode, n_runs, n_undecided)``: the smallest
     amplitude found to overturn, the largest amplitude below it found safe
     (``a_overturn - a_safe <= tol``), the overturning mode at ``a_overturn``.
     ``a_overturn`` is NaN (mode None) when nothing overturns up to ``a_max``.
     """
-    b, h, mu, gamma, j, l, g = scene.model_args()
-    st = ss.fast
-    thr = st.criterion.threshold(scene.alpha)
-    t_max = -1.0 if st.t_max is None else float(st.t_max)
-    kind = _KIND[ss.pulse]
-    period = 2.0 * math.pi / omega
-    n_runs = 0
-    n_und = 0
-
-    def run(a):
-        nonlocal n_runs, n_und
-        n_runs += 1
-        status, _r, _t, n_imp = _k.verdict(b, h, mu, gamma, j, l, g, a, omega, kind, period,
-                                           thr, st.rtol, st.atol, st.rest_velocity, t_max,
-                                           st.t_cap, st.max_steps, st.rest_step_fraction)
-        if status == _k.ST_UNDECIDED or status == _k.ST_UNSTABLE:
-            n_und += 1
-        return status == _k.ST_OVERTURNED, n_imp
-
-    a_lo = _a_start(scene, ss)
-    over, _ = run(a_lo)
-    if over:  # nothing is known below the start: refuse to report a wrong "first"
-        raise ValueError(f"a run overturns at the scan start A={a_lo:.4g} m/s^2 "
+    run = _Runner(scene, omega, ss)
+    a0 = _a_start(scene, ss)
+    over, _, quiet0 = run([a0])
+    if over[0]:  # nothing is known below the start: refuse to report a wrong "first"
+        raise ValueError(f"a run overturns at the scan start A={a0:.4g} m/s^2 "
                          f"(Omega={omega:g}); lower start_fraction")
-    a_hi = math.nan
-    n_hi = 0
-    while True:
-        a = a_lo + max(ss.scan_step, ss.scan_rel_step * a_lo)
-        if a > ss.a_max:
-            return math.nan, a_lo, None, n_runs, n_und
-        over, n_imp = run(a)
-        if over:
-            a_hi, n_hi = a, n_imp
-            break
-        a_lo = a
+    # 1. coarse scan, in compiled batches
+    amps, quiet = [a0], [bool(quiet0[0])]
+    hit = None
+    batch = 2  # grows: few runs wasted past the first hit, few calls on a long scan
+    while hit is None:
+        grid = _coarse_grid(amps[-1], ss, batch)
+        batch = min(2 * batch, _CHUNK)
+        if not grid:
+            return math.nan, amps[-1], None, run.n_runs, run.n_und
+        ov, ni, qu = run(grid)
+        k = int(np.argmax(ov)) if ov.any() else len(grid)
+        amps += grid[:k]
+        quiet += [bool(q) for q in qu[:k]]
+        if k < len(grid):
+            hit = (grid[k], int(ni[k]))
+    a_lo, (a_hi, n_hi) = amps[-1], hit
+    # 2. window scan of the non-quiet coarse intervals, lowest first
+    if ss.method == "windows":
+        bounds = amps + [a_hi]
+        for i in range(len(amps)):
+            last = i == len(amps) - 1
+            if not last and quiet[i] and quiet[i + 1]:
+                continue
+            lo, hi = bounds[i], bounds[i + 1]
+            fine = []
+            a = lo
+            while True:
+                a = a + ss.window_width(a)
+                if a >= hi:
+                    break
+                fine.append(a)
+            if not fine:
+                if last:
+                    break
+                continue
+            ov, ni, _ = run(fine)
+            if ov.any():
+                k = int(np.argmax(ov))
+                a_lo = fine[k - 1] if k > 0 else lo
+                a_hi, n_hi = fine[k], int(ni[k])
+                break
+            if last:
+                a_lo = fine[-1]
+    # 3. bisection of the last safe / first overturning pair
     while a_hi - a_lo > ss.tol:
         mid = 0.5 * (a_lo + a_hi)
-        over, n_imp = run(mid)
-        if over:
-            a_hi, n_hi = mid, n_imp
+        ov, ni, _ = run([mid])
+        if ov[0]:
+            a_hi, n_hi = mid, int(ni[0])
         else:
             a_lo = mid
-    return a_hi, a_lo, ("after-impact" if n_hi > 0 else "no-impact"), n_runs, n_und
+    return a_hi, a_lo, ("after-impact" if n_hi > 0 else "no-impact"), run.n_runs, run.n_und
 
 
 @dataclass(frozen=True, eq=False)

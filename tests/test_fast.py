@@ -235,3 +235,27 @@ def test_cosine_pulse_exactly_at_uplift_is_decided():
         pulse = Pulse(scene.g / scene.lam, omega, "cosine")
         assert verdict_for(scene, pulse).status == "survived"
         assert fast_simulate(scene, pulse).verdict.status == "survived"
+
+
+def test_certain_overturn_exit_keeps_verdicts(fig5, run_analytic):
+    """The verdict-only path ends a certain overturn early (past alpha below the
+    energy barrier after the pulse, or without pendulum past alpha moving out):
+    same status and mode as the accurate path, which integrates the whole fall,
+    at A-D and at a seeded random sample around the spectrum's thresholds; the
+    reported time is when the overturn became certain, no later than the fall."""
+    rng = np.random.default_rng(16)
+    cases = list(PAPER_POINTS.values()) + [
+        (float(a), float(w)) for a, w in zip(rng.uniform(2.0, 40.0, 10), rng.uniform(3.0, 20.0, 10))]
+    n_certain = 0
+    for scene in (fig5, fig5.without_pendulum()):
+        for amp, omega in cases:
+            v = fast.verdict_for(scene, Pulse(amp, omega))
+            ref = run_analytic(scene, amp, omega).verdict
+            assert (v.status, v.mode) == (ref.status, ref.mode), (scene.gamma, amp, omega)
+            if v.reason == fast.REASONS[kern.R_CERTAIN]:
+                n_certain += 1
+                assert v.time < ref.time
+    assert n_certain >= 5  # the exit is exercised (point D among them)
+    d = fast.verdict_for(fig5, Pulse(*PAPER_POINTS["D"]))
+    assert d.reason == fast.REASONS[kern.R_CERTAIN] and d.time == pytest.approx(
+        Pulse(*PAPER_POINTS["D"]).end_time)

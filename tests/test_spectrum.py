@@ -14,8 +14,9 @@ from analytic import fast
 from analytic.excitation import Pulse
 from analytic.parameters import Scene
 from analytic.spectrum import (Spectrum, SpectrumSettings, first_overturn_amplitude,
-                               overturning_spectrum, parse_omega_range)
+                               overturning_spectrum)
 from compare.cli import main as cli_main
+from compare.commands._common import parse_omega_range
 
 FIG5_OMEGA = np.arange(3.0, 31.0, 1.0)  # the paper's Fig. 5 range
 

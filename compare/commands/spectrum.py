@@ -5,7 +5,8 @@ import argparse
 import math
 import sys
 
-from ._common import add_scene_args, clean_nan, print_json, scene_from_args
+from ._common import (add_scene_args, clean_nan, parse_omega_range, print_json,
+                      scene_from_args)
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
 
@@ -92,7 +93,7 @@ def plot_spectrum(spec, path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from analytic.spectrum import overturning_spectrum, parse_omega_range
+    from analytic.spectrum import overturning_spectrum
 
     scene = scene_from_args(args)
     omegas = parse_omega_range(args.omega, "--omega")

@@ -1,0 +1,172 @@
+"""Step-level pieces of the fast analytic path: the compiled equations, the
+right-hand side per phase, one Dormand-Prince 5(4) step, the event functions and
+their location on the dense output (used by :mod:`analytic._fast_kernels`).
+
+The physics is *not* re-typed here: the scalar functions of
+:mod:`analytic.equations` (Eq. 1, 8, A.1, 9, 19, 21 corrected) are compiled as they
+are with ``numba.njit``.  Compiled once per process; ``cache=True`` keeps the
+machine code on disk between processes (:mod:`analytic._numba_cache` drops it when
+a source changes).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import _numba_cache  # noqa: F401  (drops stale machine code before numba loads it)
+from . import equations as _eq
+from ._fast_numerics import _A, _B, _C, _E, _ROOT_ITER, _ROOT_XTOL, _dense, _ellipk
+
+# --- the equations, compiled from the single source -------------------------------
+_rock = njit(cache=True)(_eq.rocking_accelerations)
+_rest_acc = njit(cache=True)(_eq.rest_pendulum_acceleration)
+_margin = njit(cache=True)(_eq.uplift_margin)
+_impact = njit(cache=True)(_eq.impact_velocities)
+_energy = njit(cache=True)(_eq.energy)
+_rest_energy = njit(cache=True)(_eq.rest_energy)
+_barrier = njit(cache=True)(_eq.overturn_energy_barrier)
+
+# Pulse kinds (Eq. 22 / Eq. 23); analytic.fast maps the names onto them.
+KIND_SINE, KIND_COSINE = 0, 1
+
+
+@njit(cache=True)
+def _xg(t, on, amp, omega, kind):
+    """Pulse acceleration (Eq. 22/23); ``on`` is False after the pulse end."""
+    if not on:
+        return 0.0
+    if kind == KIND_COSINE:
+        return amp * math.cos(omega * t)
+    return amp * math.sin(omega * t)
+
+
+@njit(cache=True)
+def _deriv(phase, y, xg, out, b, h, mu, gamma, j, l, g):
+    """Right-hand side in phase ``phase`` (0 = REST, +1/-1 = ROCK about that side)."""
+    if phase == 0:
+        out[0] = 0.0
+        out[1] = 0.0
+        if gamma == 0.0:
+            out[2] = 0.0
+            out[3] = 0.0
+        else:
+            out[2] = y[3]
+            out[3] = _rest_acc(y[2], xg, l, g)
+        return
+    tdd, pdd = _rock(y[0], y[1], y[2], y[3], xg, float(phase), b, h, mu, gamma, j, l, g)
+    out[0] = y[1]
+    out[1] = tdd
+    out[2] = y[3]
+    out[3] = pdd
+
+
+@njit(cache=True)
+def _dp_step(phase, t, t1, y, hstep, on, amp, omega, pkind, rtol, atol, k, ystage, ynew, f,
+             b, h, mu, gamma, j, l, g):
+    """One Dormand-Prince 5(4) step from ``(t, y)`` with ``k[0] = f(t, y)``; fills
+    ``k[1:7]`` (``k[6] = f(t1, ynew)``, first-same-as-last) and ``ynew``.  Returns
+    the RMS error norm (``<= 1`` accepts) and whether ``ynew`` is finite."""
+    for s in range(1, 6):
+        for c in range(4):
+            acc = 0.0
+            for i in range(s):
+                acc += _A[s, i] * k[i, c]
+            ystage[c] = y[c] + hstep * acc
+        _deriv(phase, ystage, _xg(t + _C[s] * hstep, on, amp, omega, pkind), f, b, h, mu,
+               gamma, j, l, g)
+        for c in range(4):
+            k[s, c] = f[c]
+    for c in range(4):
+        acc = 0.0
+        for i in range(6):
+            acc += _B[i] * k[i, c]
+        ynew[c] = y[c] + hstep * acc
+    _deriv(phase, ynew, _xg(t1, on, amp, omega, pkind), f, b, h, mu, gamma, j, l, g)
+    for c in range(4):
+        k[6, c] = f[c]
+    err = 0.0
+    finite = True
+    for c in range(4):
+        acc = 0.0
+        for i in range(7):
+            acc += _E[i] * k[i, c]
+        sc = atol + rtol * max(abs(y[c]), abs(ynew[c]))
+        e = hstep * acc / sc
+        err += e * e
+        if not math.isfinite(ynew[c]):
+            finite = False
+    return math.sqrt(err / 4.0), finite
+
+
+@njit(cache=True)
+def _event_value(kind, side, yx, t, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g):
+    """Event functions; an event happens where the value becomes <= 0.
+
+    kind 0: uplift margin about ``side`` (REST);  kind 1: ``side*theta`` (impact);
+    kind 2: ``thr - side*theta`` (overturn).
+    """
+    if kind == 0:
+        xg = _xg(t, on, amp, omega, pkind)
+        return _margin(yx[2], yx[3], xg, float(side), b, h, mu, gamma, l, g)
+    if kind == 1:
+        return side * yx[0]
+    return thr - side * yx[0]
+
+
+@njit(cache=True)
+def _locate(kind, side, y0, k, t0, hstep, on, amp, omega, pkind, thr, b, h, mu, gamma,
+            l, g, ytmp):
+    """First root in (0, 1] of an event function on the dense output, given
+    value > 0 at x = 0 and <= 0 at x = 1.  Illinois regula falsi; returns the
+    right end of the final bracket (where the event condition holds)."""
+    xa = 0.0
+    _dense(y0, k, hstep, 0.0, ytmp)
+    fa = _event_value(kind, side, ytmp, t0, on, amp, omega, pkind, thr, b, h, mu, gamma, l, g)
+    xb = 1.0
+    _dense(y0, k, hstep, 1.0, ytmp)
+    fb = _event_value(kind, side, ytmp, t0 + hstep, on, amp, omega, pkind, thr, b, h, mu,
+                      gamma, l, g)
+    last = 0
+    for _ in range(_ROOT_ITER):
+        if xb - xa <= _ROOT_XTOL:
+            break
+        if fa != fb:
+            xm = xb - fb * (xb - xa) / (fb - fa)
+        else:
+            xm = 0.5 * (xa + xb)
+        # keep the trial strictly inside; fall back to bisection on a bad secant
+        if not (xa < xm < xb):
+            xm = 0.5 * (xa + xb)
+        _dense(y0, k, hstep, xm, ytmp)
+        fm = _event_value(kind, side, ytmp, t0 + xm * hstep, on, amp, omega, pkind, thr, b,
+                          h, mu, gamma, l, g)
+        if fm <= 0.0:
+            xb = xm
+            fb = fm
+            if last == -1:
+                fa *= 0.5
+            last = -1
+        else:
+            xa = xm
+            fa = fm
+            if last == 1:
+                fb *= 0.5
+            last = 1
+    return xb
+
+
+@njit(cache=True)
+def _pendulum_period(psi, psi_dot, l, g):
+    """Free-pendulum period [s] through ``(psi, psi_dot)`` (same cases as
+    ``analytic.events.free_pendulum_period``): libration ``4 sqrt(l/g) K(m)``,
+    ``m = sin^2(psi_max/2) = e/(2 g l)``; rotation ``4 l K(2gl/e) / sqrt(2e)``
+    (one full turn); ``inf`` on the separatrix."""
+    e = 0.5 * l * l * psi_dot * psi_dot + g * l * (1.0 - math.cos(psi))
+    sep = 2.0 * g * l
+    if e < sep:
+        return 4.0 * math.sqrt(l / g) * _ellipk(e / sep)
+    if e > sep:
+        return 4.0 * l * _ellipk(sep / e) / math.sqrt(2.0 * e)
+    return math.inf
