@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from . import _numba_cache  # noqa: F401  (drops stale machine code before numba loads it)

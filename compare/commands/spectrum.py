@@ -36,6 +36,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="overturned at |theta| = 1.5 rad (topple) or at alpha [topple]")
     parser.add_argument("--t-max", type=float, default=None,
                         help="fixed run length [s]; default: exact survival rules")
+    parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
+                        help="analytic (the model's spectrum), or engines to bisect on the same "
+                             "grid around it: pybullet, pymunk, ... or all [analytic]")
+    parser.add_argument("--dt", type=float, default=None,
+                        help="engine time step [s], in (0, 0.01]; default: each engine's "
+                             "calibrated step")
+    parser.add_argument("--convergence", action="store_true",
+                        help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
+                             "solver iterations to classify the cause")
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
@@ -102,8 +111,11 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
     progress = (not args.json) and sys.stdout.isatty()
+    engines_wanted = _engines(args)
     spec = overturning_spectrum(scene, omegas, settings, workers=args.workers,
                                 progress=progress)
+    if engines_wanted:
+        return _run_engines(args, scene, spec, engines_wanted)
     if args.csv:
         spec.to_csv(args.csv)
     if args.plot:
@@ -131,4 +143,42 @@ def run(args: argparse.Namespace) -> int:
     if spec.n_undecided:
         print(f"warning: {spec.n_undecided} run(s) undecided (counted as not overturned)")
     print(f"{spec.n_runs} runs in {spec.wall_time:.2f} s")
+    return 0
+
+
+def _engines(args: argparse.Namespace) -> tuple[str, ...]:
+    """The engines asked for (empty for the analytic spectrum); checked up front."""
+    from engines import engine_list
+    if args.engine.strip() == "analytic":
+        if args.dt is not None or args.convergence:
+            raise ValueError("--dt and --convergence need --engine NAME (an engine)")
+        return ()
+    names = engine_list(args.engine)
+    if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= 0.01):
+        raise ValueError(f"--dt must be in (0, 0.01] s, got {args.dt!r}")
+    return names
+
+
+def _run_engines(args, scene, spec, names) -> int:
+    from compare import engine_spectrum as es
+
+    options = {} if args.dt is None else {"dt": args.dt}
+    results = [es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=args.workers,
+                                  convergence=args.convergence, **options) for name in names]
+    if args.csv:
+        es.write_csv(results, args.csv)
+    if args.plot:
+        es.plot(spec, results, args.plot)
+    if args.json:
+        print_json({"analytic": spec.to_dict(), "engines": {r.engine: r.to_dict() for r in results}})
+        return 0
+    for r in results:
+        print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, bracket "
+              f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %")
+        print(f"{'curve':>11} {'Omega':>6} {'A_model':>8} {'A_engine':>8} {'error':>7}  cause")
+        for curve, points in r.curves.items():
+            for p in points:
+                print(f"{curve:>11} {p.omega:6.3g} {p.a_analytic:8.3f} {p.a_engine:8.3f} "
+                      f"{100 * p.rel_error:+6.2f}%  {p.cause}"
+                      + ("" if p.cause == "agrees" else f": {p.cause_detail}"))
     return 0
