@@ -28,17 +28,26 @@ carries the lintel and the hinge; each column centre is ``r/2`` from its pivot):
 (:func:`~analytic.equations.rest_pendulum_acceleration`, ``theta = 0``) at rest.
 ``R`` is the sum over both columns: how it splits between them (and between the
 column tops under the lintel) is statically indeterminate in a rigid model.
+
+The other contact the model takes for granted, the lintel on the column tops,
+is computed alike in :mod:`analytic.contact_forces`; :func:`validity_diagnostics`
+reports both and :func:`check_model` is the single entry point that runs a
+pulse and names the first assumption that fails.
 """
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
 from . import equations as eq
+from .contact_forces import (lintel_extrema, lintel_force_from_accelerations, lintel_load,
+                             violations)
 
-__all__ = ["system_mass", "reaction_from_accelerations", "ground_reaction", "sample_sides",
-           "reaction_history", "validity_diagnostics"]
+__all__ = ["system_mass", "reaction_from_accelerations", "ground_reaction", "lintel_force",
+           "sample_sides", "reaction_history", "lintel_history", "validity_diagnostics",
+           "check_model"]
 
 
 def system_mass(mu: float, gamma: float) -> float:
@@ -115,6 +124,27 @@ def ground_reaction(theta: float, theta_dot: float, psi: float, psi_dot: float,
     return float(rx), float(ry)
 
 
+def lintel_force(theta: float, theta_dot: float, psi: float, psi_dot: float,
+                 xg_ddot: float, side: float, b: float, h: float, mu: float,
+                 gamma: float, j: float, l: float, g: float) -> tuple[float, float]:
+    """Force ``(F_x, F_y)`` per unit ``m1`` [N/kg] of both column tops on the
+    lintel and bob (:mod:`analytic.contact_forces`); arguments as in
+    :func:`ground_reaction`.
+
+    Returns
+    -------
+    (F_x, F_y) : tuple of float
+        ``F_y > 0``: the lintel stays on the columns; ``|F_x|/F_y``: the
+        Coulomb coefficient it needs there.  At rest with the pendulum hanging
+        still ``F = (mu xg_ddot, (mu + gamma) g)`` (the bob lags, Eq. 1).
+    """
+    theta_ddot, psi_ddot = _accelerations(theta, theta_dot, psi, psi_dot, xg_ddot, side,
+                                          b, h, mu, gamma, j, l, g)
+    fx, fy = lintel_force_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot,
+                                             psi_ddot, xg_ddot, side, b, h, mu, gamma, l, g)
+    return float(fx), float(fy)
+
+
 def sample_sides(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray) -> np.ndarray:
     """Phase of each sample of an analytic trajectory: +1, -1 (rocking) or 0 (rest).
 
@@ -139,16 +169,11 @@ def sample_sides(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray) -> np.
     return sides
 
 
-def reaction_history(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
-                     psi: np.ndarray, psi_dot: np.ndarray, excitation,
-                     model_args: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(R_x, R_y, side)`` at every sample of a run (:func:`ground_reaction`).
+def _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args):
+    """State arrays, ``xg_ddot``, sides and ``(theta_ddot, psi_ddot)`` at every sample.
 
-    ``excitation`` is the run's Pulse or SampledRecord (its vectorised
-    ``acceleration_array`` is used when it has one, else ``acceleration(t)``);
-    ``model_args`` is ``Scene.model_args()``.  Only the accelerations are
-    evaluated sample by sample (the scalar Eq. 8 / Eq. 1): the rest is vectorised.
-    """
+    Only the accelerations are evaluated sample by sample (the scalar Eq. 8 /
+    Eq. 1), once for both contacts."""
     t = np.asarray(t, dtype=float)
     theta, theta_dot, psi, psi_dot = (np.asarray(a, dtype=float)
                                       for a in (theta, theta_dot, psi, psi_dot))
@@ -162,9 +187,35 @@ def reaction_history(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
            for row in zip(theta.tolist(), theta_dot.tolist(), psi.tolist(), psi_dot.tolist(),
                           xg.tolist(), sides.tolist())]
     acc = np.array(acc, dtype=float).reshape(len(t), 2)
-    rx, ry = reaction_from_accelerations(theta, theta_dot, psi, psi_dot, acc[:, 0], acc[:, 1],
-                                         xg, sides, b, h, mu, gamma, l, g)
-    return rx, ry, sides
+    state = (theta, theta_dot, psi, psi_dot, acc[:, 0], acc[:, 1], xg, sides)
+    return state
+
+
+def reaction_history(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
+                     psi: np.ndarray, psi_dot: np.ndarray, excitation,
+                     model_args: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(R_x, R_y, side)`` at every sample of a run (:func:`ground_reaction`).
+
+    ``excitation`` is the run's Pulse or SampledRecord (its vectorised
+    ``acceleration_array`` is used when it has one, else ``acceleration(t)``);
+    ``model_args`` is ``Scene.model_args()``.  Only the accelerations are
+    evaluated sample by sample (the scalar Eq. 8 / Eq. 1): the rest is vectorised.
+    """
+    b, h, mu, gamma, j, l, g = model_args
+    state = _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args)
+    rx, ry = reaction_from_accelerations(*state, b, h, mu, gamma, l, g)
+    return rx, ry, state[-1]
+
+
+def lintel_history(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
+                   psi: np.ndarray, psi_dot: np.ndarray, excitation,
+                   model_args: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(F_x, F_y, side)`` at every sample of a run (:func:`lintel_force`);
+    arguments as in :func:`reaction_history`."""
+    b, h, mu, gamma, j, l, g = model_args
+    state = _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args)
+    fx, fy = lintel_force_from_accelerations(*state, b, h, mu, gamma, l, g)
+    return fx, fy, state[-1]
 
 
 def _extrema(rx: np.ndarray, ry: np.ndarray, sides: np.ndarray, weight: float
@@ -180,10 +231,18 @@ def _extrema(rx: np.ndarray, ry: np.ndarray, sides: np.ndarray, weight: float
     return min_ry, float(np.max(np.abs(rx_r) / ry_r))
 
 
+def _first_pull(t: np.ndarray, normal: np.ndarray) -> float | None:
+    """Time of the first sample with ``normal <= 0`` (None if there is none)."""
+    hit = np.flatnonzero(normal <= 0.0)
+    return float(t[hit[0]]) if hit.size else None
+
+
 def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray,
                          psi: np.ndarray, psi_dot: np.ndarray, excitation,
                          model_args: tuple, alpha: float, overturned: bool) -> dict:
-    """Whether the model's contact assumptions hold along a sampled run.
+    """Whether the model's contact assumptions hold along a sampled run: the
+    columns on the ground (this module) and the lintel on the column tops
+    (:mod:`analytic.contact_forces`).
 
     The window is the part of the run that decides the verdict: all of it,
     except that an overturned run is cut at its last sample with ``|theta| <=
@@ -215,16 +274,31 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
         still; <= 0: the columns would hop).  ``max_friction_demand``: largest
         ``|R_x|/R_y`` over the window's rocking samples (0 if none rocks, inf if
         one has ``R_y <= 0``): the Coulomb coefficient the model silently
-        assumes.  ``model_valid``: ``min_vertical_reaction > 0``.
-        ``reaction_window_end`` [s], ``min_vertical_reaction_to_verdict`` and
-        ``max_friction_demand_to_verdict`` (whole run).  Values are taken at
-        the samples only (the ``sample_dt`` grid plus event instants), so an
-        extremum between two samples can be missed by up to one grid step.
+        assumes.  ``min_lintel_normal``: least ``F_y`` of the column tops on the
+        lintel, in units of the lintel and bob's weight ``(mu + gamma) g`` (1 at
+        rest with the pendulum still; <= 0: the lintel would be thrown off).
+        ``max_lintel_friction_demand``: largest ``|F_x|/F_y`` over all the
+        window's samples, rest included (inf if one has ``F_y <= 0``); both are
+        None without a lintel and pendulum (``mu + gamma = 0``: no load on the
+        tops).  ``model_valid``: no pull at either contact
+        (``min_vertical_reaction > 0`` and ``min_lintel_normal > 0``); the
+        friction demands are left to the caller, who knows the coefficient
+        (:func:`~analytic.contact_forces.violations`, :func:`check_model`).
+        ``ground_pull_time`` and ``lintel_pull_time`` [s]: first sample of the
+        window with a normal force ``<= 0`` (None if none).  ``reaction_window_end`` [s],
+        ``min_vertical_reaction_to_verdict``, ``max_friction_demand_to_verdict``,
+        ``min_lintel_normal_to_verdict`` and ``max_lintel_friction_demand_to_verdict``
+        (whole run).  Values are taken at the samples only (the ``sample_dt``
+        grid plus event instants), so an extremum between two samples can be
+        missed by up to one grid step.
     """
     b, h, mu, gamma, j, l, g = model_args
     if len(t) == 0:
         raise ValueError("t must hold at least one sample, got an empty trajectory")
-    rx, ry, sides = reaction_history(t, theta, theta_dot, psi, psi_dot, excitation, model_args)
+    t = np.asarray(t, dtype=float)
+    state = _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args)
+    rx, ry = reaction_from_accelerations(*state, b, h, mu, gamma, l, g)
+    sides = state[-1]
     weight = system_mass(mu, gamma) * g
     end = len(t)
     if overturned:
@@ -232,7 +306,78 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
         end = int(inside[-1]) + 1 if inside.size else 1
     min_ry, demand = _extrema(rx[:end], ry[:end], sides[:end], weight)
     min_all, demand_all = _extrema(rx, ry, sides, weight)
-    return {"min_vertical_reaction": min_ry, "max_friction_demand": demand,
-            "model_valid": bool(min_ry > 0.0), "reaction_window_end": float(t[end - 1]),
-            "min_vertical_reaction_to_verdict": min_all,
-            "max_friction_demand_to_verdict": demand_all}
+    out = {"min_vertical_reaction": min_ry, "max_friction_demand": demand,
+           "reaction_window_end": float(t[end - 1]),
+           "min_vertical_reaction_to_verdict": min_all,
+           "max_friction_demand_to_verdict": demand_all,
+           "ground_pull_time": _first_pull(t[:end], ry[:end])}
+    lintel = {"min_lintel_normal": None, "max_lintel_friction_demand": None,
+              "min_lintel_normal_to_verdict": None,
+              "max_lintel_friction_demand_to_verdict": None, "lintel_pull_time": None}
+    if lintel_load(mu, gamma) > 0.0:
+        fx, fy = lintel_force_from_accelerations(*state, b, h, mu, gamma, l, g)
+        top_weight = lintel_load(mu, gamma) * g
+        lintel["min_lintel_normal"], lintel["max_lintel_friction_demand"] = lintel_extrema(
+            fx[:end], fy[:end], top_weight)
+        (lintel["min_lintel_normal_to_verdict"],
+         lintel["max_lintel_friction_demand_to_verdict"]) = lintel_extrema(fx, fy, top_weight)
+        lintel["lintel_pull_time"] = _first_pull(t[:end], fy[:end])
+    out.update(lintel)
+    out["model_valid"] = bool(min_ry > 0.0 and (lintel["min_lintel_normal"] is None
+                                                 or lintel["min_lintel_normal"] > 0.0))
+    return out
+
+
+def check_model(scene, pulse, friction: float | None = None) -> dict:
+    """Does the analytic model hold for ``pulse``?  One accurate run
+    (:func:`analytic.simulate.simulate`, default Settings) and its contact checks.
+
+    Parameters
+    ----------
+    scene : Scene
+    pulse : Pulse or SampledRecord
+    friction : float, optional
+        An engine's Coulomb coefficient (> 0), compared against both friction
+        demands; None checks the normal forces only.
+
+    Returns
+    -------
+    dict
+        ``ground_min_normal`` (fraction of the total weight),
+        ``ground_max_friction``, ``lintel_min_normal`` (fraction of the lintel
+        and bob's weight), ``lintel_max_friction`` (None without lintel and
+        pendulum), ``valid`` (no pull at either contact and, if ``friction`` is
+        given, no demand above it), ``reason`` (the first of
+        :func:`~analytic.contact_forces.violations`, "" when valid),
+        ``violations`` (all of them), ``verdict`` (the run's status) and
+        ``friction``.  The window is the verdict's (:func:`validity_diagnostics`):
+        up to the last ``|theta| <= alpha`` of an overturning run, past which the
+        fall is beyond the model.
+
+    Examples
+    --------
+    >>> from analytic.excitation import Pulse
+    >>> from scenes import load_scene
+    >>> check_model(load_scene("fig5"), Pulse(64.0, 24.0))["reason"]  # doctest: +ELLIPSIS
+    'lintel normal force -0.26 of its weight (lintel + bob) at t = ...'
+    """
+    if friction is not None:
+        if isinstance(friction, bool) or not isinstance(friction, numbers.Real):
+            raise TypeError(f"friction must be a real number or None, "
+                            f"got {type(friction).__name__}")
+        if not (math.isfinite(friction) and friction > 0.0):
+            raise ValueError(f"friction must be finite and > 0, got {friction!r}")
+        friction = float(friction)
+    from .simulate import simulate  # simulate imports this module
+    tr = simulate(scene, pulse)
+    d = tr.diagnostics
+    if "model_valid" not in d:  # non-finite samples: nothing to judge
+        raise ValueError(f"the analytic run ended {tr.verdict.status!r} with non-finite "
+                         f"samples; its contact forces cannot be computed")
+    found = violations(d, friction)
+    return {"ground_min_normal": d["min_vertical_reaction"],
+            "ground_max_friction": d["max_friction_demand"],
+            "lintel_min_normal": d["min_lintel_normal"],
+            "lintel_max_friction": d["max_lintel_friction_demand"],
+            "valid": not found, "reason": found[0] if found else "",
+            "violations": found, "verdict": tr.verdict.status, "friction": friction}

@@ -402,8 +402,9 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         gives two samples at the same time, before and after), the events
         (uplift, impact, rest, overturn), the verdict and diagnostics
         (``n_steps``, ``n_rhs_evals``, ``n_segments``; and, from the samples, the
-        ground-reaction checks of :func:`~analytic.reactions.validity_diagnostics`:
-        ``min_vertical_reaction``, ``max_friction_demand``, ``model_valid``, ...).
+        contact checks of :func:`~analytic.reactions.validity_diagnostics` at the
+        ground and at the lintel: ``min_vertical_reaction``, ``max_friction_demand``,
+        ``min_lintel_normal``, ``max_lintel_friction_demand``, ``model_valid``, ...).
     """
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")

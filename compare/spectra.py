@@ -96,9 +96,10 @@ def monotone_above(scene, omega: float, a_ref: float, span: float, n: int = 12) 
 
 def model_valid_at(scene, omega: float, amplitude: float) -> bool:
     """True when the analytic model's own assumptions hold for the pulse
-    ``(amplitude, omega)``: the ground's vertical reaction stays positive up to
-    the verdict (or to ``|theta| = alpha`` for an overturning run), see
-    :mod:`analytic.reactions`.  Where it turns negative the real columns hop,
+    ``(amplitude, omega)``: the vertical forces of the ground on the columns and
+    of the column tops on the lintel stay positive up to the verdict (or to
+    ``|theta| = alpha`` for an overturning run), see :mod:`analytic.reactions`.
+    Where one turns negative the real columns hop or the lintel is thrown off,
     the engines (which let them) are no longer comparable to the model, and an
     engine-vs-model threshold error would blame the engine for the model."""
     from analytic.excitation import Pulse
@@ -160,7 +161,7 @@ def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, floa
     range, each at least ``jump_margin`` from every mode jump and, when ``scene``
     is given, with a monotone model verdict over twice the bisection bracket
     above the threshold (:func:`monotone_above`) and a valid model there (no
-    negative ground reaction, :func:`model_valid_at`)."""
+    pull at the ground or at the lintel, :func:`model_valid_at`)."""
     n = config.n_frequencies
     if n <= 0:
         return []
@@ -171,7 +172,7 @@ def choose_frequencies(spec: dict, config, scene=None) -> list[tuple[float, floa
             and all(abs(w - wj) >= config.jump_margin for wj in jump_ws)]
     if scene is not None:
         cand = [c for c in cand if monotone_above(scene, c[0], c[1], 2.0 * config.rel_bracket)]
-        # The engines are judged only where the model itself is valid (no hop).
+        # The engines are judged only where the model itself is valid (no hop, no lintel lift).
         cand = [c for c in cand
                 if model_valid_at(scene, c[0], c[1] * (1.0 + 2.0 * config.rel_bracket))]
     if len(cand) <= n:

@@ -232,9 +232,12 @@ def test_strong_pulse_overturns_as_in_the_model(run_analytic, name, amplitude, o
     if tr.verdict.status == "collapsed":
         assert "out of step" in tr.verdict.reason or "slid" in tr.verdict.reason
         assert tr.verdict.time > (tr.t[np.argmax(np.abs(tr.theta) >= 0.5 * scene.alpha)])
-    if not ref.diagnostics["model_valid"]:
+    if ref.diagnostics["min_vertical_reaction"] <= 0.0:
         # 60 m/s^2 at 20 rad/s: the model's columns would hop before alpha
-        # (negative vertical reaction); only the verdict is comparable.
+        # (negative vertical reaction); only the verdict is comparable.  (At
+        # 45 m/s^2, 16 rad/s the model's lintel would lift off the columns from
+        # 0.164 s, min normal -0.34 / -0.31 of its weight, so model_valid is
+        # False there too; the engine still follows the model up to alpha.)
         return
     # Up to alpha the engine follows the model: measured max 3.6e-3 (bare) and
     # 4.0e-3 alpha (pendulum); 1e-2 alpha leaves room for the contact compliance

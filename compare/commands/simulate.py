@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from analytic.contact_forces import violations
+
 from ._common import (add_engine_arg, add_pulse_args, add_scene_args, clean_nan, print_json,
                       pulse_from_args, scene_from_args)
 
@@ -100,10 +102,8 @@ def run(args: argparse.Namespace) -> int:
           f"max |theta| = {traj.max_abs_theta:.4g} rad (alpha = {scene.alpha:.4g}), "
           f"t_end = {traj.t[-1]:.3f} s, wall {traj.wall_time:.3f} s")
     if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
-        d = traj.diagnostics
-        print(f"warning: the analytic model is not valid along this run: the ground would have "
-              f"to pull (min vertical reaction {d['min_vertical_reaction']:.3g} x weight), "
-              f"the columns would hop; engines may disagree for that reason")
+        print(f"warning: the analytic model is not valid along this run: "
+              f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")
     if args.csv:
         print(f"wrote {args.csv}")
     if args.plot:
