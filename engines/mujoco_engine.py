@@ -29,7 +29,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import mujoco
 
@@ -104,11 +104,11 @@ class Settings:
     psi0: float = 0.0
     base_motion: str = "gravity"
     sample_every: int = 20
-    monitor: MonitorSettings = field(default_factory=MonitorSettings)
+    monitor: MonitorSettings = MonitorSettings(impact_window=5e-3)
     friction: float = 10.0
     timeconst_steps: float = 10.0
     timeconst: float | None = None
-    dampratio: float = 1.0
+    dampratio: float = 3.0
     solimp: tuple[float, float, float, float, float] = (0.9, 0.95, 0.001, 0.5, 2.0)
     cone: str = "elliptic"
     impratio: float = 10.0
