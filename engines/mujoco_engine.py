@@ -172,6 +172,12 @@ def _validate(scene, excitation, s: Settings) -> None:
     if s.timeconst is not None:
         real("timeconst", s.timeconst, 0.0, 10.0)
     real("dampratio", s.dampratio, 0.0, 100.0)
+    if not (isinstance(s.solimp, tuple) and len(s.solimp) == 5):
+        raise ValueError(f"mujoco settings: solimp must be a tuple (dmin, dmax, width, midpoint, "
+                         f"power), got {s.solimp!r}")
+    for label, value, lo, hi in zip(("dmin", "dmax", "width", "midpoint", "power"), s.solimp,
+                                    (0.0, 0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0, 100.0)):
+        real(f"solimp {label}", value, lo, hi, lo_open=label != "power")
     choice("cone", s.cone, CONES)
     real("impratio", s.impratio, 0.0, 1e6)
     integer("iterations", s.iterations, 1, 100_000)

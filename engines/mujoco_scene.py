@@ -109,9 +109,10 @@ def mjcf(scene, s: Settings, friction: float) -> str:
         ground = f'<geom name="ground" type="plane" size="{_vec(g_half[0], g_half[1], 1.0)}" ' \
                  f'pos="{_vec(0.5 * span, 0.0, 0.0)}"/>'
     col_geom = f'<geom type="box" size="{_vec(0.5 * b, 0.5 * depth, 0.5 * h)}"/>'
-    ix, _, iz = _box_inertia(scene.m1, b, depth, h)
-    # J_G comes from the scene (it may differ from the uniform box's value).
-    col_inertia = (ix, scene.inertia_J_G, iz)
+    # J_G comes from the scene (it may differ from the uniform box's value).  Only
+    # the hinge axis (y) turns, so the other two principal inertias never enter
+    # the dynamics: equal to J_G, they satisfy MuJoCo's triangle inequality for any J_G.
+    col_inertia = (scene.inertia_J_G,) * 3
     bodies = [_planar_body(name, (x_left + 0.5 * b, 0.5 * h), scene.m1, col_inertia, col_geom)
               for name, x_left in (("column_left", 0.0), ("column_right", b + d))]
     if scene.mu > 0.0:
