@@ -106,10 +106,10 @@ class Settings:
     sample_every: int = 20
     monitor: MonitorSettings = MonitorSettings(impact_window=5e-3)
     friction: float = 10.0
-    timeconst_steps: float = 10.0
+    timeconst_steps: float = 3.0
     timeconst: float | None = None
     dampratio: float = 3.0
-    solimp: tuple[float, float, float, float, float] = (0.9, 0.95, 0.001, 0.5, 2.0)
+    solimp: tuple[float, float, float, float, float] = (0.99, 0.99, 0.001, 0.5, 2.0)
     cone: str = "elliptic"
     impratio: float = 10.0
     iterations: int = 100

@@ -236,5 +236,5 @@ def test_version_and_settings_carried_into_the_trajectory():
     tr = me.simulate(load_scene("fig5"), Pulse(4.0, 9.0), me.Settings(t_max=0.05))
     assert tr.backend == me.NAME == "mujoco"
     assert tr.settings["engine_version"] == f"mujoco {mujoco.__version__}"
-    assert tr.settings["timeconst_effective"] == pytest.approx(1e-3)
+    assert tr.settings["timeconst_effective"] == pytest.approx(3e-4)
     assert tr.diagnostics["steps"] == 500
