@@ -39,10 +39,11 @@ BACKENDS: dict[str, str] = {
     "analytic-fast": "analytic.fast",
     "pybullet": "engines.pybullet_engine",
     "pymunk": "engines.pymunk_engine",
+    "mujoco": "engines.mujoco_engine",
 }
 
 # The physics engines proper (what the comparison layer validates).
-ENGINES: tuple[str, ...] = ("pybullet", "pymunk")
+ENGINES: tuple[str, ...] = ("pybullet", "pymunk", "mujoco")
 
 
 def backend_names() -> tuple[str, ...]:
