@@ -145,9 +145,12 @@ def _iterations(settings) -> int | None:
 
 
 def _with_iterations(engine, settings, n):
-    # Each engine names its own solver-iteration field; the contract exposes the value.
-    name = "iterations" if engine == "pymunk" else "solver_iterations"
-    return configure(engine, settings, **{name: n})
+    # Each engine names its own solver-iteration field; the contract exposes the value
+    # as the attribute solver_iterations (a field, or a property over 'iterations').
+    import dataclasses
+    names = {f.name for f in dataclasses.fields(settings)}
+    return configure(engine, settings,
+                     **{"solver_iterations" if "solver_iterations" in names else "iterations": n})
 
 
 # Noise levels of the engines' contact diagnostics while the model is valid

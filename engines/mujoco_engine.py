@@ -33,22 +33,22 @@ without gap makes contacts act at a distance).
 """
 from __future__ import annotations
 
-import dataclasses
-import math
-import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 
-from analytic.trajectory import OverturnCriterion, Trajectory
+from analytic.options import check_real
+from analytic.trajectory import Trajectory
 from engines import mujoco_scene as ms
-from engines._common import MonitorSettings, RunMonitor, required_friction
+from engines._common import MonitorSettings, required_friction
+from engines.base import BASE_MOTIONS, EngineSettings, simulate_world
 
 __all__ = ["NAME", "Settings", "simulate", "version", "BASE_MOTIONS", "INTEGRATORS", "CONES",
            "SOLVERS"]
 
 NAME = "mujoco"
-BASE_MOTIONS = ("gravity", "ground")
+CAPABILITIES = frozenset({"time_step", "solver_iterations", "moving_ground", "initial_tilt",
+                          "trajectory"})
 INTEGRATORS = ("Euler", "implicitfast", "implicit", "RK4")
 CONES = ("elliptic", "pyramidal")
 SOLVERS = ("Newton", "CG", "PGS")
@@ -60,7 +60,7 @@ def version() -> str:
 
 
 @dataclass(frozen=True)
-class Settings:
+class Settings(EngineSettings):
     """Numerical settings of a MuJoCo run; defaults are the calibrated ones.
 
     Parameters
@@ -133,14 +133,7 @@ class Settings:
     error within 0.13 %, median 0.02 %.  Details in docs/mujoco.md.
     """
 
-    criterion: OverturnCriterion = OverturnCriterion()
-    t_max: float | None = None
-    dt: float = 1e-4
-    theta0: float = 0.0
-    psi0: float = 0.0
-    base_motion: str = "gravity"
-    sample_every: int = 20
-    monitor: MonitorSettings = MonitorSettings(impact_window=5e-3)
+    monitor: MonitorSettings = field(default_factory=lambda: MonitorSettings(impact_window=5e-3))
     friction: float = 10.0
     timeconst_steps: float = 3.0
     timeconst: float | None = None
@@ -152,9 +145,17 @@ class Settings:
     solver: str = "Newton"
     integrator: str = "Euler"
 
+    @property
+    def solver_iterations(self) -> int:
+        """The contract's name for ``iterations`` (convergence studies double it)."""
+        return self.iterations
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _check_own(self)
+
     def describe(self) -> dict:
-        out = dataclasses.asdict(self)
-        out["criterion"] = self.criterion.describe()
+        out = super().describe()
         out["timeconst_effective"] = max(self.effective_timeconst(), 2.0 * self.dt)
         return out
 
@@ -163,53 +164,26 @@ class Settings:
         return self.timeconst if self.timeconst is not None else self.timeconst_steps * self.dt
 
 
-def _validate(scene, excitation, s: Settings) -> None:
-    """Check ``s`` before any model is built; ValueError naming the field."""
-    if not isinstance(s, Settings):
-        raise ValueError(f"mujoco settings must be engines.mujoco_engine.Settings, "
-                         f"got {type(s).__name__}")
-
+def _check_own(s: Settings) -> None:
+    """MuJoCo's own fields, at construction; ValueError naming the field."""
     def real(name, value, lo, hi, lo_open=True):
-        ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
-              and math.isfinite(value) and (value > lo if lo_open else value >= lo)
-              and value <= hi)
-        if not ok:
-            left = "(" if lo_open else "["
-            raise ValueError(f"mujoco settings: {name} must be finite in {left}{lo:g}, {hi:g}], "
-                             f"got {value!r}")
+        check_real("mujoco Settings", name, value, lo, hi, lo_open=lo_open)
 
     def integer(name, value, lo, hi):
         if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-            raise ValueError(f"mujoco settings: {name} must be an integer in [{lo}, {hi}], "
+            raise ValueError(f"mujoco Settings: {name} must be an integer in [{lo}, {hi}], "
                              f"got {value!r}")
 
     def choice(name, value, allowed):
         if value not in allowed:
-            raise ValueError(f"mujoco settings: {name} must be one of {allowed}, got {value!r}")
+            raise ValueError(f"mujoco Settings: {name} must be one of {allowed}, got {value!r}")
 
-    if not isinstance(s.criterion, OverturnCriterion):
-        raise ValueError(f"mujoco settings: criterion must be an OverturnCriterion, "
-                         f"got {type(s.criterion).__name__}")
-    if not isinstance(s.monitor, MonitorSettings):
-        raise ValueError(f"mujoco settings: monitor must be a MonitorSettings, "
-                         f"got {type(s.monitor).__name__}")
-    real("dt", s.dt, 0.0, 0.1)
-    if s.t_max is not None:
-        real("t_max", s.t_max, 0.0, 1e5)
-    choice("base_motion", s.base_motion, BASE_MOTIONS)
-    integer("sample_every", s.sample_every, 1, 10_000)
-    limit = min(s.criterion.threshold(scene.alpha), 0.5 * math.pi)
-    if not (isinstance(s.theta0, (int, float)) and math.isfinite(s.theta0)
-            and abs(s.theta0) < limit):
-        raise ValueError(f"mujoco settings: theta0 must be in (-{limit:.4g}, {limit:.4g}) rad, "
-                         f"got {s.theta0!r}")
-    real("psi0", s.psi0, -math.pi, math.pi, lo_open=False)
     real("timeconst_steps", s.timeconst_steps, 0.0, 1e6)
     if s.timeconst is not None:
         real("timeconst", s.timeconst, 0.0, 10.0)
     real("dampratio", s.dampratio, 0.0, 100.0)
     if not (isinstance(s.solimp, tuple) and len(s.solimp) == 5):
-        raise ValueError(f"mujoco settings: solimp must be a tuple (dmin, dmax, width, midpoint, "
+        raise ValueError(f"mujoco Settings: solimp must be a tuple (dmin, dmax, width, midpoint, "
                          f"power), got {s.solimp!r}")
     for label, value, lo, hi in zip(("dmin", "dmax", "width", "midpoint", "power"), s.solimp,
                                     (0.0, 0.0, 0.0, 0.0, 1.0), (1.0, 1.0, 1.0, 1.0, 100.0)):
@@ -219,15 +193,18 @@ def _validate(scene, excitation, s: Settings) -> None:
     integer("iterations", s.iterations, 1, 100_000)
     choice("solver", s.solver, SOLVERS)
     choice("integrator", s.integrator, INTEGRATORS)
+
+
+def _validate(scene, excitation, s: Settings) -> None:
+    """Checks that need the scene, before any model is built."""
+    if not isinstance(s, Settings):
+        raise TypeError(f"mujoco settings must be engines.mujoco_engine.Settings, "
+                        f"got {type(s).__name__}")
     if scene.mu == 0.0 and scene.has_pendulum:
         raise ValueError("mujoco: mu must be > 0 when gamma > 0 (a massless lintel, which the "
                          "analytic model allows, cannot carry the pendulum hinge in an engine)")
-    real("friction", s.friction, 0.0, 1e3)
-    need = required_friction(scene, excitation)
-    if s.friction < need:
-        raise ValueError(f"mujoco settings: friction must be >= {need:.4g} for rocking without "
-                         f"sliding in this scene and excitation (see required_friction), "
-                         f"got {s.friction!r}")
+    s.check_scene(scene)
+    s.check_friction(s.friction, scene, excitation)
 
 
 def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
@@ -261,25 +238,12 @@ def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
     """
     s = settings if settings is not None else Settings()
     _validate(scene, excitation, s)
-    wall0 = time.perf_counter()
-    monitor = RunMonitor(scene, excitation, s.criterion, s.t_max, s.monitor)
-    world = ms.World(scene, excitation, s, s.friction)
-    try:
-        decided = monitor.record(0.0, *world.sample()[:5])
-        while not decided:
-            world.advance(s.sample_every)
-            t = world.step_index * s.dt
-            *state, problem = world.sample()
-            if problem is not None:
-                monitor.mark_unstable(t, problem)
-                break
-            decided = monitor.record(t, *state)
-        diagnostics = dict(world.diag, steps=world.step_index,
-                           required_friction=required_friction(scene, excitation))
-    finally:
-        world.close()
-    wall = time.perf_counter() - wall0
-    diagnostics["wall_time"] = wall
     info = s.describe()
     info["engine_version"] = version()
-    return monitor.finish(NAME, info, diagnostics, wall)
+
+    def make_world():
+        world = ms.World(scene, excitation, s, s.friction)
+        world.diag["required_friction"] = required_friction(scene, excitation)
+        return world
+
+    return simulate_world(NAME, make_world, scene, excitation, s, info)

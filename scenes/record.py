@@ -31,7 +31,7 @@ __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", 
 
 # ``--engine all``: the accurate analytic reference and every physics engine
 # (``analytic-fast`` is the same model as ``analytic``; a panel for it adds nothing).
-ALL_ENGINES = ("analytic", "pybullet", "pymunk")
+ALL_ENGINES = ("analytic", "pybullet", "pymunk", "mujoco")  # the model and every engine
 FORMATS = (".gif", ".mp4")
 # The paper integrates to at least ten pulse periods (Sec. 5.1): the default length.
 DEFAULT_PERIODS = 10.0

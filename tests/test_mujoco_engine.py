@@ -19,60 +19,17 @@ import pytest
 
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
-from compare.campaign import POINTS
 from compare.spectra import first_overturning_amplitude
 from compare.thresholds import engine_threshold
-from engines import get_backend
 from engines import mujoco_engine as me
 from engines import mujoco_scene as ms
-from engines._common import MonitorSettings
-from engines.restitution import measure_restitution
+from compare.restitution import measure_restitution
 from scenes import load_scene
 
 # Issue acceptance: 0.5 %.  Measured at the defaults (docs/mujoco.md): max
 # 0.051 % (Eq. 20 grid, 36 impacts, median 0.02 %) and 0.053 % (Eq. 19, 12
 # impacts); max 0.13 % over 216 impacts from releases at 0.3, 0.5, 0.8 alpha.
 RESTITUTION_TOL = 5e-3
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("lam", [3.0, 5.0, 7.0])
-def test_restitution_matches_eq20(lam):
-    for mu in (0.5, 1.0, 2.0):
-        scene = load_scene("fig5", lam=lam, mu=mu, gamma=0.0)
-        res = measure_restitution("mujoco", scene, 0.5 * scene.alpha)
-        assert res.complete, (lam, mu, res.status)
-        assert res.max_rel_error <= RESTITUTION_TOL, (lam, mu, res.rel_errors)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("lam", [3.0, 5.0, 7.0])
-def test_pendulum_restitution_matches_eq19(lam):
-    scene = load_scene("fig5", lam=lam)
-    res = measure_restitution("mujoco", scene, 0.5 * scene.alpha)
-    assert res.complete, res.status
-    assert max(abs(p) for p in res.psi) > 0.1  # the pendulum really swings (0.16-0.32 rad)
-    assert res.max_rel_error <= RESTITUTION_TOL, res.rel_errors
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("point", sorted(POINTS))
-@pytest.mark.parametrize("pendulum", [True, False], ids=["pendulum", "bare"])
-def test_points_a_to_d_same_verdict_and_mode_as_analytic(point, pendulum):
-    amplitude, omega = POINTS[point]
-    scene = load_scene("fig5" if pendulum else "no_pendulum")
-    ref = get_backend("analytic").simulate(scene, Pulse(amplitude, omega))
-    tr = me.simulate(scene, Pulse(amplitude, omega))
-    assert (tr.verdict.status, tr.verdict.mode) == (ref.verdict.status, ref.verdict.mode)
-    if tr.overturned:
-        # Measured within 0.9 % (bare D: 1.662 s vs 1.677 s); 5 % as for PyBullet.
-        assert tr.verdict.time == pytest.approx(ref.verdict.time, rel=0.05)
-    d = tr.diagnostics
-    # Measured: lintel rotation <= 2.1e-7 rad, penetration <= 3.7e-5 m, pivot
-    # sliding <= 6.9e-5 m (D, 2.5 g: the soft friction constraint creeps).
-    assert d["lintel_rotation_max"] < 1e-6
-    assert d["penetration_max"] < 1e-4
-    assert d["pivot_sliding_max"] < 2e-4
 
 
 @pytest.mark.slow
@@ -112,9 +69,9 @@ def test_bad_settings_raise_before_a_model_is_built(monkeypatch, changes, name):
     """friction 0.1 is below required_friction (0.41 at fig. 5 under 10 m/s^2)."""
     monkeypatch.setattr(mujoco.MjModel, "from_xml_string",
                         lambda *a, **k: pytest.fail("model built before validation"))
-    settings = dataclasses.replace(me.Settings(), **changes)
-    with pytest.raises(ValueError, match=name):
-        me.simulate(load_scene("fig5"), Pulse(10.0, 9.0), settings)
+    with pytest.raises((ValueError, TypeError), match=name):  # at construction or at the run
+        me.simulate(load_scene("fig5"), Pulse(10.0, 9.0),
+                    dataclasses.replace(me.Settings(), **changes))
 
 
 def test_massless_lintel_with_pendulum_is_refused(monkeypatch):
@@ -161,8 +118,9 @@ def test_mu_zero_builds_no_lintel_and_rocks_as_housner():
     w = ms.World(scene, Still(), me.Settings(), 10.0)
     assert w.model.nbody == 3 and w.lintel is None  # world + two columns
     res = measure_restitution("mujoco", scene, 0.5 * scene.alpha, n_impacts=2)
-    assert res.predicted[0] == pytest.approx(1.0 - 1.5 * math.sin(scene.alpha) ** 2, rel=1e-12)
-    assert res.max_rel_error <= RESTITUTION_TOL, res.rel_errors
+    assert res.impacts[0].predicted == pytest.approx(1.0 - 1.5 * math.sin(scene.alpha) ** 2,
+                                                     rel=1e-12)
+    assert res.max_rel_error <= RESTITUTION_TOL, [i.rel_error for i in res.impacts]
 
 
 @pytest.mark.parametrize("sign", [1, -1])
@@ -177,7 +135,7 @@ def test_tilted_start_rests_on_its_pivots_and_rocks_to_the_other_side(sign):
     assert np.min(w.data.contact.dist[:w.data.ncon]) == pytest.approx(0.0, abs=1e-12)
     assert w.sample()[:2] == (theta0, theta0)
     tr = me.simulate(scene, Still(), me.Settings(theta0=theta0, t_max=0.8,
-                                                 monitor=MonitorSettings(energy_rule=False)))
+                                                 early_stop=False))
     assert tr.theta[0] == theta0
     assert np.sign(tr.theta_dot[5]) == -sign
     assert tr.impacts and tr.impacts[0].side == -sign
@@ -190,28 +148,12 @@ def test_pendulum_sign_matches_eq1():
     scene = load_scene("fig5")
     psi0 = 0.1
     tr = me.simulate(scene, Still(), me.Settings(psi0=psi0, t_max=1.0,
-                                                 monitor=MonitorSettings(energy_rule=False)))
+                                                 early_stop=False))
     assert tr.max_abs_theta < 1e-4  # the trilith stayed down
     omega = math.sqrt(scene.g / scene.pendulum_length)
     # Small-angle reference: its own error is ~psi0^2/16 = 6e-4 of the phase per period.
     assert np.max(np.abs(tr.psi - psi0 * np.cos(omega * tr.t))) < 5e-3
     assert tr.psi[0] == psi0
-
-
-def test_gravity_and_ground_base_motion_agree():
-    """Point B with pendulum, 1.5 s: measured 0.063 % of the peak angle for
-    theta and 0.026 % for psi (the prescribed ground's soft friction creeps:
-    pivot sliding 43 um vs 0.3 um with the gravity load); 0.3 % leaves room."""
-    scene, pulse = load_scene("fig5"), Pulse(4.0, 9.0)
-    runs = {bm: me.simulate(scene, pulse, me.Settings(base_motion=bm, t_max=1.5))
-            for bm in me.BASE_MOTIONS}
-    a, b = runs["gravity"], runs["ground"]
-    assert np.array_equal(a.t, b.t)
-    peak = a.max_abs_theta
-    assert peak > 0.03  # it rocked
-    assert np.max(np.abs(a.theta - b.theta)) <= 3e-3 * peak
-    assert np.max(np.abs(a.psi - b.psi)) <= 3e-3 * np.max(np.abs(a.psi))
-    assert a.verdict.status == b.verdict.status == "survived"
 
 
 def test_mujoco_reset_warning_ends_the_run_as_unstable(monkeypatch):
@@ -230,10 +172,3 @@ def test_mujoco_reset_warning_ends_the_run_as_unstable(monkeypatch):
     assert "mjWARN_BADQVEL" in tr.verdict.reason
     assert tr.verdict.time == pytest.approx(0.2, abs=3e-3)
 
-
-def test_version_and_settings_carried_into_the_trajectory():
-    tr = me.simulate(load_scene("fig5"), Pulse(4.0, 9.0), me.Settings(t_max=0.05))
-    assert tr.backend == me.NAME == "mujoco"
-    assert tr.settings["engine_version"] == f"mujoco {mujoco.__version__}"
-    assert tr.settings["timeconst_effective"] == pytest.approx(3e-4)
-    assert tr.diagnostics["steps"] == 500

@@ -11,7 +11,7 @@ import importlib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-ENGINES = ("pybullet", "pymunk")
+from engines import ENGINES  # every registered engine
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
