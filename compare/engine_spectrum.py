@@ -127,16 +127,22 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
         rows.append({"dt": more.dt, "iterations": _iterations(more), "a_engine": p.a_engine,
                      "rel_error": p.rel_error})
     errs = [abs(r["rel_error"]) for r in rows[:3]]
-    if all(math.isfinite(e) for e in errs) and errs[0] > errs[1] > errs[2]:
-        # Observed order from three steps in ratio 2: e ~ C dt^p.
-        order = math.log2(errs[1] / errs[2]) if errs[2] > 0 else math.inf
-        meets = next((r["dt"] for r in rows[:3] if abs(r["rel_error"]) <= tol), None)
-        if meets is None and math.isfinite(order) and order > 0:
-            meets = rows[2]["dt"] * (tol / errs[2]) ** (1.0 / order)
-        return ("discretisation",
-                f"error {100 * errs[0]:.2g} % -> {100 * errs[1]:.2g} % -> {100 * errs[2]:.2g} % "
-                f"at dt, dt/2, dt/4 (observed order {order:.2g}); dt <= {meets:.3g} s "
-                f"meets {100 * tol:g} %", tuple(rows))
+    iters = (f"; doubled solver iterations: {100 * rows[3]['rel_error']:+.2g} %"
+             if len(rows) > 3 else "")
+    steps = ", ".join(f"{100 * r['rel_error']:+.2g} %" for r in rows[:3])
+    finer = next((r["dt"] for r in rows[1:3] if abs(r["rel_error"]) <= tol), None)
+    if finer is not None:  # the error falls within the tolerance at a smaller step
+        order = (f"observed order {math.log2(errs[1] / errs[2]):.2g}"
+                 if errs[2] > 0 and errs[1] > errs[2] else
+                 "observed order not resolved: the finer errors are at the bracket width")
+        return ("discretisation", f"error {steps} at dt, dt/2, dt/4 ({order}); dt <= {finer:.3g} s "
+                f"meets {100 * tol:g} %{iters}", tuple(rows))
+    if all(math.isfinite(e) for e in errs) and errs[0] > errs[1] > errs[2] > 0:
+        order = math.log2(errs[1] / errs[2])
+        meets = rows[2]["dt"] * (tol / errs[2]) ** (1.0 / order) if order > 0 else math.nan
+        return ("discretisation", f"error {steps} at dt, dt/2, dt/4 (observed order {order:.2g}); "
+                f"dt <= {meets:.3g} s would meet {100 * tol:g} % (extrapolated){iters}",
+                tuple(rows))
     return "contact", _contact_detail(engine, scene, omega, point, settings, kind), tuple(rows)
 
 
