@@ -30,7 +30,8 @@ def test_scene_rejects(field, value):
 
 
 def test_scene_rejects_non_numbers():
-    with pytest.raises(ValueError, match="b must be a real number"):
+    # A wrong type is a TypeError (numpy's convention), still naming the parameter.
+    with pytest.raises(TypeError, match="b must be a real number"):
         Scene(b="wide")
 
 
