@@ -45,7 +45,7 @@ import numpy as np
 
 from . import _fast_kernels as _k
 from . import fast
-from .excitation import PULSE_KINDS
+from .excitation import OMEGA_RANGE, PULSE_KINDS
 from .parameters import Scene
 from .trajectory import OverturnCriterion
 
@@ -104,6 +104,9 @@ class SpectrumSettings:
         return out
 
 
+MAX_FREQUENCIES = 100_000
+
+
 def parse_omega_range(spec: str, option: str = "--omega") -> np.ndarray:
     """``'START:STOP:STEP'`` (STOP included) or ``'W1,W2,...'`` -> frequencies [rad/s]."""
     text = str(spec).strip()
@@ -115,17 +118,25 @@ def parse_omega_range(spec: str, option: str = "--omega") -> np.ndarray:
             start, stop, step = parts
             if not all(math.isfinite(p) for p in parts) or step <= 0 or stop < start:
                 raise ValueError
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
+            n = math.floor((stop - start) / step + 1e-9) + 1
+            if n > MAX_FREQUENCIES:  # before np.arange: 1:1e4:1e-7 would need 800 GB
+                raise ValueError(f"{option} must give 1 to {MAX_FREQUENCIES} frequencies, "
+                                 f"got {n} from {spec!r}")
             values = np.round(start + step * np.arange(n), 12)
         else:
             values = np.array([float(p) for p in text.split(",")])
-    except ValueError:
+    except ValueError as exc:
+        if str(exc).startswith(option):
+            raise
         raise ValueError(f"{option} expects START:STOP:STEP with 0 < START <= STOP, STEP > 0 "
                          f"(or a comma list), got {spec!r}") from None
-    if values.size == 0 or values.size > 100_000:
-        raise ValueError(f"{option} must give 1 to 100000 frequencies, got {values.size}")
-    if not np.all(np.isfinite(values)) or np.any(values <= 0) or np.any(values > 1e4):
-        raise ValueError(f"{option}: every frequency must be in (0, 1e4] rad/s, got {spec!r}")
+    if values.size == 0 or values.size > MAX_FREQUENCIES:
+        raise ValueError(f"{option} must give 1 to {MAX_FREQUENCIES} frequencies, "
+                         f"got {values.size}")
+    lo, hi = OMEGA_RANGE
+    if not np.all(np.isfinite(values)) or np.any(values < lo) or np.any(values > hi):
+        raise ValueError(f"{option}: every frequency must be in [{lo:g}, {hi:g}] rad/s "
+                         f"(a pulse's range), got {spec!r}")
     return values
 
 

@@ -16,7 +16,9 @@ from pathlib import Path
 
 from analytic.parameters import Scene
 
-__all__ = ["load_scene", "scene_names", "scene_path", "SCENE_DIR"]
+from .ground_motion import load_record
+
+__all__ = ["load_scene", "load_record", "scene_names", "scene_path", "SCENE_DIR"]
 
 SCENE_DIR = Path(__file__).resolve().parent / "data"
 
