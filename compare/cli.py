@@ -27,9 +27,10 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+class HelpFormatter(argparse.HelpFormatter):
     """Shows every default that is a value (not None/False) as ``(default: X)``,
-    and turns reST ``literal`` markup into plain text."""
+    turns reST ``literal`` markup into plain text, and keeps the line breaks of
+    multi-line descriptions (module docstrings) while wrapping one-liners."""
 
     def _get_help_string(self, action):
         text = action.help or ""
@@ -40,7 +41,10 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         return text
 
     def _format_text(self, text):
-        return super()._format_text(_plain(text))
+        text = _plain(text)
+        if "\n" in text.strip():  # a docstring: laid out by hand
+            return argparse.RawDescriptionHelpFormatter._format_text(self, text)
+        return super()._format_text(text)
 
     def _expand_help(self, action):
         return _plain(super()._expand_help(action))
