@@ -96,14 +96,14 @@ def run(args: argparse.Namespace) -> int:
     backend = get_backend(args.engine)
     settings = _settings(backend, args.criterion, args.t_max)
     check_run_budget(args.engine, settings, excitation)
-    if args.csv:
+    if args.csv is not None:
         check_output_path(args.csv, "--csv")
-    if args.plot:
+    if args.plot is not None:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     traj = backend.simulate(scene, excitation, settings)
-    if args.csv:
+    if args.csv is not None:
         traj.to_csv(args.csv)
-    if args.plot:
+    if args.plot is not None:
         _plot(traj, scene, args.plot)
     if args.json:
         summary = traj.summary()
@@ -130,8 +130,8 @@ def run(args: argparse.Namespace) -> int:
         info(f"warning: the analytic model is not valid along this run: the ground would have "
              f"to pull (min vertical reaction {sig(d['min_vertical_reaction'], 3)} x weight), "
              f"the columns would hop; engines may disagree for that reason")
-    if args.csv:
+    if args.csv is not None:
         info(f"wrote {args.csv}")
-    if args.plot:
+    if args.plot is not None:
         info(f"wrote {args.plot}")
     return 0

@@ -107,16 +107,16 @@ def run(args: argparse.Namespace) -> int:
     omegas = parse_omega_range(args.omega, "--omega")
     settings = _settings(args)
     workers = resolve_workers(args.workers)
-    if args.csv:
+    if args.csv is not None:
         check_output_path(args.csv, "--csv")
-    if args.plot:
+    if args.plot is not None:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     spec = overturning_spectrum(scene, omegas, settings, workers=workers, progress=progress)
-    if args.csv:
+    if args.csv is not None:
         spec.to_csv(args.csv)
-    if args.plot:
+    if args.plot is not None:
         plot_spectrum(spec, args.plot)
     if args.json:
         body = spec.to_dict()
@@ -150,8 +150,8 @@ def run(args: argparse.Namespace) -> int:
     if spec.n_undecided:
         info(f"warning: {spec.n_undecided} run(s) undecided (counted as not overturned)")
     info(f"{spec.n_runs} runs in {spec.wall_time:.2f} s on {workers} worker(s)")
-    if args.csv:
+    if args.csv is not None:
         info(f"wrote {args.csv}")
-    if args.plot:
+    if args.plot is not None:
         info(f"wrote {args.plot}")
     return 0
