@@ -15,25 +15,40 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass
 
-__all__ = ["Scene", "DENSITY_STONE", "G_STANDARD"]
+__all__ = ["Scene", "DENSITY_STONE", "G_STANDARD", "LENGTH_RANGE", "MASS_RANGE",
+           "INERTIA_RATIO_RANGE", "G_RANGE"]
 
 G_STANDARD = 9.81  # m/s^2, the value the paper's a_up = g/lam plots imply
 DENSITY_STONE = 2500.0  # kg/m^3, used only to give the columns a default mass
 
 
-def _check_finite(name: str, value: float) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+# Physical ranges (documented in the Scene docstring and docs/model.md): the
+# engines are calibrated on metre-sized stone blocks; these bounds keep every
+# backend's numbers finite (a 1e-300 m column or a 1e-320 kg mass divides by
+# zero or underflows) while covering millimetre models to tens-of-metres ruins.
+LENGTH_RANGE = (1e-3, 100.0)  # m: b, h = lam b, l, gap, lintel_height, depth
+MASS_RANGE = (1e-6, 1e10)  # kg: one column; contains the stone default at every size
+INERTIA_RATIO_RANGE = (0.1, 10.0)  # J_G over the uniform rectangle's m1 (b^2 + h^2)/12
+G_RANGE = (0.1, 100.0)  # m/s^2: from small moons to well past Jupiter
+
+
+def _check_finite(name: str, value) -> float:
+    """``value`` as a float; ``TypeError`` for non-numbers (str, bool, None),
+    ``ValueError`` for NaN/inf, both naming the parameter."""
+    # bool is an int subclass (b=True would be stored as 1 m); str would reach numba.
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {value!r} "
+                        f"({type(value).__name__})")
+    value = float(value)
     if not math.isfinite(value):
         raise ValueError(f"{name} must be finite, got {value!r}")
     return value
 
 
-def _check_range(name: str, value: float, lo: float, hi: float, *,
+def _check_range(name: str, value, lo: float, hi: float, *,
                  lo_open: bool = True, hi_open: bool = False) -> float:
     value = _check_finite(name, value)
     ok_lo = value > lo if lo_open else value >= lo
@@ -50,12 +65,20 @@ def _check_range(name: str, value: float, lo: float, hi: float, *,
 class Scene:
     """A trilith (two equal rigid columns and a translating lintel) with a pendulum.
 
+    Every value is checked at construction: ``TypeError`` for a non-number
+    (``str``, ``bool``, ``None`` where a number is needed), ``ValueError`` naming
+    the parameter and its range otherwise.  The ranges are physical, so that every
+    backend gets finite, well-scaled numbers: sizes from a millimetre to 100 m
+    (``LENGTH_RANGE``), a column mass in [1e-6, 1e10] kg (``MASS_RANGE``),
+    bounded mass and inertia ratios.
+
     Parameters
     ----------
     b : float
-        Column width [m], > 0.  Default 0.6 (the paper's Fig. 5).
+        Column width [m], in [1e-3, 100].  Default 0.6 (the paper's Fig. 5).
     lam : float
-        Column slenderness ``h/b`` [-], in [1, 100].  Default 5.
+        Column slenderness ``h/b`` [-], in [1, 100]; the height ``h = lam b``
+        must be in [1e-3, 100] m too.  Default 5.
     mu : float
         Lintel mass over one column's mass, ``m3/m1`` (Eq. 10), in [0, 100].
     gamma : float
@@ -63,27 +86,38 @@ class Scene:
         ``gamma = 0`` means no pendulum at all: no pendulum coordinate in the
         analytic model and no pendulum body in the engines.
     l : float or None
-        Pendulum length [m], > 0.  ``None`` gives the paper's ``2h/3``.
+        Pendulum length [m], in [1e-3, 100].  ``None`` gives the paper's ``2h/3``.
     column_mass : float or None
-        Mass of one column ``m1`` [kg], > 0.  ``None`` gives a stone column of
-        unit depth.  The analytic response does not depend on it (only ratios do).
+        Mass of one column ``m1`` [kg], in [1e-6, 1e10].  ``None`` gives a stone
+        column (2500 kg/m^3) of depth ``depth``, always inside that range
+        (2.5e-6 to 2.5e9 kg).  The analytic response does not depend on it.
     J_G : float or None
-        Polar inertia of one column about its centre of mass [kg m^2], > 0.
-        ``None`` gives the uniform rectangle ``m1 (b^2 + h^2) / 12``.
+        Polar inertia of one column about its centre of mass [kg m^2], within
+        [0.1, 10] times the uniform rectangle's ``m1 (b^2 + h^2) / 12``, which
+        ``None`` gives.
     gap : float or None
-        Clear distance ``d`` between the columns [m], >= 0.  ``None`` gives ``h``
-        (the columns cannot touch each other before lying on the ground).
+        Clear distance ``d`` between the columns [m], in [0, 100].  ``None``
+        gives ``h`` (the columns cannot touch each other before lying on the ground).
     lintel_height : float or None
-        Lintel thickness [m], > 0 (engines only).  ``None`` gives ``b/2``.
+        Lintel thickness [m], in [1e-3, 100] (engines only).  ``None`` gives ``b/2``.
     hinge_x : float
         Horizontal position of the pendulum hinge, measured from the middle of
-        the lintel's underside [m] (engines only).  Default 0.
+        the lintel's underside [m] (engines only), on the lintel.  Default 0.
     depth : float
-        Out-of-plane depth of every body [m], > 0 (PyBullet only).  Default 1.
+        Out-of-plane depth of every body [m], in [1e-3, 100] (PyBullet only).
+        Default 1.
     g : float
-        Gravity [m/s^2], > 0.  Default 9.81.
+        Gravity [m/s^2], in [0.1, 100].  Default 9.81.
     name : str
         A label carried into reports.
+
+    Examples
+    --------
+    >>> Scene(b=0.6, lam=5.0).h
+    3.0
+    >>> Scene(b=True)
+    Traceback (most recent call last):
+    TypeError: b must be a real number, got True (bool)
     """
 
     b: float = 0.6
@@ -101,19 +135,41 @@ class Scene:
     name: str = "custom"
 
     def __post_init__(self) -> None:
-        _check_range("b", self.b, 0.0, 1e3)
-        _check_range("lam", self.lam, 1.0, 100.0, lo_open=False)
-        _check_range("mu", self.mu, 0.0, 100.0, lo_open=False)
-        _check_range("gamma", self.gamma, 0.0, 10.0, lo_open=False)
-        _check_range("depth", self.depth, 0.0, 1e3)
-        _check_range("g", self.g, 0.0, 1e3)
-        _check_finite("hinge_x", self.hinge_x)
-        for name in ("l", "column_mass", "J_G", "lintel_height"):
-            value = getattr(self, name)
-            if value is not None:
-                _check_range(name, value, 0.0, math.inf)
+        lo, hi = LENGTH_RANGE
+        # Store floats: Scene(b=1) and Scene(b=np.float32(1)) compare and hash alike.
+        checked = {
+            "b": _check_range("b", self.b, lo, hi, lo_open=False),
+            "lam": _check_range("lam", self.lam, 1.0, 100.0, lo_open=False),
+            "mu": _check_range("mu", self.mu, 0.0, 100.0, lo_open=False),
+            "gamma": _check_range("gamma", self.gamma, 0.0, 10.0, lo_open=False),
+            "depth": _check_range("depth", self.depth, lo, hi, lo_open=False),
+            "g": _check_range("g", self.g, *G_RANGE, lo_open=False),
+            "hinge_x": _check_finite("hinge_x", self.hinge_x),
+        }
+        for name in ("l", "lintel_height"):
+            if getattr(self, name) is not None:
+                checked[name] = _check_range(name, getattr(self, name), lo, hi, lo_open=False)
         if self.gap is not None:
-            _check_range("gap", self.gap, 0.0, math.inf, lo_open=False)
+            checked["gap"] = _check_range("gap", self.gap, 0.0, hi, lo_open=False)
+        if self.column_mass is not None:
+            checked["column_mass"] = _check_range("column_mass", self.column_mass,
+                                                  *MASS_RANGE, lo_open=False)
+        if self.J_G is not None:
+            checked["J_G"] = _check_finite("J_G", self.J_G)
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a str, got {self.name!r} ({type(self.name).__name__})")
+        for key, value in checked.items():
+            object.__setattr__(self, key, value)
+        if not (lo <= self.h <= hi):
+            raise ValueError(f"h = lam*b must be in [{lo:g}, {hi:g}] m, got {self.h!r} "
+                             f"(lam={self.lam:g}, b={self.b:g})")
+        if self.J_G is not None:
+            uniform = self.m1 * (self.b ** 2 + self.h ** 2) / 12.0
+            rlo, rhi = INERTIA_RATIO_RANGE
+            if not (rlo * uniform <= self.J_G <= rhi * uniform):
+                raise ValueError(f"J_G must be in [{rlo:g}, {rhi:g}] x the uniform column's "
+                                 f"m1 (b^2 + h^2)/12 = [{rlo * uniform:.4g}, {rhi * uniform:.4g}] "
+                                 f"kg m^2, got {self.J_G!r}")
         half_span = 0.5 * self.lintel_length
         if abs(self.hinge_x) > half_span:
             raise ValueError(f"hinge_x must be in [-{half_span:g}, {half_span:g}] "

@@ -184,9 +184,19 @@ class Trajectory:
         return float(np.max(np.abs(self.theta))) if len(self.theta) else 0.0
 
     def summary(self) -> dict:
-        """The JSON object of ``trilith simulate --json``."""
+        """The result part of ``trilith simulate --json``.
+
+        ``engine`` names the backend (the key every JSON document uses); wall
+        times (``wall_time``, and the engines' ``diagnostics['wall_time']``) sit
+        in the last key, ``timings``, so that everything before it is identical
+        between reruns.
+        """
+        diagnostics = dict(self.diagnostics)
+        timings = {"wall_time": self.wall_time}
+        if "wall_time" in diagnostics:
+            timings["engine_wall_time"] = diagnostics.pop("wall_time")
         return {
-            "backend": self.backend,
+            "engine": self.backend,
             "status": self.verdict.status,
             "overturned": self.overturned,
             "mode": self.verdict.mode,
@@ -201,8 +211,8 @@ class Trajectory:
             "reason": self.verdict.reason,
             "events": [e.to_dict() for e in self.events],
             "settings": self.settings,
-            "diagnostics": self.diagnostics,
-            "wall_time": self.wall_time,
+            "diagnostics": diagnostics,
+            "timings": timings,
         }
 
     def to_csv(self, path) -> None:

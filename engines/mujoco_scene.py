@@ -249,7 +249,7 @@ class World:
         diagnostics are taken while both columns stand (``|theta| < alpha`` at
         every sample so far): a collapse is beyond the model.
         """
-        m, d, scene, diag = self.model, self.data, self.scene, self.diag
+        d, scene, diag = self.data, self.scene, self.diag
         qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
         (al, ar), li, pe = self.columns, self.lintel, self.pendulum
         theta_l, theta_r = qpos[al + 2], qpos[ar + 2]

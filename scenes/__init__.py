@@ -16,10 +16,11 @@ from pathlib import Path
 
 from analytic.parameters import Scene
 
+from .ground_motion import load_record
 from .points import PAPER_OUTCOMES, POINTS, point_pulse
 
-__all__ = ["load_scene", "scene_names", "scene_path", "SCENE_DIR", "POINTS", "PAPER_OUTCOMES",
-           "point_pulse"]
+__all__ = ["load_scene", "load_record", "scene_names", "scene_path", "SCENE_DIR", "POINTS",
+           "PAPER_OUTCOMES", "point_pulse"]
 
 SCENE_DIR = Path(__file__).resolve().parent / "data"
 
@@ -30,8 +31,16 @@ def scene_names() -> tuple[str, ...]:
 
 
 def _resolve(name_or_path: str | Path) -> Path:
+    if not isinstance(name_or_path, (str, Path)):
+        raise TypeError(f"scene must be a name (str) or a path (str or Path), got "
+                        f"{name_or_path!r} ({type(name_or_path).__name__})")
     candidate = Path(name_or_path)
-    if candidate.suffix == ".toml" or candidate.exists():
+    if candidate.suffix == ".toml" or candidate.exists() or candidate.is_symlink():
+        if candidate.is_dir():
+            raise ValueError(f"scene file {str(candidate)!r} is a directory, not a TOML file")
+        if candidate.exists() and not candidate.is_file():
+            raise ValueError(f"scene file {str(candidate)!r} is not a regular file "
+                             "(a FIFO, socket or device)")
         if not candidate.is_file():
             raise ValueError(f"scene file {str(candidate)!r} does not exist")
         return candidate
@@ -64,8 +73,10 @@ def _check_value(where: str, key: str, value) -> None:
 def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
     """Read a scene file and apply ``overrides`` (field name -> value).
 
-    Raises ``ValueError`` naming the file and the key for unknown keys or bad
-    values (wrong type, out of the range :class:`analytic.Scene` allows).
+    Raises ``TypeError`` when ``name_or_path`` is neither a str nor a Path,
+    ``ValueError`` naming the file and the key for unknown keys or bad values
+    in the file (wrong type, out of the range :class:`analytic.Scene` allows),
+    or naming the override when the file is valid but an override is not.
     """
     path = _resolve(name_or_path)
     try:
@@ -85,16 +96,23 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
             raise ValueError(f"{path}: unknown key {key!r}; allowed: {allowed}")
     for key in overrides:
         if key not in fields:
-            raise ValueError(f"{path} (override): unknown key {key!r}; allowed: {allowed}")
+            raise ValueError(f"override: unknown key {key!r}; allowed: {allowed}")
     for key, value in table.items():
         _check_value(str(path), key, value)
     for key, value in overrides.items():
-        _check_value(f"{path} (override)", key, value)
+        _check_value(f"override {key}={value!r}", key, value)
     values = {"name": path.stem}
     values.update(table)
-    values.update(overrides)
     try:
-        return Scene(**values)
+        scene = Scene(**values)
     except (TypeError, ValueError) as exc:
         # Scene's messages start with the field name ("b must be in ...").
         raise ValueError(f"{path}: {exc}") from None
+    if not overrides:
+        return scene
+    try:
+        return scene.replace(**overrides)
+    except (TypeError, ValueError) as exc:
+        # The file alone is valid: the override is to blame.
+        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
+        raise ValueError(f"override {shown}: {exc}") from None

@@ -220,7 +220,8 @@ def readme_commands() -> list[str]:
     text = README.read_text()
     section = text[text.index("## Watching a run"):]
     block = re.search(r"```\n(.*?)```", section, re.S).group(1)
-    return [line.strip() for line in block.splitlines() if line.strip().startswith("trilith ")]
+    lines = [line.strip().removeprefix(".venv/bin/") for line in block.splitlines()]
+    return [line for line in lines if line.startswith("trilith ")]
 
 
 def test_readme_section_has_commands():

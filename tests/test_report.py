@@ -77,10 +77,10 @@ def test_coarse_time_step_fails_a_verdict(tiny_report):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["report", "--engines", "mujoco"], "--engines"),
+    (["report", "--engine", "mujoco"], "--engine"),
     (["report", "--scene", "no_such_scene"], "unknown scene"),
     (["report", "--workers", "0"], "--workers"),
-    (["report", "--dt", "-1"], "engine_dt"),
+    (["report", "--dt", "-1"], "--dt"),
 ])
 def test_cli_bad_input_exits_2(argv, needle, capsys, tmp_path):
     assert main([*argv, "--out", str(tmp_path)]) == 2

@@ -167,7 +167,7 @@ def test_cli_json(capsys):
                  "--n-impacts", "1", "--json"])
     assert code == 0
     out = json.loads(capsys.readouterr().out)
-    for key in ("impacts", "equation", "max_rel_error", "engine", "version", "settings"):
+    for key in ("impacts", "equation", "max_rel_error", "engine", "engine_version", "settings"):
         assert key in out
     assert out["engine"] == "pymunk" and len(out["impacts"]) == 1
     assert out["settings"]["theta0"] == pytest.approx(0.5 * math.atan(1 / 4))

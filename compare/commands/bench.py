@@ -3,12 +3,18 @@
 Runs :mod:`benchmarks.bench_workprecision` from the source tree (``benchmarks/``
 is not an installed package: it lives next to ``compare/``).  Outputs go to
 ``benchmarks/out/`` unless ``--out`` says otherwise; see ``docs/benchmarks.md``.
+With ``--strict`` the exit code is 1 when a backend's default settings are
+dominated (another setting is clearly faster or more accurate, beyond the noise
+margins of ``bench_workprecision``) or a default run failed.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import math
 from pathlib import Path
+
+from ._common import add_engine_list_arg, check_output_path, info, parse_engine_list
 
 ROOT = Path(__file__).resolve().parents[2]
 from engines import ENGINES  # every registered engine
@@ -23,24 +29,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--quick", action="store_true",
                         help="the < 2 min variant (fewer points, coarser bisection)")
     parser.add_argument("--out", default=None, metavar="DIR",
-                        help="output directory [benchmarks/out]")
-    parser.add_argument("--engines", default=",".join(ENGINES),
-                        help="comma-separated engines to measure, or 'none' "
-                             f"[{','.join(ENGINES)}]")
+                        help="output directory, created if missing (default: benchmarks/out)")
+    add_engine_list_arg(parser, ENGINES, ENGINES, none_ok=True)
     parser.add_argument("--no-analytic", action="store_true",
                         help="skip the analytic paths")
+    parser.add_argument("--strict", action="store_true",
+                        help="exit with code 1 when a default setting is dominated or failed")
     return parser
-
-
-def _engines(value: str) -> tuple[str, ...]:
-    if value.strip() == "none":
-        return ()
-    names = tuple(v.strip() for v in value.split(",") if v.strip())
-    for name in names:
-        if name not in ENGINES:
-            raise ValueError(f"--engines: unknown engine {name!r}; allowed: "
-                             f"{', '.join(ENGINES)} or none")
-    return names
 
 
 def _load_bench():
@@ -48,11 +43,28 @@ def _load_bench():
     return importlib.import_module("benchmarks.bench_workprecision")
 
 
+def failed_defaults(bench, points) -> list[str]:
+    """``backend / metric`` of each default point that failed or is dominated."""
+    out = []
+    for d in (p for p in points if p.default):
+        group = [p for p in points if p.metric == d.metric
+                 and p.family.split()[0] == d.family.split()[0]]
+        if not math.isfinite(d.error):
+            out.append(f"{d.family.split()[0]} / {d.metric}: default run failed")
+        elif any(p is not d and bench._dominates(p, d) for p in group):
+            out.append(f"{d.family.split()[0]} / {d.metric}: default dominated")
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
-    engines = _engines(args.engines)  # validate before any heavy work
-    out = Path(args.out) if args.out is not None else None
-    if out is not None and out.exists() and not out.is_dir():
-        raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
+    engines = parse_engine_list(args.engine, ENGINES, none_ok=True)  # before any heavy work
+    if not engines and args.no_analytic:
+        raise ValueError("--engine none with --no-analytic leaves nothing to measure")
+    out = check_output_path(args.out, "--out", directory=True) if args.out is not None else None
     bench = _load_bench()
-    bench.run(quick=args.quick, out=out, engines=engines, analytic=not args.no_analytic)
-    return 0
+    payload = bench.run(quick=args.quick, out=out, engines=engines,
+                        analytic=not args.no_analytic, log=info)
+    failures = failed_defaults(bench, payload["points"])
+    for line in failures:
+        print(f"  FAIL {line}")
+    return 1 if (args.strict and failures) else 0

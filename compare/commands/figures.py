@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ._common import add_workers_arg, check_output_path, info, resolve_workers
+
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
@@ -13,23 +15,23 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "(with and without pendulum, mode jumps marked) over Omega = 3..30 "
                     "rad/s and write fig5.png ... fig11.png and figures.json into --out.")
     parser.add_argument("--out", default="figures", metavar="DIR",
-                        help="output directory, created if missing [figures]")
-    parser.add_argument("--workers", type=int, default=1, help="processes, in [1, 256] [1]")
+                        help="output directory, created if missing")
+    add_workers_arg(parser)
     parser.add_argument("--quick", action="store_true",
                         help="5 frequencies and coarser tolerances: a smoke run in seconds")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
+    workers = resolve_workers(args.workers)
+    check_output_path(args.out, "--out", directory=True)
     from compare.figures import FigureSettings, make_figures, quick_settings
 
-    if not (1 <= args.workers <= 256):
-        raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
     fs = quick_settings() if args.quick else FigureSettings()
-    doc = make_figures(args.out, fs, workers=args.workers, progress=sys.stderr.isatty())
+    doc = make_figures(args.out, fs, workers=workers, progress=sys.stderr.isatty())
     for name, fig in doc["figures"].items():
         print(f"{args.out}/{fig['file']}: {fig['caption']}")
-    print(f"{args.out}/figures.json: {doc['n_spectra']} spectra, {len(doc['omega'])} "
-          f"frequencies each, {doc['n_runs']} runs ({doc['n_undecided']} undecided) "
-          f"in {doc['wall_time']:.1f} s")
+    info(f"{args.out}/figures.json: {doc['n_spectra']} spectra, {len(doc['omega'])} "
+         f"frequencies each, {doc['n_runs']} runs ({doc['n_undecided']} undecided) "
+         f"in {doc['wall_time']:.1f} s")
     return 0

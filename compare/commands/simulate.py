@@ -1,4 +1,4 @@
-"""``trilith simulate``: one run of one backend under a one-sine/one-cosine pulse."""
+"""``trilith simulate``: one run of one backend under a pulse or a recorded ground motion."""
 from __future__ import annotations
 
 import argparse
@@ -6,40 +6,43 @@ import math
 
 from analytic.contact_forces import violations
 
-from ._common import (add_engine_arg, add_pulse_args, add_scene_args, clean_nan, print_json,
-                      pulse_from_args, scene_from_args)
+from ._common import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
+                      add_scene_args, check_output_path, check_run_budget, clean_nan, detail,
+                      envelope, excitation_from_args, info, print_json, scene_from_args, sig)
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "simulate",
-        help="simulate one pulse in one backend; verdict, events, optional CSV/plot",
-        description="Run the trilith under a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse "
-                    "in one backend and report the verdict (overturned or not, mode, time), "
-                    "the events and the backend's diagnostics.")
+        help="simulate one pulse (or record) in one backend; verdict, events, optional CSV/plot",
+        description="Run the trilith under a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse, "
+                    "or a recorded ground motion (--record), in one backend and report the "
+                    "verdict (overturned or not, mode, time), the events and the backend's "
+                    "diagnostics.")
     add_scene_args(parser)
-    add_pulse_args(parser, required=True)
+    add_pulse_args(parser, required=False)
+    add_record_arg(parser)
     add_engine_arg(parser)
     parser.add_argument("--criterion", choices=("topple", "alpha"), default=None,
                         help="overturned at |theta| = 1.5 rad (topple) or at alpha "
-                             "[the backend's default: topple]")
-    parser.add_argument("--t-max", type=float, default=None,
-                        help="fixed run length [s], > 0; default: until the verdict is "
-                             "decided exactly (docs/overturning.md)")
+                             "(default: the backend's, topple)")
+    parser.add_argument("--t-max", type=float, default=None, metavar="S",
+                        help="fixed run length [s], > 0 (default: until the verdict is "
+                             "decided exactly, docs/overturning.md)")
     parser.add_argument("--json", action="store_true",
-                        help="print the trajectory summary as strict JSON")
+                        help="print the inputs and the trajectory summary as strict JSON")
     parser.add_argument("--csv", metavar="FILE", default=None,
                         help="write t, theta, theta_dot, psi, psi_dot samples")
     parser.add_argument("--plot", metavar="FILE.png", default=None,
-                        help="write theta(t)/alpha and psi(t) (PNG)")
+                        help="write theta(t)/alpha and psi(t) (PNG, PDF or SVG)")
     return parser
 
 
 def _settings(name: str, criterion: str | None, t_max: float | None):
     """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied."""
     from engines import configure
-    if t_max is not None and not (math.isfinite(t_max) and t_max > 0.0):
-        raise ValueError(f"--t-max must be a finite time > 0 s, got {t_max!r}")
+    if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
+        raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
     options = {}
     if criterion is not None:  # configure keeps the backend's topple angle
         options["criterion"] = criterion
@@ -74,38 +77,58 @@ def _plot(traj, scene, path: str) -> None:
     plt.close(fig)
 
 
+def _describe_excitation(excitation) -> str:
+    d = excitation.describe()
+    if d["type"] == "pulse":
+        return (f"{d['kind']} pulse A = {sig(d['amplitude'])} m/s^2, "
+                f"Omega = {sig(d['omega'])} rad/s")
+    return (f"record {d['label']} ({d['n_samples']} samples, {sig(d['end_time'])} s, "
+            f"peak {sig(d['peak'])} m/s^2)")
+
+
 def run(args: argparse.Namespace) -> int:
     from engines import get_backend
 
+    # Every check before the run: scene, excitation, engine, settings, budget, outputs.
     scene = scene_from_args(args)
-    pulse = pulse_from_args(args)
+    excitation = excitation_from_args(args)
     backend = get_backend(args.engine)
     settings = _settings(args.engine, args.criterion, args.t_max)
-    traj = backend.simulate(scene, pulse, settings)
-    if args.csv:
+    check_run_budget(args.engine, settings, excitation)
+    if args.csv is not None:
+        check_output_path(args.csv, "--csv")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    traj = backend.simulate(scene, excitation, settings)
+    if args.csv is not None:
         traj.to_csv(args.csv)
-    if args.plot:
+    if args.plot is not None:
         _plot(traj, scene, args.plot)
     if args.json:
-        print_json(clean_nan(traj.summary()))
+        summary = traj.summary()
+        timings = summary.pop("timings")
+        inputs = {"scene": scene.to_dict(), "excitation": excitation.describe(),
+                  "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max}
+        body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
+        print_json(clean_nan(envelope("simulate", inputs, body, timings)))
         return 0
     v = traj.verdict
-    print(f"{traj.backend}: scene {scene.name} (lam={scene.lam:g}, b={scene.b:g} m, "
-          f"mu={scene.mu:g}, gamma={scene.gamma:g}), {pulse.kind} pulse "
-          f"A={pulse.amplitude:g} m/s^2, Omega={pulse.omega:g} rad/s")
+    print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
+          f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}")
     line = f"verdict: {v.status}"
     if v.overturned:
         line += f" ({v.mode}) at t = {v.time:.4f} s"
     print(line + (f" -- {v.reason}" if v.reason else ""))
     up = traj.uplift_time
     print(f"uplift: {'none' if up is None else f'{up:.4f} s'}, impacts: {traj.n_impacts}, "
-          f"max |theta| = {traj.max_abs_theta:.4g} rad (alpha = {scene.alpha:.4g}), "
-          f"t_end = {traj.t[-1]:.3f} s, wall {traj.wall_time:.3f} s")
+          f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "
+          f"t_end = {traj.t[-1]:.3f} s")
+    detail(f"engine {backend.version()}, wall time {traj.wall_time:.3f} s")
     if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
-        print(f"warning: the analytic model is not valid along this run: "
-              f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")
-    if args.csv:
-        print(f"wrote {args.csv}")
-    if args.plot:
-        print(f"wrote {args.plot}")
+        info(f"warning: the analytic model is not valid along this run: "
+             f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")
+    if args.csv is not None:
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        info(f"wrote {args.plot}")
     return 0

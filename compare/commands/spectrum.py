@@ -5,10 +5,12 @@ import argparse
 import math
 import sys
 
-from ._common import (add_scene_args, clean_nan, parse_omega_range, print_json,
-                      scene_from_args)
+from . import _common
+from ._common import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
+                      clean_nan, envelope, parse_omega_range, info, print_json, resolve_workers, scene_from_args)
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
+ENGINE = "analytic-fast"  # the spectra's backend (compiled model, same verdicts)
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -22,26 +24,27 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "Delta = 100 (A_yp - A_np)/A_np and the overturning modes.")
     add_scene_args(parser)
     parser.add_argument("--pulse", choices=("sine", "cosine"), default="sine",
-                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse [sine]")
+                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
     parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
-                        help=f"frequencies [rad/s], STOP included, or a comma list "
-                             f"[{DEFAULT_OMEGA}]")
-    parser.add_argument("--tol", type=float, default=None,
-                        help="bisection resolution of the amplitude [m/s^2] [0.01]")
-    parser.add_argument("--scan-step", type=float, default=None,
-                        help="scan step floor [m/s^2] (windows narrower than the step can "
-                             "be missed) [0.1]")
-    parser.add_argument("--workers", type=int, default=1, help="processes, in [1, 256] [1]")
+                        help="frequencies [rad/s] in [0.1, 1e4], STOP included, or a comma "
+                             "list; at most 100000")
+    parser.add_argument("--tol", type=float, default=None, metavar="A",
+                        help="bisection resolution of the amplitude [m/s^2], in (1e-6, 10] "
+                             "(default: 0.01)")
+    parser.add_argument("--scan-step", type=float, default=None, metavar="A",
+                        help="scan step floor [m/s^2], in (1e-4, 100]; windows narrower than "
+                             "the step can be missed (default: 0.1)")
+    add_workers_arg(parser)
     parser.add_argument("--criterion", choices=("topple", "alpha"), default="topple",
-                        help="overturned at |theta| = 1.5 rad (topple) or at alpha [topple]")
-    parser.add_argument("--t-max", type=float, default=None,
-                        help="fixed run length [s]; default: exact survival rules")
+                        help="overturned at |theta| = 1.5 rad (topple) or at alpha")
+    parser.add_argument("--t-max", type=float, default=None, metavar="S",
+                        help="fixed run length [s] (default: exact survival rules)")
     parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
                         help="analytic (the model's spectrum), or engines to bisect on the same "
-                             "grid around it: pybullet, pymunk, ... or all [analytic]")
-    parser.add_argument("--dt", type=float, default=None,
-                        help="engine time step [s], in (0, 0.01]; default: each engine's "
-                             "calibrated step")
+                             "grid around it: pybullet, pymunk, mujoco, or all")
+    parser.add_argument("--dt", type=float, default=None, metavar="S",
+                        help="engine time step [s], in (0, 0.01] (default: each engine's "
+                             "calibrated step)")
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
                              "solver iterations to classify the cause")
@@ -56,8 +59,8 @@ def _settings(args: argparse.Namespace):
     from analytic.spectrum import SpectrumSettings
     from analytic.trajectory import OverturnCriterion
 
-    if args.t_max is not None and not (math.isfinite(args.t_max) and args.t_max > 0):
-        raise ValueError(f"--t-max must be a finite time > 0 s, got {args.t_max!r}")
+    if args.t_max is not None and not (math.isfinite(args.t_max) and 0 < args.t_max <= 1e5):
+        raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {args.t_max!r}")
     if args.tol is not None and not (math.isfinite(args.tol) and 1e-6 < args.tol <= 10):
         raise ValueError(f"--tol must be in (1e-06, 10] m/s^2, got {args.tol!r}")
     if args.scan_step is not None and not (math.isfinite(args.scan_step)
@@ -101,48 +104,68 @@ def plot_spectrum(spec, path) -> None:
     plt.close(fig)
 
 
+def _number(value: float, width: int) -> str:
+    return f"{value:{width}.4g}" if math.isfinite(value) else f"{'nan':>{width}}"
+
+
 def run(args: argparse.Namespace) -> int:
+    from analytic.fast import version
     from analytic.spectrum import overturning_spectrum
 
     scene = scene_from_args(args)
     omegas = parse_omega_range(args.omega, "--omega")
     settings = _settings(args)
-    if not (1 <= args.workers <= 256):
-        raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
+    workers = resolve_workers(args.workers)
+    if args.csv is not None:
+        check_output_path(args.csv, "--csv")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
-    progress = (not args.json) and sys.stdout.isatty()
+    progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
-    spec = overturning_spectrum(scene, omegas, settings, workers=args.workers,
-                                progress=progress)
+    spec = overturning_spectrum(scene, omegas, settings, workers=workers, progress=progress)
     if engines_wanted:
-        return _run_engines(args, scene, spec, engines_wanted)
-    if args.csv:
+        return _run_engines(args, scene, spec, engines_wanted, workers)
+    if args.csv is not None:
         spec.to_csv(args.csv)
-    if args.plot:
+    if args.plot is not None:
         plot_spectrum(spec, args.plot)
     if args.json:
-        print_json(clean_nan(spec.to_dict()))
+        body = spec.to_dict()
+        timings = {"wall_time": body.pop("wall_time"), "workers": workers}
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+                  "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
+                  "scan_step": args.scan_step, "engine": ENGINE}
+        body = {"engine": ENGINE, "engine_version": version(), **body}
+        print_json(clean_nan(envelope("spectrum", inputs, body, timings)))
         return 0
-    print(f"scene {scene.name}: lam={scene.lam:g} b={scene.b:g} mu={scene.mu:g} "
-          f"gamma={scene.gamma:g}; {settings.pulse} pulse; criterion {settings.criterion.kind}, "
-          f"t_max={settings.t_max}, tol={settings.tol:g} m/s^2, scan step "
-          f"max({settings.scan_step:g}, {100 * settings.scan_rel_step:g}% A)")
-    print(f"{'Omega':>7} {'A_np':>9} {'mode_np':>13} {'A_yp':>9} {'mode_yp':>13} {'Delta%':>8}")
+    print(f"scene {scene.name}: lam = {scene.lam:.4g}, b = {scene.b:.4g} m, mu = {scene.mu:.4g}, "
+          f"gamma = {scene.gamma:.4g}; {settings.pulse} pulse; criterion "
+          f"{settings.criterion.kind}, t_max = {settings.t_max}, tol = {settings.tol:g} m/s^2, "
+          f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)")
+    print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13} {'A_yp [m/s^2]':>12} "
+          f"{'mode_yp':>13} {'Delta [%]':>9}")
     gain = spec.gain_percent
     for i, w in enumerate(spec.omega):
-        print(f"{w:7.3g} {spec.a_no_pendulum[i]:9.3f} {spec.mode_no_pendulum[i] or '-':>13} "
-              f"{spec.a_pendulum[i]:9.3f} {spec.mode_pendulum[i] or '-':>13} {gain[i]:8.1f}")
+        print(f"{w:13.4g} {_number(spec.a_no_pendulum[i], 12)} "
+              f"{spec.mode_no_pendulum[i] or '-':>13} {_number(spec.a_pendulum[i], 12)} "
+              f"{spec.mode_pendulum[i] or '-':>13} {_number(gain[i], 9)}")
     for jump in spec.mode_jumps():
-        print(f"mode jump ({jump['curve']}): {jump['mode_before']} at Omega="
-              f"{jump['omega_before']:g} -> {jump['mode_after']} at {jump['omega_after']:g}")
+        print(f"mode jump ({jump['curve']}): {jump['mode_before']} at Omega = "
+              f"{jump['omega_before']:g} rad/s -> {jump['mode_after']} at "
+              f"{jump['omega_after']:g} rad/s")
     missing = int(sum(1 for a in list(spec.a_no_pendulum) + list(spec.a_pendulum)
                       if not math.isfinite(a)))
     if missing:
-        print(f"warning: {missing} point(s) did not overturn up to a_max="
-              f"{settings.a_max:g} m/s^2 (shown as nan)")
+        info(f"warning: {missing} point(s) did not overturn up to a_max = "
+             f"{settings.a_max:g} m/s^2 (shown as nan)")
     if spec.n_undecided:
-        print(f"warning: {spec.n_undecided} run(s) undecided (counted as not overturned)")
-    print(f"{spec.n_runs} runs in {spec.wall_time:.2f} s")
+        info(f"warning: {spec.n_undecided} run(s) undecided (counted as not overturned)")
+    info(f"{spec.n_runs} runs in {spec.wall_time:.2f} s on {workers} worker(s)")
+    if args.csv is not None:
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        info(f"wrote {args.plot}")
     return 0
 
 
@@ -159,11 +182,11 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     return names
 
 
-def _run_engines(args, scene, spec, names) -> int:
+def _run_engines(args, scene, spec, names, workers: int) -> int:
     from compare import engine_spectrum as es
 
     options = {} if args.dt is None else {"dt": args.dt}
-    results = [es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=args.workers,
+    results = [es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
                                   convergence=args.convergence, **options) for name in names]
     if args.csv:
         es.write_csv(results, args.csv)

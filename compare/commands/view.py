@@ -8,8 +8,7 @@ import argparse
 
 from scenes.view import view
 
-from ._common import pulse_from_args, scene_from_args
-from .record import add_watch_args
+from .record import add_watch_args, watch_inputs
 
 
 def add_parser(subparsers) -> None:
@@ -21,7 +20,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    scene = scene_from_args(args)
-    pulse = pulse_from_args(args)
-    view(scene, pulse, args.engine, fps=args.fps, duration=args.duration, scene_arg=args.scene)
+    scene, excitation, _ = watch_inputs(args)
+    view(scene, excitation, args.engine, fps=args.fps, duration=args.duration,
+         scene_arg=args.scene)
     return 0

@@ -1,0 +1,168 @@
+"""Recorded ground motions from files: two-column CSV or PEER NGA ``.AT2``.
+
+``load_record(path)`` returns an :class:`analytic.excitation.SampledRecord`
+(linear interpolation, zero outside the record), which every backend accepts in
+place of a pulse.  Formats:
+
+* **CSV** (any suffix but ``.at2``): two columns ``t [s], a [m/s^2]`` separated by
+  a comma (or blanks); lines starting with ``#`` and one header line of column
+  names are skipped.  Times must increase strictly, from ``t >= 0``.
+* **PEER NGA** ``.AT2``: four header lines, the fourth giving ``NPTS`` and ``DT``
+  (``NPTS=  5590, DT=   .0050 SEC`` or the older ``5590   .0050   NPTS, DT``),
+  then the accelerations in g, several per line.  Sample ``k`` is at ``k DT``;
+  accelerations are converted with the standard gravity 9.80665 m/s^2.
+
+Every problem is a ``ValueError`` naming the file and, where there is one, the
+line (1-based): a non-number, a missing column, a time that does not increase,
+a non-finite value, a count that does not match ``NPTS``.  The record's own
+bounds (at most 600 s and 1e6 samples, ``|a| <= 1e4 m/s^2``) come from
+``SampledRecord``.  ``scenes/records/make_sample.py`` writes a synthetic example
+in both formats.
+"""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
+
+__all__ = ["load_record", "G_PEER"]
+
+G_PEER = 9.80665  # m/s^2: the standard gravity of the g units in PEER files
+MAX_FILE_BYTES = 64 * 2 ** 20  # a 1e6-sample record is about 25 MB of text
+_NPTS_DT = re.compile(r"NPTS\s*=\s*([0-9]+)\s*,?\s*DT\s*=\s*([0-9.eE+-]+)", re.I)
+_OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
+
+
+def _open_text(path: Path, where: str) -> list[str]:
+    if path.is_dir():
+        raise ValueError(f"{where}: {str(path)!r} is a directory, not a record file")
+    if not path.exists():
+        raise ValueError(f"{where}: file {str(path)!r} does not exist")
+    if not path.is_file():
+        raise ValueError(f"{where}: {str(path)!r} is not a regular file (a FIFO or device)")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ValueError(f"{where}: {str(path)!r} is larger than {MAX_FILE_BYTES >> 20} MB")
+    try:
+        return path.read_text().splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{where}: {str(path)!r} is not a UTF-8 text file") from None
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot read {str(path)!r} ({exc.strerror})") from None
+
+
+def _number(text: str, where: str, lineno: int, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"{where}, line {lineno}: {what} {text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{where}, line {lineno}: {what} must be finite, got {text!r}")
+    return value
+
+
+def _read_csv(lines: list[str], where: str) -> tuple[list[float], list[float]]:
+    times: list[float] = []
+    accels: list[float] = []
+    header_seen = False
+    for lineno, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        cells = [c for c in re.split(r"[,;\s]+", line) if c]
+        if not times and not header_seen and not _is_number(cells[0]):
+            header_seen = True  # one line of column names, e.g. "t,a"
+            continue
+        if len(cells) != 2:
+            raise ValueError(f"{where}, line {lineno}: expected 2 columns (t [s], a [m/s^2]), "
+                             f"got {len(cells)}")
+        t = _number(cells[0], where, lineno, "time")
+        a = _number(cells[1], where, lineno, "acceleration")
+        if times and t <= times[-1]:
+            raise ValueError(f"{where}, line {lineno}: time {t:g} s does not increase "
+                             f"(previous {times[-1]:g} s)")
+        if not times and t < 0.0:
+            raise ValueError(f"{where}, line {lineno}: the first time must be >= 0 s, got {t:g}")
+        times.append(t)
+        accels.append(a)
+        if len(times) > MAX_RECORD_SAMPLES:
+            raise ValueError(f"{where}: more than {MAX_RECORD_SAMPLES} samples")
+    if len(times) < 2:
+        raise ValueError(f"{where}: needs at least 2 samples (t [s], a [m/s^2]), got {len(times)}")
+    return times, accels
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _read_at2(lines: list[str], where: str) -> tuple[list[float], list[float]]:
+    if len(lines) < 5:
+        raise ValueError(f"{where}: a PEER .AT2 file has 4 header lines and data, "
+                         f"got {len(lines)} lines")
+    units = lines[2].upper()
+    if "UNITS OF G" in units:
+        scale = G_PEER
+    elif re.search(r"CM/S(/S|\^?2|EC/SEC|/SEC)", units):
+        scale = 0.01
+    else:
+        raise ValueError(f"{where}, line 3: units not recognised (expected 'UNITS OF G'), "
+                         f"got {lines[2].strip()!r}")
+    match = _NPTS_DT.search(lines[3]) or _OLD_NPTS_DT.search(lines[3])
+    if not match:
+        raise ValueError(f"{where}, line 4: expected 'NPTS= N, DT= S SEC', got "
+                         f"{lines[3].strip()!r}")
+    npts = int(match.group(1))
+    dt = _number(match.group(2), where, 4, "DT")
+    if not (0.0 < dt <= 1.0):
+        raise ValueError(f"{where}, line 4: DT must be in (0, 1] s, got {dt:g}")
+    if not (2 <= npts <= MAX_RECORD_SAMPLES):
+        raise ValueError(f"{where}, line 4: NPTS must be in [2, {MAX_RECORD_SAMPLES}], got {npts}")
+    accels: list[float] = []
+    for lineno, raw in enumerate(lines[4:], start=5):
+        for cell in raw.split():
+            accels.append(scale * _number(cell, where, lineno, "acceleration"))
+        if len(accels) > npts:
+            raise ValueError(f"{where}, line {lineno}: more values than NPTS = {npts}")
+    if len(accels) != npts:
+        raise ValueError(f"{where}: {len(accels)} values, but NPTS = {npts} (line 4)")
+    return [k * dt for k in range(npts)], accels
+
+
+def load_record(path, option: str | None = None) -> SampledRecord:
+    """Read a ground-acceleration record (CSV or PEER ``.AT2``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.  ``.at2`` (any case) is read as PEER NGA, anything else as CSV.
+    option : str, optional
+        The command-line option that gave the path (``'--record'``), named in errors.
+
+    Returns
+    -------
+    SampledRecord
+        Times [s] and accelerations [m/s^2], labelled with the file name.
+
+    Examples
+    --------
+    >>> rec = load_record("scenes/records/sample.csv")  # doctest: +SKIP
+    >>> rec.end_time
+    10.0
+    """
+    if not isinstance(path, (str, Path)):
+        raise TypeError(f"path must be a str or Path, got {path!r} ({type(path).__name__})")
+    path = Path(path)
+    where = f"{option} {path}" if option else str(path)
+    lines = _open_text(path, option or "record")
+    reader = _read_at2 if path.suffix.lower() == ".at2" else _read_csv
+    times, accels = reader(lines, where)
+    try:
+        return SampledRecord(tuple(times), tuple(accels), label=path.name)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
