@@ -43,8 +43,9 @@ def no_work(monkeypatch):
     import compare.commands.view
     import compare.figures
     import engines.pybullet_engine
+    import compare.restitution
+    import engines.mujoco_engine
     import engines.pymunk_engine
-    import engines.restitution
 
     def boom(*args, **kwargs):
         raise WorkStarted("work started before the input was checked")
@@ -52,11 +53,12 @@ def no_work(monkeypatch):
     for module, name in ((analytic.simulate, "simulate"), (analytic.fast, "simulate"),
                          (engines.pymunk_engine, "simulate"),
                          (engines.pybullet_engine, "simulate"),
+                         (engines.mujoco_engine, "simulate"),
                          (analytic.spectrum, "overturning_spectrum"),
                          (compare.campaign, "run_campaign"), (compare.figures, "make_figures"),
                          (compare.commands.record, "record"), (compare.commands.view, "view"),
                          (compare.commands.bench, "_load_bench"),
-                         (engines.restitution, "measure_restitution")):
+                         (compare.restitution, "measure_restitution")):
         monkeypatch.setattr(module, name, boom)
 
 
@@ -166,7 +168,7 @@ CLI_CASES = [
     (["bench", "--engine", "none", "--no-analytic"], "nothing to measure"),
     (["report", "--engine", ""], "--engine"),
     (["report", "--engine", "pymunk,pymunk"], "named twice"),
-    (["report", "--engine", "mujoco"], "unknown engine"),
+    (["report", "--engine", "havok"], "unknown engine"),
     (["report", "--dt", "1e-9"], "--dt must be in"),
     (["report", "--dt", "-1"], "--dt must be in"),
     (["report", "--workers", "0"], "--workers"),
