@@ -42,6 +42,7 @@ def parse_engines(text: str) -> tuple[str, ...]:
 
 def run(args: argparse.Namespace) -> int:
     from compare.campaign import CampaignConfig, run_campaign
+    from compare.provenance import collect
     from compare.report_html import write_report
 
     scene_path(args.scene)  # ValueError naming the scene before any work
@@ -52,11 +53,12 @@ def run(args: argparse.Namespace) -> int:
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     t0 = time.perf_counter()
     result = run_campaign(config)
-    paths = write_report(result, args.out)
+    provenance = collect(args, quick=args.quick, backends=result.versions)
+    paths = write_report(result, args.out, provenance)
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"
-          f"{len(result.verdicts)} verdicts pass, {time.perf_counter() - t0:.0f} s)",
-          file=sys.stdout)
+          f"{len(result.verdicts)} verdicts pass{' (QUICK run)' if args.quick else ''}, "
+          f"{time.perf_counter() - t0:.0f} s)", file=sys.stdout)
     for v in result.verdicts:
         if not v["passed"]:
             print(f"  FAIL {v['backend']}: {v['metric']} = {v['value']} "
