@@ -1,32 +1,42 @@
-"""``trilith figures``: the paper's spectrum figures (Figs. 5, 8, 9, 10, 11) as PNG."""
+"""``trilith figures``: the paper's spectrum figures (Figs. 5, 8, 9, 10, 11) as PNG,
+PDF or SVG at a publication size (3.5 in or 7 in wide, 300 dpi by default)."""
 from __future__ import annotations
 
 import argparse
 import sys
 
+from compare.figures import DEFAULT_DPI, FORMATS
+
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "figures",
-        help="recompute the paper's overturning-spectrum figures (Figs. 5, 8-11) as PNG",
+        help="recompute the paper's overturning-spectrum figures (Figs. 5, 8-11)",
         description="Compute the overturning spectra of the paper's Figs. 5, 8, 9, 10 and 11 "
                     "(with and without pendulum, mode jumps marked) over Omega = 3..30 "
-                    "rad/s and write fig5.png ... fig11.png and figures.json into --out.")
+                    "rad/s and write fig5 ... fig11 (PNG, PDF or SVG; Fig. 5 one journal "
+                    "column wide, 3.5 in, the others two, 7 in) and figures.json into --out.")
     parser.add_argument("--out", default="figures", metavar="DIR",
                         help="output directory, created if missing [figures]")
     parser.add_argument("--workers", type=int, default=1, help="processes, in [1, 256] [1]")
+    parser.add_argument("--dpi", type=int, default=DEFAULT_DPI,
+                        help=f"resolution, in [50, 1200] [{DEFAULT_DPI}]")
+    parser.add_argument("--format", default="png", choices=FORMATS, metavar="FMT",
+                        help=f"output format: {', '.join(FORMATS)} [png]")
     parser.add_argument("--quick", action="store_true",
                         help="5 frequencies and coarser tolerances: a smoke run in seconds")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.figures import FigureSettings, make_figures, quick_settings
+    from compare.figures import FigureSettings, check_output_options, make_figures, quick_settings
 
     if not (1 <= args.workers <= 256):
         raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
+    check_output_options(args.dpi, args.format)  # before minutes of spectra
     fs = quick_settings() if args.quick else FigureSettings()
-    doc = make_figures(args.out, fs, workers=args.workers, progress=sys.stderr.isatty())
+    doc = make_figures(args.out, fs, workers=args.workers, progress=sys.stderr.isatty(),
+                       dpi=args.dpi, fmt=args.format)
     for name, fig in doc["figures"].items():
         print(f"{args.out}/{fig['file']}: {fig['caption']}")
     print(f"{args.out}/figures.json: {doc['n_spectra']} spectra, {len(doc['omega'])} "
