@@ -79,7 +79,7 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     to quote in it, by default ``scene.name``).
     """
     from scenes.record import (RecordSettings, Panels, default_duration, frame_times,
-                               load_backend, resolve_engines, run_backend)
+                               load_backend, resolve_engines, run_backend, shown_duration)
 
     settings = RecordSettings(fps=fps, duration=duration)  # validates fps/duration
     names = resolve_engines(engine)
@@ -103,8 +103,9 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     span = settings.duration if settings.duration is not None else default_duration(excitation)
     if names == ("pybullet",) and _pybullet_gui(scene, excitation, span):
         return {}
-    times = frame_times(span, settings.fps)
+    frame_times(span, settings.fps)  # validates the frame count before any run
     trajectories = {name: run_backend(name, scene, excitation, span) for name in names}
+    times = frame_times(shown_duration(trajectories, span), settings.fps)
 
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation

@@ -46,7 +46,4 @@ def run(args: argparse.Namespace) -> int:
                          for name, traj in result.trajectories.items())
     print(f"wrote {result.path}: {result.n_frames} frames at {result.fps:g} fps "
           f"({result.duration:.3f} s); {verdicts}")
-    for name, renderer in result.renderers.items():
-        if name == "pybullet" and renderer == "2d":
-            print("note: pybullet drawn in 2D from its trajectory (no 3D renderer available)")
     return 0
