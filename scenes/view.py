@@ -110,7 +110,9 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
-    figure = plt.figure(figsize=(4.8 * len(names), 3.6))
+    # At most 12 in (1200 px at 100 dpi) wide: three panels fit a 1280 px screen.
+    width = min(4.8, 12.0 / len(names))
+    figure = plt.figure(figsize=(width * len(names), 0.75 * width))
     panels = Panels(scene, excitation, times, trajectories, figure)
     # Keep a reference: an unreferenced FuncAnimation is garbage-collected and stops.
     # blit: only the moving artists are redrawn (Panels.update returns them), which
