@@ -203,7 +203,7 @@ def conclusion(engine: str, row: dict) -> str:
                      f"({cost['runs_per_point']:.2g} runs) and a spectrum of "
                      f"{cost['spectrum_frequencies']} frequencies about "
                      f"{fmt_seconds(cost['spectrum_s'])}")
-        parts.append(text + " (wall time on this machine).")
+        parts.append(text + " (wall time on the measuring machine).")
     return " ".join(parts)
 
 
