@@ -27,8 +27,9 @@ END = "<!-- findings: end -->"
 
 
 def render(doc: dict) -> str:
-    """Markdown bullets of the findings in summary document ``doc``."""
-    trust = doc.get("trust") or trust_table(doc)
+    """Markdown bullets of the findings in summary document ``doc`` (the trust
+    table recomputed from its measurements by :func:`compare.trust.trust_table`)."""
+    trust = trust_table(doc)
     prov = doc.get("provenance") or {}
     n = len(doc["verdicts"])
     n_pass = sum(bool(v["passed"]) for v in doc["verdicts"])

@@ -110,7 +110,7 @@ def _trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     trust = doc["trust"]
     engines = list(trust)
     tols = doc["config"]["tolerances"]
-    header = ["", "tolerance"] + [trust[e]["label"] for e in engines]
+    header = ["check (tolerance)"] + [trust[e]["label"] for e in engines]
 
     def verdict_cell(row, key):
         v = row.get(key)
@@ -134,13 +134,18 @@ def _trust_rows(doc: dict) -> tuple[list[str], list[list]]:
             return _cell("not measured")
         if not t["failing"]:
             return _cell("all agree")
+        measured = any(p.get("cause") for p in t["failing"])
         parts = []
         for p in t["failing"]:
             err = "not bracketed" if p["rel_error"] is None else f"{100 * p['rel_error']:+.2g} %"
-            cause = p.get("cause") or "not measured"
-            detail = f" ({p['cause_detail']})" if p.get("cause_detail") else ""
-            parts.append(f"Ω {p['omega']:g}: {err}, {cause}{detail}")
-        return _cell("; ".join(parts), False)
+            where = f"Ω {p['omega']:g}{'' if p['case'] == 'pendulum' else ' (no pend.)'}"
+            cause = ""
+            if measured:
+                cause = f", {p.get('cause') or 'not measured'}"
+                cause += f" ({p['cause_detail']})" if p.get("cause_detail") else ""
+            parts.append(f"{where}: {err}{cause}")
+        text = "; ".join(parts)
+        return _cell(text if measured else f"not measured ({text})", False)
 
     def ad(row):
         v = row.get("verdicts_AD")
@@ -160,27 +165,28 @@ def _trust_rows(doc: dict) -> tuple[list[str], list[list]]:
                      f"{c['spectrum_frequencies']} frequencies")
 
     def settings(row):
-        return _cell(", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+        return _cell(", ".join(f"{k} = {fmt_sci(v)}" if isinstance(v, float) else f"{k} = {v}"
                                for k, v in row["settings"].items()) or "defaults")
 
-    spec = [("restitution vs Eq. 20 (worst impact)", f"≤ {fmt_pct(tols['restitution'])}",
+    spec = [("restitution vs Eq. 20, worst impact", f"≤ {fmt_pct(tols['restitution'])}",
              lambda r: verdict_cell(r, "restitution_eq20")),
             ("restitution vs Eq. 19 at the measured ψ",
              f"≤ {fmt_pct(tols['restitution_pendulum'])}",
              lambda r: verdict_cell(r, "restitution_eq19")),
-            ("the paper's verdicts at A-D (status and mode)", "all", ad),
+            ("the paper's verdicts at A-D, status and mode", "all must agree", ad),
             ("θ(t) RMS error before the first impact", f"≤ {fmt_sci(tols['theta_rms_first'])} α",
              lambda r: verdict_cell(r, "theta_first_impact")),
             ("overturning thresholds agree up to", f"within {fmt_pct(tols['threshold'])}",
              thresholds),
             ("where thresholds disagree: measured cause", "", causes),
-            ("cost per run (A-D, median wall time)", "", lambda r: cost(r, "run")),
+            ("cost per run: median wall time at A-D", "", lambda r: cost(r, "run")),
             ("cost per threshold point and per spectrum", "", lambda r: cost(r, "spectrum")),
             ("settings that achieve it", "", settings),
             ("verdicts passed", "", lambda r: _cell(
                 f"{r['verdicts']['passed']} of {r['verdicts']['total']}",
                 r["verdicts"]["passed"] == r["verdicts"]["total"]))]
-    rows = [[name, tol] + [fn(trust[e]) for e in engines] for name, tol, fn in spec]
+    rows = [[f"{name} ({tol})" if tol else name] + [fn(trust[e]) for e in engines]
+            for name, tol, fn in spec]
     return header, rows
 
 
@@ -330,7 +336,8 @@ th{background:#eee}td.pass{background:#d4edda}td.fail{background:#f8d7da}
 .headline{font-size:1.1em}.small{font-size:0.85em;color:#444}.conclusion{margin:0.4em 0 0.8em 0}
 pre{white-space:pre-wrap;overflow-wrap:anywhere;font-size:11px;background:#f6f6f6;padding:0.5em}
 code{overflow-wrap:anywhere}
-@media (max-width:600px){body{padding:0.4em}table{font-size:12px}}
+td{overflow-wrap:anywhere}
+@media (max-width:600px){body{padding:0.4em}table{font-size:11px}td,th{padding:2px 3px}}
 @media print{body{max-width:none;padding:0}.scroll{overflow:visible}
 td.pass,td.fail,th,.banner{-webkit-print-color-adjust:exact;print-color-adjust:exact}
 img,table{break-inside:avoid}h2{break-after:avoid}}"""

@@ -151,7 +151,7 @@ def conclusion(engine: str, row: dict) -> str:
     """A short conclusion for one engine, template sentences filled from ``row``."""
     name = f"{label(engine)} ({row.get('version', 'unknown')})"
     dt = row["settings"].get("dt")
-    head = f"{name}" + (f" at dt = {dt:g} s" if dt is not None else "")
+    head = f"{name}" + (f" at dt = {fmt_sci(dt)} s" if dt is not None else "")
     good, bad = [], []
     for key, what in (("restitution_eq20", "restitution against Eq. 20"),
                       ("restitution_eq19", "restitution against Eq. 19")):

@@ -52,8 +52,9 @@ def run(args: argparse.Namespace) -> int:
                    engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     t0 = time.perf_counter()
+    provenance = collect(args, quick=args.quick)  # the code as it was when the run started
     result = run_campaign(config)
-    provenance = collect(args, quick=args.quick, backends=result.versions)
+    provenance["versions"].update(result.versions)
     paths = write_report(result, args.out, provenance)
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"
