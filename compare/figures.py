@@ -36,7 +36,13 @@ from compare.jsonable import plain as clean_nan
 from scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",
-           "plot_figure", "make_figures", "omega_grid", "quick_settings"]
+           "plot_figure", "make_figures", "omega_grid", "quick_settings", "figure_size",
+           "check_output_options", "plain_text",
+           "FORMATS", "DEFAULT_DPI"]
+
+FORMATS = ("png", "pdf", "svg")
+DEFAULT_DPI = 300  # print resolution of journals
+SINGLE_COLUMN, DOUBLE_COLUMN = 3.5, 7.0  # in: one and two journal columns
 
 
 @dataclass(frozen=True)
@@ -106,28 +112,40 @@ class FigureSpec:
 
 def _figures() -> tuple[FigureSpec, ...]:
     lams = (3, 5, 7)
-    fig8 = tuple(Panel(f"fig8_lam{lam}_gamma{g}", "sine", f"lam={lam}, gamma={g}", r, c)
+    # Titles in matplotlib mathtext: Greek symbols in every output format.
+    lam_, gam_, mu_ = r"$\lambda$", r"$\gamma$", r"$\mu$"
+    fig8 = tuple(Panel(f"fig8_lam{lam}_gamma{g}", "sine", f"{lam_} = {lam}, {gam_} = {g}", r, c)
                  for r, lam in enumerate(lams) for c, g in enumerate((0.1, 0.2, 0.3)))
-    fig9 = tuple(Panel(f"fig9_lam{lam}_b{b}", "sine", f"lam={lam}, b={b} m", r, c)
+    fig9 = tuple(Panel(f"fig9_lam{lam}_b{b}", "sine", f"{lam_} = {lam}, b = {b} m", r, c)
                  for r, lam in enumerate(lams) for c, b in enumerate((0.2, 0.4, 0.6, 0.8)))
-    fig10 = tuple(Panel(f"fig9_lam{lam}_b0.4", "cosine", f"lam={lam}", 0, c)
+    fig10 = tuple(Panel(f"fig9_lam{lam}_b0.4", "cosine", f"{lam_} = {lam}", 0, c)
                   for c, lam in enumerate(lams))
-    fig11 = tuple(Panel(f"fig11_mu{mu}", "sine", f"mu={mu}", 0, c)
+    fig11 = tuple(Panel(f"fig11_mu{mu}", "sine", f"{mu_} = {mu}", 0, c)
                   for c, mu in enumerate(("0.5", "1", "2", "4")))
     return (
-        FigureSpec("fig5", "Fig. 5: one-sine, lam=5, b=0.6 m, gamma=0.3, mu=1",
-                   (Panel("fig5", "sine", "lam=5, b=0.6 m, gamma=0.3, mu=1"),), 2, 1),
-        FigureSpec("fig8", "Fig. 8: one-sine, b=0.6 m, mu=1; rows lam, columns gamma",
+        FigureSpec("fig5", f"Fig. 5: one-sine, {lam_} = 5, b = 0.6 m, {gam_} = 0.3, {mu_} = 1",
+                   (Panel("fig5", "sine", f"{lam_} = 5, b = 0.6 m, {gam_} = 0.3, {mu_} = 1"),),
+                   2, 1),
+        FigureSpec("fig8", f"Fig. 8: one-sine, b = 0.6 m, {mu_} = 1; rows {lam_}, columns {gam_}",
                    fig8, 3, 3),
-        FigureSpec("fig9", "Fig. 9: one-sine, gamma=0.3, mu=1; rows lam, columns b",
+        FigureSpec("fig9", f"Fig. 9: one-sine, {gam_} = 0.3, {mu_} = 1; rows {lam_}, columns b",
                    fig9, 3, 4),
-        FigureSpec("fig10", "Fig. 10: one-cosine, b=0.4 m, gamma=0.3, mu=1", fig10, 1, 3),
-        FigureSpec("fig11", "Fig. 11: one-sine, lam=5, b=0.6 m, gamma=0.3; lintel mass mu",
-                   fig11, 1, 4),
+        FigureSpec("fig10", f"Fig. 10: one-cosine, b = 0.4 m, {gam_} = 0.3, {mu_} = 1", fig10,
+                   1, 3),
+        FigureSpec("fig11", f"Fig. 11: one-sine, {lam_} = 5, b = 0.6 m, {gam_} = 0.3; lintel mass "
+                   f"{mu_}", fig11, 1, 4),
     )
 
 
 FIGURES: tuple[FigureSpec, ...] = _figures()
+_GREEK = {r"$\lambda$": "λ", r"$\gamma$": "γ", r"$\mu$": "μ"}
+
+
+def plain_text(text: str) -> str:
+    """A title without mathtext (``$\\lambda$`` -> ``λ``): for terminals and JSON."""
+    for tex, char in _GREEK.items():
+        text = text.replace(tex, char)
+    return text
 
 
 def _key(panel: Panel) -> tuple:
@@ -192,54 +210,82 @@ def _draw_spectrum(ax, sp: Spectrum, legend: bool) -> None:
         i = int(np.flatnonzero(sp.omega == jump["omega_before"])[0])
         x, y = 0.5 * (sp.omega[i] + sp.omega[i + 1]), 0.5 * (a[i] + a[i + 1])
         # Dashed circle as in the paper's Fig. 5 (scatter edges take a line style).
-        ax.scatter([x], [y], s=160, facecolors="none", edgecolors="tab:red",
+        ax.scatter([x], [y], s=70, facecolors="none", edgecolors="tab:red",
                    linestyles="--", linewidths=1.0, zorder=3,
                    label="mode jump" if first else None)
         first = False
     if legend:
-        ax.legend(fontsize=7, loc="upper left", frameon=False)
+        ax.legend(loc="upper left", frameon=False)
 
 
-def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path) -> None:
-    """Draw one figure of :data:`FIGURES` from computed ``spectra`` into ``path`` (PNG)."""
+def figure_size(spec: FigureSpec) -> tuple[float, float]:
+    """Publication size [in]: Fig. 5 one journal column wide (3.5 in), the
+    multi-panel figures two columns (7 in), rows ~1.9 in tall."""
+    if spec.name == "fig5":
+        return SINGLE_COLUMN, 4.2
+    return DOUBLE_COLUMN, 1.9 * spec.nrows + 0.7
+
+
+def check_output_options(dpi: int, fmt: str) -> None:
+    """ValueError naming ``--dpi``/``--format`` when out of range."""
+    if isinstance(dpi, bool) or not isinstance(dpi, int) or not 50 <= dpi <= 1200:
+        raise ValueError(f"--dpi must be an integer in [50, 1200], got {dpi!r}")
+    if fmt not in FORMATS:
+        raise ValueError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+
+
+def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path,
+                dpi: int = DEFAULT_DPI) -> None:
+    """Draw one figure of :data:`FIGURES` from computed ``spectra`` into ``path``;
+    the format (PNG, PDF or SVG) follows the suffix, ``dpi`` sets the raster
+    resolution (and the PNG's pixel size, :func:`figure_size` x ``dpi``)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    with plt.rc_context(_RC):
+        _draw_figure(plt, spec, spectra, path, dpi)
+
+
+# Type sizes for a figure printed at its own size (7 pt text, 6 pt ticks).
+_RC = {"font.size": 7, "axes.titlesize": 7, "axes.labelsize": 7, "xtick.labelsize": 6,
+       "ytick.labelsize": 6, "legend.fontsize": 6, "lines.markersize": 3}
+
+
+def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int) -> None:
     if spec.name == "fig5":
         sp = spectra[_key(spec.panels[0])]
-        fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(5.6, 5.6),
+        fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=figure_size(spec),
                                        gridspec_kw={"height_ratios": [2, 1]})
         _draw_spectrum(ax1, sp, legend=True)
         ax1.set_ylabel(r"$A_s$ [m/s$^2$]")
-        ax1.set_title("(a) overturning spectrum", fontsize=9)
+        ax1.set_title("(a) overturning spectrum")
         ax2.plot(sp.omega, sp.gain_percent, "k-", lw=1.2)
         ax2.axhline(0.0, color="0.6", lw=0.8)
         ax2.set_ylabel(r"$\Delta$ [%]")
         ax2.set_xlabel(r"$\Omega$ [rad/s]")
-        ax2.set_title(r"(b) gain $\Delta = 100\,(A_{yp}-A_{np})/A_{np}$", fontsize=9)
+        ax2.set_title(r"(b) gain $\Delta = 100\,(A_{yp}-A_{np})/A_{np}$")
     else:
         fig, axes = plt.subplots(spec.nrows, spec.ncols, sharex=True, squeeze=False,
-                                 figsize=(2.6 * spec.ncols, 2.2 * spec.nrows + 0.5))
+                                 figsize=figure_size(spec))
         for k, panel in enumerate(spec.panels):
             ax = axes[panel.row][panel.col]
             _draw_spectrum(ax, spectra[_key(panel)], legend=(k == 0))
-            ax.set_title(panel.title, fontsize=8)
-            ax.tick_params(labelsize=7)
+            ax.set_title(panel.title)
             if panel.row == spec.nrows - 1:
-                ax.set_xlabel(r"$\Omega$ [rad/s]", fontsize=8)
+                ax.set_xlabel(r"$\Omega$ [rad/s]")
             if panel.col == 0:
-                ax.set_ylabel(r"$A_s$ [m/s$^2$]", fontsize=8)
-    fig.suptitle(spec.caption, fontsize=9)
+                ax.set_ylabel(r"$A_s$ [m/s$^2$]")
+    fig.suptitle(spec.caption, fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=80)
+    fig.savefig(path, dpi=dpi, format=Path(path).suffix.lstrip(".").lower() or "png")
     plt.close(fig)
 
 
 # --- the whole run --------------------------------------------------------------------
 def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
-                 progress: bool = False) -> dict:
-    """Compute every spectrum, write ``<fig>.png`` per figure and ``figures.json``.
+                 progress: bool = False, dpi: int = DEFAULT_DPI, fmt: str = "png") -> dict:
+    """Compute every spectrum, write ``<fig>.<fmt>`` per figure and ``figures.json``.
 
     Parameters
     ----------
@@ -251,6 +297,10 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
         Processes per spectrum, in [1, 256].
     progress : bool
         Show a tqdm bar.
+    dpi : int
+        Raster resolution in [50, 1200] (PNG pixels = :func:`figure_size` x dpi).
+    fmt : {'png', 'pdf', 'svg'}
+        Output format.
 
     Returns
     -------
@@ -259,6 +309,7 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
         panel with its scene name, pulse and the spectrum's ``to_dict()``.
     """
     fs = FigureSettings() if fs is None else fs
+    check_output_options(dpi, fmt)
     if not isinstance(fs, FigureSettings):
         raise ValueError("settings must be compare.figures.FigureSettings")
     out = Path(out_dir)
@@ -267,13 +318,15 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     t0 = time.perf_counter()
     spectra = compute_spectra(fs, workers=workers, progress=progress)
     out.mkdir(parents=True, exist_ok=True)
-    doc = {"settings": fs.describe(), "omega": omega_grid(fs).tolist(), "figures": {}}
+    doc = {"settings": fs.describe(), "omega": omega_grid(fs).tolist(), "figures": {},
+           "dpi": dpi, "format": fmt}
     for spec in FIGURES:
-        path = out / f"{spec.name}.png"
-        plot_figure(spec, spectra, path)
+        path = out / f"{spec.name}.{fmt}"
+        plot_figure(spec, spectra, path, dpi)
         doc["figures"][spec.name] = {
-            "caption": spec.caption, "file": path.name,
-            "panels": [{"scene": p.scene, "pulse": p.pulse, "title": p.title, "row": p.row,
+            "caption": plain_text(spec.caption), "file": path.name,
+            "panels": [{"scene": p.scene, "pulse": p.pulse, "title": plain_text(p.title),
+                        "row": p.row,
                         "col": p.col, "spectrum": spectra[_key(p)].to_dict()}
                        for p in spec.panels]}
     doc["n_spectra"] = len(spectra)

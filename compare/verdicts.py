@@ -8,22 +8,27 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["build_verdicts"]
+__all__ = ["build_verdicts", "VERDICT_IDS"]
+
+# Stable ids of the verdict rows (summary.json ``verdicts[*].id``): scripts key on
+# these, never on the human-readable ``metric`` text, which may be reworded.
+VERDICT_IDS = ("restitution_eq20", "restitution_eq19", "threshold_pendulum",
+               "threshold_no_pendulum", "verdicts_AD", "theta_first_impact")
 
 
 def _finite(values) -> list[float]:
     return [float(v) for v in values if v is not None and math.isfinite(float(v))]
 
 
-def _row(metric: str, backend: str, values: list, tolerance: float, reason: str, unit: str,
-         n_expected: int, absolute: bool = True) -> dict:
+def _row(vid: str, metric: str, backend: str, values: list, tolerance: float, reason: str,
+         unit: str, n_expected: int, absolute: bool = True) -> dict:
     """Worst case of ``values`` against ``tolerance``; any missing value fails."""
     vals = _finite(abs(v) if (absolute and v is not None) else v for v in values)
     missing = n_expected - len(vals)
     value = max(vals) if vals else None
     passed = bool(vals) and missing == 0 and value <= tolerance
     detail = f"worst of {len(vals)}" + (f"; {missing} not measured" if missing else "")
-    return {"metric": metric, "backend": backend, "value": value, "tolerance": tolerance,
+    return {"id": vid, "metric": metric, "backend": backend, "value": value, "tolerance": tolerance,
             "passed": passed, "unit": unit, "reason": reason, "detail": detail}
 
 
@@ -40,17 +45,18 @@ def build_verdicts(result) -> list[dict]:
     why = tol.reasons()
     rows: list[dict] = []
     for name in cfg.engines:
-        for pend, metric, tolerance, key in (
-                (False, "restitution vs Eq. 20 (max rel. error)", tol.restitution, "restitution"),
-                (True, "restitution vs Eq. 19 (max rel. error)", tol.restitution_pendulum,
-                 "restitution_pendulum")):
+        for vid, pend, metric, tolerance, key in (
+                ("restitution_eq20", False, "restitution vs Eq. 20 (max rel. error)",
+                 tol.restitution, "restitution"),
+                ("restitution_eq19", True, "restitution vs Eq. 19 (max rel. error)",
+                 tol.restitution_pendulum, "restitution_pendulum")):
             runs = [r for r in result.restitution if r["backend"] == name and r["pendulum"] == pend]
             n_err = _n_errors(result, "restitution", name, pend)
             if not runs and not n_err:
                 continue
             # Every run must deliver at least one impact; each run's worst impact counts.
             values = [r["max_rel_error"] if r["impacts"] else None for r in runs]
-            rows.append(_row(metric, name, values, tolerance, why[key], "relative",
+            rows.append(_row(vid, metric, name, values, tolerance, why[key], "relative",
                              len(runs) + n_err))
         for case, label in (("pendulum", "with pendulum"), ("no_pendulum", "without pendulum")):
             points = result.spectra.get(case, {}).get("engines", {}).get(name, [])
@@ -58,12 +64,13 @@ def build_verdicts(result) -> list[dict]:
             if not points and not n_err:
                 continue
             values = [p["rel_error"] if p["bracketed"] else None for p in points]
-            row = _row(f"overturning threshold {label}, away from jumps (max rel. error)",
+            row = _row(f"threshold_{case}",
+                       f"overturning threshold {label}, away from jumps (max rel. error)",
                        name, values, tol.threshold, why["threshold"], "relative",
                        len(points) + n_err)
             irregular = sum(p["irregular_runs"] for p in points)
             if irregular:  # 'unstable'/'undecided' runs count as survived in the bisection
-                row["detail"] += f"; {irregular} unstable/undecided engine runs"
+                row["detail"] += f"; {irregular} unstable/undecided/collapsed engine runs"
             rows.append(row)
         comps = [c for c in result.comparisons if c["backend"] == name]
         n_cases = len(cfg.points) * (2 if result.scene.has_pendulum else 1)
@@ -72,7 +79,8 @@ def build_verdicts(result) -> list[dict]:
             # A case that could not be run counts as a disagreement.
             n_bad = len(mismatches) + (n_cases - len(comps))
             rows.append({
-                "metric": "verdict disagreements at A-D (status and mode)", "backend": name,
+                "id": "verdicts_AD", "metric": "verdict disagreements at A-D (status and mode)",
+                "backend": name,
                 "value": n_bad, "tolerance": tol.verdict_mismatches,
                 "passed": n_bad <= tol.verdict_mismatches, "unit": "count",
                 "reason": why["verdict_mismatches"],
@@ -80,7 +88,8 @@ def build_verdicts(result) -> list[dict]:
                                     f"{c['status_test']}/{c['mode_test']} vs "
                                     f"{c['status_reference']}/{c['mode_reference']}"
                                     for c in mismatches) or f"{len(comps)} cases agree"})
-            rows.append(_row("theta RMS error / alpha before the first impact (A-D)", name,
+            rows.append(_row("theta_first_impact",
+                             "theta RMS error / alpha before the first impact (A-D)", name,
                              [c["theta_rms_first"] for c in comps], tol.theta_rms_first,
                              why["theta_rms_first"], "fraction of alpha", n_cases))
     return rows

@@ -8,7 +8,12 @@ patches and updates them frame by frame (recordings and live windows use the
 same code).
 
 Frame: x to the right, y up, origin at the middle of the gap between the
-columns on the ground *at rest*; the ground itself is displaced by ``x_g(t)``.
+columns on the ground *at rest*; :func:`trilith_shape` displaces everything by
+the ground displacement ``x_g(t)``.  Panels (:class:`TrilithArtist`) are drawn
+in the base frame instead: the camera follows the ground, so a trilith keeps its
+place and scale however far the base drifts (a one-sine pulse leaves it
+``2 pi A / Omega^2`` away, 1.3 m at A = 25 m/s^2, Omega = 11 rad/s), and light
+vertical lines fixed in the world slide by ``-x_g`` to show the base motion.
 Conventions (``analytic/trajectory.py``): ``theta > 0`` rotates the columns
 counter-clockwise about their *left* base corners, ``theta < 0`` clockwise
 about their right ones; the lintel rides on the top-right corner of each column
@@ -16,6 +21,10 @@ when ``theta > 0`` and on the top-left one when ``theta < 0`` (Eq. 5:
 ``r_G3 = x_g + b3 + b cos(theta) - h sin(theta)``, ...), so it translates
 without rotating.  ``psi`` is the pendulum's angle from the downward vertical,
 counter-clockwise positive: the bob is at ``hinge + l (sin psi, -cos psi)``.
+The model has no contact between the bob and the ground: once the columns have
+fallen far enough for that point to be below the ground, the bob is drawn lying
+on the ground at the same distance ``l`` from the hinge (where a real bob would be),
+and ``TrilithShape.bob_grounded`` says so.
 """
 from __future__ import annotations
 
@@ -31,7 +40,7 @@ __all__ = ["TrilithShape", "trilith_shape", "view_limits", "TrilithArtist", "dra
 
 # Muted colours that stay distinct after GIF palette quantisation.
 COLORS = {"column": "#8c7b6b", "lintel": "#6b5b4b", "edge": "#2b2b2b",
-          "pendulum": "#b03a2e", "ground": "#4a4a4a", "text": "#111111"}
+          "pendulum": "#b03a2e", "ground": "#4a4a4a", "text": "#111111", "world": "#c8d0dc"}
 
 
 @dataclass(frozen=True)
@@ -51,6 +60,7 @@ class TrilithShape:
     hinge: np.ndarray | None
     bob: np.ndarray | None
     ground_x: float
+    bob_grounded: bool = False
 
 
 def _rotation(angle: float) -> np.ndarray:
@@ -107,11 +117,20 @@ def trilith_shape(scene: Scene, theta: float, psi: float = 0.0, x_g: float = 0.0
     if scene.mu > 0.0 or scene.has_pendulum:
         lintel = _rectangle(-0.5 * length, h, length, scene.lintel_thickness) + lift + shift
     hinge = bob = None
+    grounded = False
     if scene.has_pendulum:
+        ell = scene.pendulum_length
         hinge = np.array([scene.hinge_x, h]) + lift + shift
-        bob = hinge + scene.pendulum_length * np.array([math.sin(psi), -math.cos(psi)])
+        bob = hinge + ell * np.array([math.sin(psi), -math.cos(psi)])
+        r = bob_radius(scene)
+        if bob[1] < r:  # below the ground: lay it on the ground, still l from the hinge
+            grounded = True
+            drop = max(hinge[1] - r, 0.0)
+            reach = math.sqrt(max(ell * ell - drop * drop, 0.0))
+            bob = np.array([hinge[0] + math.copysign(reach, math.sin(psi) or 1.0),
+                            hinge[1] - min(drop, ell)])
     return TrilithShape(columns=(columns[0], columns[1]), lintel=lintel, hinge=hinge, bob=bob,
-                        ground_x=float(x_g))
+                        ground_x=float(x_g), bob_grounded=grounded)
 
 
 def bob_radius(scene: Scene) -> float:
@@ -125,7 +144,8 @@ def view_limits(scene: Scene, theta, psi, x_g, margin: float = 0.08, headroom: f
     and ``headroom`` (fraction of the height) above it for the text overlay.
 
     ``theta``, ``psi``, ``x_g`` are equal-length sequences (all frames of a
-    recording), so the view does not jump from frame to frame.
+    recording), so the view does not jump from frame to frame; panels drawn in
+    the base frame pass ``x_g = 0``.
     """
     theta = np.atleast_1d(np.asarray(theta, dtype=float))
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
@@ -176,8 +196,10 @@ class TrilithArtist:
                               ec=COLORS["edge"], lw=0.8, zorder=3)
             ax.add_patch(self.bob)
         (self.ground,) = ax.plot([], [], color=COLORS["ground"], lw=2.0)
-        # Hatch ticks below the ground line move with x_g: they show the base motion.
+        # Hatch ticks below the ground line belong to the base (drawn once the limits
+        # are known); the light vertical lines are fixed in the world and slide by -x_g.
         (self.hatch,) = ax.plot([], [], color=COLORS["ground"], lw=0.8)
+        (self.world,) = ax.plot([], [], color=COLORS["world"], lw=0.8, zorder=0)
         self.text = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", ha="left",
                             family="monospace", fontsize=8, color=COLORS["text"])
         if title:
@@ -187,13 +209,29 @@ class TrilithArtist:
         ax.set_yticks([])
 
     def set_limits(self, xlim, ylim) -> None:
+        """Set the view and draw the base (ground line and hatch: static in the
+        base frame)."""
         self.ax.set_xlim(*xlim)
         self.ax.set_ylim(*ylim)
+        x_lo, x_hi = xlim
+        self.ground.set_data([x_lo, x_hi], [0.0, 0.0])
+        depth = 0.03 * (x_hi - x_lo)
+        starts = np.arange(x_lo, x_hi + self._step, self._step)
+        hx = np.full(3 * starts.size, np.nan)
+        hy = np.full(3 * starts.size, np.nan)
+        hx[0::3], hx[1::3] = starts, starts - depth
+        hy[0::3], hy[1::3] = 0.0, -depth
+        self.hatch.set_data(hx, hy)
+
+    @property
+    def _step(self) -> float:
+        return 0.5 * self.scene.b
 
     def update(self, t: float, theta: float, psi: float, x_g: float, note: str = "") -> list:
-        """Move every artist to state ``(theta, psi)`` with the ground at ``x_g``
-        and write the overlay (time, angles, ground displacement, ``note``)."""
-        shape = trilith_shape(self.scene, theta, psi, x_g)
+        """Move every artist to state ``(theta, psi)``, in the base frame (the
+        camera follows the ground); slide the world lines by ``-x_g`` and write the
+        overlay (time, angles, ground displacement, ``note``)."""
+        shape = trilith_shape(self.scene, theta, psi, 0.0)
         for patch, outline in zip(self.columns, shape.columns):
             patch.set_xy(outline)
         if shape.lintel is not None:
@@ -202,16 +240,15 @@ class TrilithArtist:
             self.rod.set_data([shape.hinge[0], shape.bob[0]], [shape.hinge[1], shape.bob[1]])
             self.bob.center = (float(shape.bob[0]), float(shape.bob[1]))
         x_lo, x_hi = self.ax.get_xlim()
-        self.ground.set_data([x_lo, x_hi], [0.0, 0.0])
-        step = 0.5 * self.scene.b
-        depth = 0.03 * (x_hi - x_lo)
-        first = x_g + step * math.floor((x_lo - x_g) / step)
-        starts = np.arange(first, x_hi + step, step)
-        hx = np.full(3 * starts.size, np.nan)
-        hy = np.full(3 * starts.size, np.nan)
-        hx[0::3], hx[1::3] = starts, starts - depth
-        hy[0::3], hy[1::3] = 0.0, -depth
-        self.hatch.set_data(hx, hy)
+        y_lo, y_hi = self.ax.get_ylim()
+        step = 4.0 * self._step  # world lines every 2 b
+        first = -x_g + step * math.floor((x_lo + x_g) / step)
+        xs = np.arange(first, x_hi + step, step)
+        wx = np.full(3 * xs.size, np.nan)
+        wy = np.full(3 * xs.size, np.nan)
+        wx[0::3], wx[1::3] = xs, xs
+        wy[0::3], wy[1::3] = y_lo, y_hi
+        self.world.set_data(wx, wy)
         lines = [f"t     = {t:7.3f} s",
                  f"theta = {theta:+7.4f} rad",
                  f"psi   = {psi:+7.4f} rad" if self.scene.has_pendulum else "psi   =   (none)",
@@ -219,7 +256,7 @@ class TrilithArtist:
         if note:
             lines.append(note)
         self.text.set_text("\n".join(lines))
-        artists = [*self.columns, self.lintel, self.ground, self.hatch, self.text]
+        artists = [self.world, *self.columns, self.lintel, self.ground, self.hatch, self.text]
         if self.rod is not None:
             artists += [self.rod, self.bob]
         return artists
@@ -233,6 +270,6 @@ def draw_trilith(ax, scene: Scene, t: float, theta: float, psi: float = 0.0, x_g
     (:func:`view_limits`).
     """
     artist = TrilithArtist(ax, scene, title)
-    artist.set_limits(*(limits or view_limits(scene, [theta], [psi], [x_g])))
+    artist.set_limits(*(limits or view_limits(scene, [theta], [psi], [0.0])))
     artist.update(t, theta, psi, x_g)
     return artist

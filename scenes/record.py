@@ -2,16 +2,22 @@
 
 Every backend runs the same scene under the same excitation; its
 :class:`~analytic.trajectory.Trajectory` is sampled on one common time base
-(``k / fps``) and drawn with :mod:`scenes.draw`, so panels side by side show the
-same instants.  PyBullet panels are rendered by PyBullet's own software renderer
-when ``engines.pybullet_engine`` provides ``render_frames`` (see
-:func:`pybullet_images`); otherwise its trajectory is drawn in 2D like the others.
+(``k / fps``) and drawn with :mod:`scenes.draw` in every panel: one scale, one
+camera (it follows the moving base), theta and psi written on each panel, so
+panels side by side compare at a glance.  (PyBullet's own software renderer had
+its own world-fixed camera and scale and lost the lintel as the base drifted; it
+is no longer used for recordings.)
+
+When every run has ended before ``--duration`` (all overturned), the recording
+stops :data:`HOLD_AFTER_END` seconds after the last one, so the verdicts can be
+read but no panel sits frozen for long.
 
 The figure is drawn with matplotlib's Agg canvas directly (no pyplot), so
 recording works without a display and never touches the GUI backend.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 import subprocess
@@ -25,13 +31,13 @@ from analytic.trajectory import Trajectory
 
 __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
            "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
-           "find_ffmpeg",
+           "find_ffmpeg", "shown_duration",
            "check_output", "record", "ALL_ENGINES", "FORMATS", "DEFAULT_AMPLITUDE",
-           "DEFAULT_OMEGA"]
+           "DEFAULT_OMEGA", "HOLD_AFTER_END"]
 
 # ``--engine all``: the accurate analytic reference and every physics engine
 # (``analytic-fast`` is the same model as ``analytic``; a panel for it adds nothing).
-ALL_ENGINES = ("analytic", "pybullet", "pymunk", "mujoco")  # the model and every engine
+ALL_ENGINES = ("analytic", "pybullet", "pymunk")
 FORMATS = (".gif", ".mp4")
 # The paper integrates to at least ten pulse periods (Sec. 5.1): the default length.
 DEFAULT_PERIODS = 10.0
@@ -41,6 +47,8 @@ DEFAULT_PERIODS = 10.0
 DEFAULT_AMPLITUDE = 19.0
 DEFAULT_OMEGA = 15.0
 MAX_FRAMES = 20000  # about 11 min at 30 fps: beyond that a GIF is not a sensible output
+# Seconds shown after the last run has ended: enough to read "OVERTURNED (mode)".
+HOLD_AFTER_END = 0.5
 
 
 @dataclass(frozen=True)
@@ -84,7 +92,6 @@ class RecordResult:
     fps: float
     duration: float
     trajectories: dict[str, Trajectory]
-    renderers: dict[str, str]  # backend -> '2d' or 'pybullet-tiny-renderer'
 
 
 def default_duration(excitation) -> float:
@@ -132,26 +139,55 @@ def resolve_engines(engine: str) -> tuple[str, ...]:
 
 
 def load_backend(name: str):
-    """The backend module (:func:`engines.get_backend`; ValueError if unknown)."""
-    from engines import get_backend
-    return get_backend(name)
+    """The backend module, or a ValueError saying it is not in this checkout yet."""
+    from engines import BACKENDS, get_backend
+
+    try:
+        return get_backend(name)
+    except ModuleNotFoundError as exc:
+        if exc.name and BACKENDS[name].startswith(exc.name):
+            raise ValueError(f"backend {name!r} is not available in this checkout "
+                             f"(module {BACKENDS[name]} is missing)") from None
+        raise
 
 
-def backend_settings(name: str, duration: float):
-    """Backend ``name``'s calibrated settings, run for the whole recorded span.
+def backend_settings(module, duration: float, **changes):
+    """The backend's default Settings, set to run for the whole recorded span.
 
-    ``early_stop=False``: a run would otherwise stop as soon as survival is
-    certain (energy below the barrier, or at rest), which freezes the picture
-    while the pendulum still swings; every backend runs to ``t_max`` (or until it
-    overturns).
+    ``t_max`` is the span; an engine's run monitor (``monitor`` field) would stop
+    a run as soon as survival is certain (energy below the barrier, or at rest),
+    which freezes the picture while the pendulum still swings: for a recording
+    those early stops are switched off, so every backend runs to ``t_max``
+    (or until it overturns).
     """
-    from engines import configure
-    return configure(name, t_max=duration, early_stop=False)
+    settings = module.Settings()
+    names = {f.name for f in dataclasses.fields(settings)}
+    if "t_max" in names:
+        changes["t_max"] = duration
+    monitor = getattr(settings, "monitor", None)
+    if "monitor" in names and dataclasses.is_dataclass(monitor):
+        monitor_names = {f.name for f in dataclasses.fields(monitor)}
+        early = {"energy_rule": False, "rest_hold": duration}
+        changes.setdefault("monitor", dataclasses.replace(
+            monitor, **{k: v for k, v in early.items() if k in monitor_names}))
+    return dataclasses.replace(settings, **{k: v for k, v in changes.items() if k in names})
 
 
 def run_backend(name: str, scene: Scene, excitation, duration: float) -> Trajectory:
     """Simulate ``scene`` in backend ``name`` up to ``duration`` seconds."""
-    return load_backend(name).simulate(scene, excitation, backend_settings(name, duration))
+    module = load_backend(name)
+    return module.simulate(scene, excitation, backend_settings(module, duration))
+
+
+def shown_duration(trajectories: dict[str, Trajectory], duration: float,
+                   hold: float = HOLD_AFTER_END) -> float:
+    """The span to show: ``duration``, or ``hold`` seconds after the last run's
+    end when every run ended earlier (overturned; the early "survived" stops
+    are off in recordings), so no panel is frozen for longer than ``hold``."""
+    ends = [float(tr.t[-1]) for tr in trajectories.values() if len(tr.t)]
+    if not ends:
+        return duration
+    return min(duration, max(ends) + hold)
 
 
 def sample_states(traj: Trajectory, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,46 +211,31 @@ def _note(traj: Trajectory, t: float) -> str:
 
 
 class Panels:
-    """One figure, one panel per backend, all on the same time base.
-
-    ``trajectories``: backend -> Trajectory (drawn in 2D).  ``images``: backend
-    -> sequence of RGB frames already rendered at ``times`` (PyBullet's own
-    renderer); those panels show the image with the same text overlay.
-    """
+    """One figure, one panel per backend, all on the same time base, the same
+    scale and the same camera (following the base)."""
 
     def __init__(self, scene: Scene, excitation, times: np.ndarray,
-                 trajectories: dict[str, Trajectory], figure,
-                 images: dict[str, list] | None = None) -> None:
+                 trajectories: dict[str, Trajectory], figure) -> None:
         from scenes.draw import TrilithArtist, view_limits
 
         self.times = np.asarray(times, dtype=float)
         self.trajectories = trajectories
-        self.images = images or {}
         self.x_g = np.array([excitation.displacement(float(t)) for t in self.times])
         self.states = {name: sample_states(traj, self.times)
                        for name, traj in trajectories.items()}
-        # One set of limits for every panel, so the panels compare at a glance.
+        # One set of limits for every panel (base frame: x_g = 0), so the panels
+        # compare at a glance.
         all_theta = np.concatenate([s[0] for s in self.states.values()])
         all_psi = np.concatenate([s[1] for s in self.states.values()])
-        limits = view_limits(scene, all_theta, all_psi, np.tile(self.x_g, len(self.states)))
+        limits = view_limits(scene, all_theta, all_psi, np.zeros_like(all_theta))
         names = list(trajectories)
         axes = figure.subplots(1, len(names), squeeze=False)[0]
         figure.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.92, wspace=0.03)
         self.artists = {}
-        self.image_artists = {}
         for ax, name in zip(axes, names):
-            if name in self.images:
-                ax.set_title(f"{name} (3D render)", fontsize=10)
-                ax.set_xticks([])
-                ax.set_yticks([])
-                self.image_artists[name] = (
-                    ax.imshow(np.asarray(self.images[name][0])),
-                    ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", ha="left",
-                            family="monospace", fontsize=8, color="#111111"))
-            else:
-                artist = TrilithArtist(ax, scene, title=name)
-                artist.set_limits(*limits)
-                self.artists[name] = artist
+            artist = TrilithArtist(ax, scene, title=name)
+            artist.set_limits(*limits)
+            self.artists[name] = artist
 
     def __len__(self) -> int:
         return self.times.size
@@ -227,13 +248,6 @@ class Panels:
             theta, psi = self.states[name]
             changed += artist.update(t, float(theta[k]), float(psi[k]), float(self.x_g[k]),
                                      note=_note(self.trajectories[name], t))
-        for name, (image, text) in self.image_artists.items():
-            theta, psi = self.states[name]
-            image.set_data(np.asarray(self.images[name][k]))
-            lines = [f"t     = {t:7.3f} s", f"theta = {theta[k]:+7.4f} rad",
-                     f"x_g   = {self.x_g[k]:+7.4f} m", _note(self.trajectories[name], t)]
-            text.set_text("\n".join(line for line in lines if line))
-            changed += [image, text]
         return changed
 
 
@@ -316,22 +330,6 @@ def write_mp4(frames: list[np.ndarray], path: Path, fps: float) -> None:
         raise RuntimeError(f"ffmpeg failed: {proc.stderr.decode(errors='replace').strip()}")
 
 
-def pybullet_images(scene: Scene, excitation, times: np.ndarray, duration: float,
-                    width: int, height: int) -> list | None:
-    """PyBullet's own software-rendered frames (``ER_TINY_RENDERER``) at ``times``,
-    if it declares the ``'render'`` capability; else ``None``."""
-    from engines import supports
-    if not supports("pybullet", "render"):
-        return None
-    frames = load_backend("pybullet").render_frames(
-        scene, excitation, times, backend_settings("pybullet", duration), width, height)
-    frames = [np.asarray(f)[:, :, :3].astype(np.uint8) for f in frames]
-    if len(frames) != len(times):
-        raise RuntimeError(f"pybullet render_frames returned {len(frames)} frames, "
-                           f"expected {len(times)}")
-    return frames
-
-
 def record(scene: Scene, excitation, engine: str, out: str | Path,
            settings: RecordSettings | None = None,
            trajectories: dict[str, Trajectory] | None = None) -> RecordResult:
@@ -341,7 +339,7 @@ def record(scene: Scene, excitation, engine: str, out: str | Path,
     ----------
     engine : str
         A registered backend name or ``'all'`` (analytic, pybullet, pymunk side
-        by side on the same time base).
+        by side on the same time base, scale and camera).
     out : path
         ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
     trajectories : dict, optional
@@ -354,26 +352,21 @@ def record(scene: Scene, excitation, engine: str, out: str | Path,
     path = check_output(out)
     names = tuple(trajectories) if trajectories else resolve_engines(engine)
     duration = settings.duration if settings.duration is not None else default_duration(excitation)
-    times = frame_times(duration, settings.fps)
+    frame_times(duration, settings.fps)  # validates the frame count before any run
     if trajectories is None:
         for name in names:  # fail on a missing backend before any long run
             load_backend(name)
         trajectories = {name: run_backend(name, scene, excitation, duration) for name in names}
-    images, renderers = {}, {name: "2d" for name in names}
-    if "pybullet" in names:
-        frames = pybullet_images(scene, excitation, times, duration, settings.panel_width,
-                                 settings.panel_height)
-        if frames is not None:
-            images["pybullet"] = frames
-            renderers["pybullet"] = "pybullet-tiny-renderer"
+    duration = shown_duration(trajectories, duration)
+    times = frame_times(duration, settings.fps)
     dpi = 100
     figure = Figure(figsize=(len(names) * settings.panel_width / dpi,
                              settings.panel_height / dpi), dpi=dpi)
-    panels = Panels(scene, excitation, times, trajectories, figure, images)
+    panels = Panels(scene, excitation, times, trajectories, figure)
     frames = render_frames(panels, figure)
     if path.suffix.lower() == ".gif":
         write_gif(frames, path, settings.fps)
     else:
         write_mp4(frames, path, settings.fps)
     return RecordResult(path=path, n_frames=len(frames), fps=settings.fps, duration=duration,
-                        trajectories=trajectories, renderers=renderers)
+                        trajectories=trajectories)

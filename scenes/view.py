@@ -79,7 +79,7 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     to quote in it, by default ``scene.name``).
     """
     from scenes.record import (RecordSettings, Panels, default_duration, frame_times,
-                               load_backend, resolve_engines, run_backend)
+                               load_backend, resolve_engines, run_backend, shown_duration)
 
     settings = RecordSettings(fps=fps, duration=duration)  # validates fps/duration
     names = resolve_engines(engine)
@@ -103,13 +103,16 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     span = settings.duration if settings.duration is not None else default_duration(excitation)
     if names == ("pybullet",) and _pybullet_gui(scene, excitation, span):
         return {}
-    times = frame_times(span, settings.fps)
+    frame_times(span, settings.fps)  # validates the frame count before any run
     trajectories = {name: run_backend(name, scene, excitation, span) for name in names}
+    times = frame_times(shown_duration(trajectories, span), settings.fps)
 
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation
 
-    figure = plt.figure(figsize=(4.8 * len(names), 3.6))
+    # At most 12 in (1200 px at 100 dpi) wide: three panels fit a 1280 px screen.
+    width = min(4.8, 12.0 / len(names))
+    figure = plt.figure(figsize=(width * len(names), 0.75 * width))
     panels = Panels(scene, excitation, times, trajectories, figure)
     # Keep a reference: an unreferenced FuncAnimation is garbage-collected and stops.
     # blit: only the moving artists are redrawn (Panels.update returns them), which

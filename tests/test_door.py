@@ -9,10 +9,7 @@ parameter.
 """
 from __future__ import annotations
 
-import math
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest

@@ -10,7 +10,8 @@ import pytest
 
 from analytic.spectrum import overturning_spectrum
 from compare.cli import main as cli_main
-from compare.figures import FIGURES, FigureSettings, omega_grid, quick_settings
+from compare.figures import (FIGURES, FigureSettings, compute_spectra, figure_size, omega_grid,
+                             plot_figure, quick_settings)
 from scenes import load_scene
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -27,12 +28,55 @@ def quick_run(tmp_path_factory):
 
 
 def test_pngs_written(quick_run):
+    from PIL import Image
+
     code, out, doc = quick_run
     assert code == 0
+    assert doc["dpi"] == 300 and doc["format"] == "png"
     for name in EXPECTED:
         data = (out / f"{name}.png").read_bytes()
         assert data.startswith(PNG_MAGIC) and len(data) > 5_000  # a drawn figure, not a stub
         assert doc["figures"][name]["file"] == f"{name}.png"
+        # Publication size at 300 dpi: Fig. 5 one column (3.5 in), the others two (7 in).
+        spec = next(f for f in FIGURES if f.name == name)
+        w_in, h_in = figure_size(spec)
+        assert w_in == (3.5 if name == "fig5" else 7.0)
+        with Image.open(out / f"{name}.png") as im:
+            assert im.size == (round(300 * w_in), round(300 * h_in))
+
+
+def test_titles_use_greek_symbols(quick_run):
+    _, _, doc = quick_run
+    # mathtext in the figures ($\lambda$ ...), plain Greek in figures.json.
+    assert all("$" in p.title for spec in FIGURES[1:] for p in spec.panels)
+    assert "λ" in doc["figures"]["fig8"]["panels"][0]["title"]
+    assert "γ" in doc["figures"]["fig8"]["panels"][0]["title"]
+    assert "μ" in doc["figures"]["fig11"]["panels"][0]["title"]
+    assert "lam" not in doc["figures"]["fig5"]["caption"]
+
+
+@pytest.fixture(scope="module")
+def fig5_spectra():
+    return compute_spectra(quick_settings(), figures=(FIGURES[0],))
+
+
+@pytest.mark.parametrize("fmt, magic", [("pdf", b"%PDF"), ("svg", b"<?xml")])
+def test_vector_formats(fig5_spectra, tmp_path, fmt, magic):
+    path = tmp_path / f"fig5.{fmt}"
+    plot_figure(FIGURES[0], fig5_spectra, path, dpi=300)
+    data = path.read_bytes()
+    assert data.startswith(magic) and len(data) > 5_000
+    if fmt == "svg":
+        assert b'width="252pt"' in data  # 3.5 in x 72 pt/in
+
+
+def test_dpi_sets_the_pixel_size(fig5_spectra, tmp_path):
+    from PIL import Image
+
+    for dpi in (100, 200):
+        plot_figure(FIGURES[0], fig5_spectra, tmp_path / f"f{dpi}.png", dpi=dpi)
+        with Image.open(tmp_path / f"f{dpi}.png") as im:
+            assert im.size == (round(3.5 * dpi), round(4.2 * dpi))
 
 
 def test_json_arrays_consistent(quick_run):
@@ -119,6 +163,7 @@ def test_every_figure_has_distinct_panels():
 
 @pytest.mark.parametrize("argv, needle", [
     (["figures", "--workers", "0", "--quick"], "--workers"),
+    (["figures", "--dpi", "10", "--quick"], "--dpi"),
 ])
 def test_bad_input(argv, needle, capsys, tmp_path):
     assert cli_main(argv + ["--out", str(tmp_path / "x")]) == 2

@@ -17,7 +17,7 @@ from analytic.excitation import Pulse
 from analytic.trajectory import OverturnCriterion, Trajectory, Verdict
 from compare.cli import main
 from scenes import load_scene
-from scenes.draw import trilith_shape, view_limits
+from scenes.draw import bob_radius, trilith_shape, view_limits
 from scenes.view import display_problem
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -86,6 +86,26 @@ def test_mirror_symmetry_and_pendulum():
     assert trilith_shape(s.without_pendulum(), 0.3).bob is None
 
 
+@pytest.mark.parametrize("theta, psi", [(1.5, 0.87), (-1.5, -0.9), (1.4, 0.0), (1.45, -0.3)])
+def test_fallen_trilith_bob_lies_on_the_ground(theta, psi):
+    """Past overturning the model's bob point is below the ground (the model has no
+    bob-ground contact); it is drawn on the ground, still l from the hinge."""
+    s = FIG5
+    free = trilith_shape(s, theta, psi)
+    hinge = free.hinge
+    raw = hinge + s.pendulum_length * np.array([math.sin(psi), -math.cos(psi)])
+    assert raw[1] < 0.0  # the case of the issue: the model's point is under the ground
+    r = bob_radius(s)
+    assert free.bob_grounded and free.bob[1] == pytest.approx(r, abs=TOL)
+    assert np.linalg.norm(free.bob - hinge) == pytest.approx(s.pendulum_length, abs=TOL)
+    assert np.sign(free.bob[0] - hinge[0]) == np.sign(math.sin(psi) or 1.0)
+
+
+def test_upright_bob_is_not_moved():
+    shape = trilith_shape(FIG5, 0.3, 0.8)
+    assert not shape.bob_grounded
+
+
 def test_lintel_only_when_there_is_one():
     # single_block: mu = 0 and no pendulum, the engines build no lintel body.
     assert trilith_shape(load_scene("single_block"), 0.1).lintel is None
@@ -146,6 +166,59 @@ def test_gif_has_fps_times_duration_frames_that_change(tmp_path):
         assert im.info["duration"] == pytest.approx(1000.0 / fps, abs=10)
 
 
+def overturning(backend: str, t_end: float, t_over: float) -> Trajectory:
+    """A synthetic run that overturns (|theta| = 1.5 rad) at ``t_over`` and stops."""
+    t = np.linspace(0.0, t_end, 101)
+    theta = 1.5 * (t / t_over) ** 2
+    keep = t <= t_over
+    t, theta = t[keep], theta[keep]
+    psi = 0.2 * np.sin(4 * t)
+    return Trajectory(backend, t, theta, np.gradient(theta, t), psi, np.gradient(psi, t), (),
+                      Verdict("overturned", mode="no-impact", time=float(t[-1])),
+                      OverturnCriterion(), t_end)
+
+
+def test_recording_stops_soon_after_every_run_has_ended(tmp_path):
+    """No frozen panels: 0.5 s after the last run ended, not the whole --duration."""
+    trajs = {"analytic": overturning("analytic", 3.0, 1.0),
+             "pymunk": overturning("pymunk", 3.0, 1.2)}
+    fps = 10.0
+    result = rec.record(FIG5, Pulse(25.0, 11.0), "all", tmp_path / "o.gif",
+                        rec.RecordSettings(fps=fps, duration=3.0, panel_width=96,
+                                           panel_height=72), trajectories=trajs)
+    end = max(float(tr.t[-1]) for tr in trajs.values())
+    assert result.duration == pytest.approx(end + rec.HOLD_AFTER_END)
+    assert result.n_frames == round(fps * (end + rec.HOLD_AFTER_END))
+    # A run that goes on keeps the full span.
+    trajs["pybullet"] = synthetic("pybullet", 0.1, t_end=3.0)
+    assert rec.shown_duration(trajs, 3.0) == 3.0
+
+
+def test_panels_share_scale_camera_and_time_base():
+    """Every panel: same limits; the camera follows the base (a state drawn at two
+    ground displacements lands on the same pixels); the world lines move by -x_g."""
+    from matplotlib.figure import Figure
+
+    pulse = Pulse(25.0, 11.0)
+    times = rec.frame_times(2.0, 10.0)
+    trajs = {"analytic": synthetic("analytic", 0.2, 2.0), "pymunk": synthetic("pymunk", -0.1, 2.0),
+             "pybullet": synthetic("pybullet", 0.05, 2.0)}
+    panels = rec.Panels(FIG5, pulse, times, trajs, Figure(figsize=(9, 3)))
+    limits = {(a.ax.get_xlim(), a.ax.get_ylim()) for a in panels.artists.values()}
+    assert len(limits) == 1
+    art = panels.artists["analytic"]
+    art.update(0.0, 0.1, 0.2, 0.0)
+    cols0, world0 = art.columns[0].get_xy().copy(), art.world.get_xdata().copy()
+    art.update(0.0, 0.1, 0.2, 0.37)
+    assert art.columns[0].get_xy() == pytest.approx(cols0, abs=TOL)
+    shifted = np.asarray(art.world.get_xdata(), dtype=float)
+    step = 2.0 * FIG5.b
+    # World lines: same set modulo the line spacing, moved by -0.37 m.
+    frac = lambda x: np.mod(x[np.isfinite(x)], step)  # noqa: E731
+    assert sorted(frac(shifted))[0] == pytest.approx(np.mod(-0.37, step), abs=1e-9)
+    assert sorted(frac(np.asarray(world0, float)))[0] == pytest.approx(0.0, abs=1e-9)
+
+
 def test_held_state_after_the_run_ends(tmp_path):
     traj = synthetic("analytic", 0.1, t_end=0.5)
     theta, psi = rec.sample_states(traj, np.array([0.25, 0.5, 0.9]))
@@ -180,8 +253,8 @@ def test_missing_backend_is_a_clear_error(tmp_path, monkeypatch):
 
 
 def test_all_backends_side_by_side(tmp_path):
-    """Real backends, short run: three panels on one time base, PyBullet rendered by
-    its own software renderer when the engine module provides ``render_frames``."""
+    """Real backends, short run: three panels on one time base, all drawn in 2D from
+    their trajectories (one scale, one camera)."""
     out = tmp_path / "all.gif"
     settings = rec.RecordSettings(fps=10.0, duration=0.4, panel_width=128, panel_height=96)
     result = rec.record(FIG5, Pulse(19.0, 15.0), "all", out, settings)

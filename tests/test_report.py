@@ -1,5 +1,7 @@
 """The report pipeline: a tiny campaign written to disk, and its verdicts shown to
 be computed (a coarse engine time step makes one fail), plus CLI input errors.
+The report's content (trust table, conclusions, provenance) is checked on a
+synthetic campaign result (``tests/synthetic_report.py``, ~1 s).
 
 A tiny campaign (Pymunk only, point B, one restitution scene each way, one
 threshold frequency in a narrow spectrum window) keeps this file at ~30 s; the
@@ -14,6 +16,7 @@ import pytest
 from compare.campaign import CampaignConfig, run_campaign
 from compare.cli import main
 from compare.report_html import write_report
+from compare.verdicts import VERDICT_IDS
 
 # Narrow window 6-8 rad/s: far from the Fig. 5 mode jump without the pendulum
 # (17.5-18 rad/s), so the one threshold point is away from jumps.
@@ -43,7 +46,10 @@ def test_report_files_and_keys(tiny_report):
     # Self-contained: plots inline, nothing fetched.
     assert html.count("data:image/png;base64,") >= 3
     assert "http://" not in html and "https://" not in html
-    assert "| metric | backend |" in (out / "summary.md").read_text()
+    assert "| id | engine | value |" in (out / "summary.md").read_text()
+    assert summary["schema_version"] == 2 and summary["quick"] is False
+    assert {v["id"] for v in summary["verdicts"]} <= set(VERDICT_IDS)
+    assert set(summary["trust"]) == {"pymunk"}
     # Provenance travels with every number.
     thr = summary["spectra"]["no_pendulum"]["engines"]["pymunk"][0]
     assert thr["provenance"]["dt"] == pytest.approx(1e-4)
@@ -102,3 +108,89 @@ def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
     (row,) = result.verdicts
     assert row["value"] is None and row["passed"] is False
     assert "1 not measured" in row["detail"]
+
+
+# --- report content, on the synthetic campaign result ---------------------------------
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    from synthetic_report import synthetic_result
+
+    from compare.provenance import collect
+
+    result = synthetic_result()
+    out = tmp_path_factory.mktemp("synthetic")
+    write_report(result, out, collect(quick=True, backends=result.versions))
+    return result, json.loads((out / "summary.json").read_text()), out
+
+
+def test_trust_table_is_computed_from_the_measurements(synthetic):
+    result, doc, _ = synthetic
+    pb = doc["trust"]["pybullet"]
+    # Worst restitution of the no-pendulum runs, as measured.
+    assert pb["restitution_eq20"]["value"] == pytest.approx(max(
+        r["max_rel_error"] for r in result.restitution
+        if r["backend"] == "pybullet" and not r["pendulum"]))
+    # Thresholds: sorted by the model's amplitude, the engine agrees (2 %) up to the
+    # last point before the first disagreement (-6.6 % at 60 m/s^2 in the synthetic data).
+    thr = pb["thresholds"]
+    assert (thr["n_points"], thr["n_agree"]) == (4, 3)
+    assert thr["agree_up_to"] == pytest.approx(30.0)
+    assert thr["omega_range"] == [8.0, 14.0]
+    first = thr["first_disagreement"]
+    assert first["rel_error"] == pytest.approx(-0.066) and first["cause"] == "contact"
+    assert doc["trust"]["pymunk"]["thresholds"]["agree_up_to"] == pytest.approx(60.0)
+    # Cost: median of the A-D run walls.
+    assert pb["cost"]["run_s"] == pytest.approx(1.1)
+    assert pb["settings"] == {"dt": 1e-4, "solver_iterations": 50}
+
+
+def test_conclusions_follow_the_numbers(synthetic):
+    _, doc, _ = synthetic
+    pb, pm = doc["trust"]["pybullet"]["conclusion"], doc["trust"]["pymunk"]["conclusion"]
+    assert "up to A = 30 m/s²" in pb and "-6.6 %" in pb and "cause: contact" in pb
+    assert "Eq. 19: off by 0.6 %" in pb  # the synthetic PyBullet misses Eq. 19
+    assert "does not reproduce" not in pm  # every synthetic Pymunk number is within tolerance
+    assert "up to A = 60 m/s²" in pm
+
+
+def test_missing_cause_reads_not_measured():
+    from compare.trust import threshold_agreement
+
+    pts = [{"omega": 10.0, "a_reference": 20.0, "a_engine": 21.0, "rel_error": 0.05,
+            "bracketed": True}]
+    out = threshold_agreement(pts, 0.02)
+    assert out["agree_up_to"] is None and out["failing"][0]["cause"] is None
+    from compare.trust import conclusion
+    row = {"version": "v", "settings": {}, "thresholds": out,
+           "cost": {"run_s": None, "spectrum_s": None}}
+    assert "cause: not measured" in conclusion("pymunk", row)
+
+
+def test_html_first_screen_provenance_and_layout(synthetic):
+    _, doc, out = synthetic
+    html = (out / "index.html").read_text(encoding="utf-8")
+    # The trust table comes before any evidence; settings are folded away at the end.
+    assert html.index("Trust table") < html.index("Verdicts") < html.index("<details>")
+    assert "QUICK RUN" in html and doc["quick"] is True
+    assert "name='viewport'" in html and "max-width:100%" in html
+    assert html.count("class='scroll'") >= 5  # every table scrolls inside its own box
+    assert "Runs that raised" not in html  # no empty table
+    assert "threshold:pybullet" not in html  # human labels for run times
+    assert "overturning thresholds (bisections), PyBullet" in html
+    assert "http://" not in html and "https://" not in html
+    assert html.count("data:image/png;base64,") >= 5  # spectra, convergence, A, B, restitution
+    prov = doc["provenance"]
+    for key in ("date", "commit", "command", "versions", "machine"):
+        assert prov[key]
+    assert {"python", "numpy", "scipy", "pybullet", "pymunk"} <= set(prov["versions"])
+    # Percentages where the tolerance is a percentage.
+    assert "≤ 0.5 %" in html and "within 2 %" in html
+
+
+def test_command_line_is_recorded(tmp_path, monkeypatch):
+    import argparse
+
+    from compare.provenance import command_line
+
+    args = argparse.Namespace(command="report", scene="fig5", quick=True, out="x y", dt=None)
+    assert command_line(args) == "trilith report --scene fig5 --quick --out 'x y'"

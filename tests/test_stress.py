@@ -20,7 +20,7 @@ import pytest
 
 from analytic import equations as eq
 from analytic import fast
-from analytic.excitation import Pulse, Still
+from analytic.excitation import Pulse
 from analytic.parameters import Scene
 from analytic.simulate import Settings as AccurateSettings
 from analytic.simulate import simulate as simulate_accurate

@@ -58,17 +58,20 @@ def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "--out", directory=True)
 
     from compare.campaign import CampaignConfig, run_campaign
+    from compare.provenance import collect
     from compare.report_html import write_report
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     t0 = time.perf_counter()
+    provenance = collect(args, quick=args.quick)  # the code as it was when the run started
     result = run_campaign(config)
-    paths = write_report(result, out)
+    provenance["versions"].update(result.versions)
+    paths = write_report(result, out, provenance)
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"
-          f"{len(result.verdicts)} verdicts pass, {time.perf_counter() - t0:.0f} s)",
-          file=sys.stdout)
+          f"{len(result.verdicts)} verdicts pass{' (QUICK run)' if args.quick else ''}, "
+          f"{time.perf_counter() - t0:.0f} s)", file=sys.stdout)
     detail(f"{workers} workers; engines {', '.join(engines)}")
     for v in result.verdicts:
         if not v["passed"]:

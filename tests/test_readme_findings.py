@@ -1,0 +1,49 @@
+"""The README's engine findings are not typed by hand: the block between the
+findings markers is exactly what ``compare.findings.render`` makes of the stored
+full-campaign summary (``docs/validation/summary.json``), and that summary's
+trust table is what ``compare.trust`` computes from its own measurements."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from compare.findings import BEGIN, END, render
+from compare.trust import trust_table
+from compare.verdicts import VERDICT_IDS
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+SUMMARY = ROOT / "docs" / "validation" / "summary.json"
+
+
+@pytest.fixture(scope="module")
+def doc() -> dict:
+    return json.loads(SUMMARY.read_text(encoding="utf-8"))
+
+
+def test_readme_block_is_generated_from_the_summary(doc):
+    text = README.read_text(encoding="utf-8")
+    assert text.count(BEGIN) == 1 and text.count(END) == 1
+    block = text.split(BEGIN, 1)[1].split(END, 1)[0].strip("\n")
+    assert block == render(doc), ("README findings differ from docs/validation/summary.json; "
+                                  "run: python -m compare.findings docs/validation/summary.json "
+                                  "README.md")
+
+
+def test_stored_summary_is_a_full_campaign_with_a_consistent_trust_table(doc):
+    assert doc["schema_version"] == 2 and doc["quick"] is False
+    assert "--quick" not in doc["provenance"]["command"]
+    assert {v["id"] for v in doc["verdicts"]} == set(VERDICT_IDS)
+    # The stored trust table is what compare.trust computes from the stored
+    # measurements (the conclusion's wording may have been improved since).
+    recomputed = trust_table(doc)
+    strip = lambda t: {e: {k: v for k, v in row.items() if k != "conclusion"}  # noqa: E731
+                       for e, row in t.items()}
+    assert strip(recomputed) == strip(doc["trust"])
+
+
+def test_no_stale_hand_typed_threshold_claim():
+    # Issue 14: "within 0.4 % up to about 53 m/s^2" contradicted the report.
+    assert "0.4 % of the model up to about 53" not in README.read_text(encoding="utf-8")
