@@ -163,11 +163,33 @@ def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omeg
     return settings
 
 
+@dataclass(frozen=True)
+class ClassifiedThreshold:
+    """An engine threshold point and the measured cause of its disagreement
+    (:func:`compare.engine_spectrum.classify`; 'agrees' within tolerance)."""
+
+    point: object
+    cause: str
+    cause_detail: str
+    convergence: tuple = ()
+
+    def to_dict(self) -> dict:
+        return {**self.point.to_dict(), "cause": self.cause, "cause_detail": self.cause_detail,
+                "convergence": list(self.convergence)}
+
+
 def _job_threshold(name, scene, omega, a_ref, mode_ref, config):
+    from .engine_spectrum import classify
     # The bracket never widens past 2 A_ref (rel_bracket * 2^max_expand < 1).
     settings = _pulse_settings(name, config, scene, 2.0 * a_ref, omega)
-    return engine_threshold(name, scene, omega, a_ref, settings, mode_reference=mode_ref,
-                            rel_bracket=config.rel_bracket, rel_tol=config.rel_tol)
+    p = engine_threshold(name, scene, omega, a_ref, settings, mode_reference=mode_ref,
+                         rel_bracket=config.rel_bracket, rel_tol=config.rel_tol)
+    tol = config.tolerances.threshold
+    if p.bracketed and abs(p.rel_error) <= tol and not p.collapsed_below:
+        return ClassifiedThreshold(p, "agrees", f"within {100 * tol:g} %")
+    # A failing point is always explained: model check, then dt/2, dt/4, 2x iterations.
+    return ClassifiedThreshold(p, *classify(name, scene, omega, p, settings, tol=tol,
+                                            rel_tol=config.rel_tol))
 
 
 def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
