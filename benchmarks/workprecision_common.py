@@ -19,6 +19,8 @@ from typing import Callable
 
 import numpy as np
 
+from compare import atomic
+
 __all__ = ["Point", "timed", "pareto_front", "mark_front", "bisect_threshold", "machine_info",
            "write_json", "plot_work_precision", "OUT_DIR"]
 
@@ -173,7 +175,7 @@ def machine_info() -> dict:
 def write_json(path: Path, machine: dict, points: list[Point], meta: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"machine": machine, "meta": meta, "points": [p.to_dict() for p in points]}
-    path.write_text(json.dumps(payload, indent=1, allow_nan=False, default=_default))
+    atomic.write_text(path, json.dumps(payload, indent=1, allow_nan=False, default=_default))
 
 
 def _default(value):
@@ -220,5 +222,5 @@ def plot_work_precision(points: list[Point], metric: str, path: Path, title: str
     ax.legend(fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    atomic.savefig(fig, path, dpi=110)
     plt.close(fig)

@@ -10,14 +10,15 @@
   (bisection bracketed by the analytic spectrum) and the jump frequency shift;
 * a verdict table (metric, backend, value, tolerance, passed, reason).
 
-Independent runs go to a process pool (fork; results in submission order, so
-the numbers do not depend on scheduling).  Progress bar on a terminal only.
+Independent runs go to :func:`compare.runs.run_many` (local processes or a Dask
+cluster; results in submission order, so the numbers do not depend on
+scheduling), every engine run through the run store (:mod:`compare.runs`).
+Progress bar on a terminal only.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
-import multiprocessing as mp
 import sys
 import time
 from dataclasses import dataclass, field
@@ -26,7 +27,7 @@ from analytic.excitation import Pulse, Still
 from engines import ENGINES, get_backend
 from scenes import load_scene
 
-from . import metrics
+from . import metrics, runs
 from .spectra import choose_frequencies, reference_spectrum
 from .thresholds import engine_jump_frequency, engine_threshold
 
@@ -154,7 +155,7 @@ def _free_rocking_settings(name: str, config: CampaignConfig, theta0: float):
 def _job_history(name, scene, point, config):
     amp, omega = POINTS[point]
     settings = backend_settings(name, config)
-    return get_backend(name).simulate(scene, Pulse(amp, omega), settings)
+    return runs.simulate(name, scene, Pulse(amp, omega), settings)
 
 
 def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = None
@@ -171,7 +172,7 @@ def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = N
     t_max = (0.5 * (times[-2] + times[-1]) if len(times) > config.n_impacts
              else (times[-1] if times else 0.0) + 0.5)
     settings = dataclasses.replace(_free_rocking_settings(name, config, theta0), t_max=t_max)
-    traj = get_backend(name).simulate(scene, Still(), settings)
+    traj = runs.simulate(name, scene, Still(), settings)
     return metrics.restitution_from_trajectory(traj, scene, config.n_impacts)
 
 
@@ -235,30 +236,12 @@ def _progress(total: int):
 def _execute(jobs: list, workers: int) -> list:
     """Run ``jobs`` ((kind, args) pairs); results in job order."""
     bar = _progress(len(jobs))
-    results = [None] * len(jobs)
     try:
-        if workers <= 1 or len(jobs) <= 1:
-            for i, job in enumerate(jobs):
-                results[i] = _run_one(job)
-                if bar is not None:
-                    bar.update()
-        else:
-            ctx = mp.get_context("fork")
-            with ctx.Pool(workers) as pool:
-                indexed = pool.imap_unordered(_indexed, list(enumerate(jobs)))
-                for i, res in indexed:
-                    results[i] = res
-                    if bar is not None:
-                        bar.update()
+        return list(runs.run_many(_run_one, jobs, workers=workers,
+                                  on_done=None if bar is None else lambda i, r: bar.update()))
     finally:
         if bar is not None:
             bar.close()
-    return results
-
-
-def _indexed(pair):
-    i, job = pair
-    return i, _run_one(job)
 
 
 def _case(pendulum: bool) -> str:

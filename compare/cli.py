@@ -46,7 +46,9 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:  # includes UsageError: validation at the boundary
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # pending work was cancelled (compare.runs.run_many)
+        print("interrupted: cancelled; finished runs are kept in the run store",
+              file=sys.stderr)
         return 130
 
 

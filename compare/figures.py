@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
+from compare import atomic
 from compare.commands._common import clean_nan
 from scenes import load_scene
 
@@ -232,7 +233,7 @@ def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path) ->
                 ax.set_ylabel(r"$A_s$ [m/s$^2$]", fontsize=8)
     fig.suptitle(spec.caption, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=80)
+    atomic.savefig(fig, path, dpi=80)
     plt.close(fig)
 
 
@@ -281,6 +282,5 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     doc["n_undecided"] = int(sum(s.n_undecided for s in spectra.values()))
     doc["wall_time"] = time.perf_counter() - t0
     doc = clean_nan(doc)
-    with open(out / "figures.json", "w") as fh:
-        json.dump(doc, fh, indent=1, allow_nan=False)
+    atomic.write_text(out / "figures.json", json.dumps(doc, indent=1, allow_nan=False))
     return doc

@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from . import atomic  # noqa: E402
 from .campaign import POINTS  # noqa: E402
 from .commands._common import clean_nan  # noqa: E402
 from .metrics import _plain  # noqa: E402
@@ -266,7 +267,7 @@ def write_report(result, out_dir) -> dict[str, Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md"}
-    paths["json"].write_text(json.dumps(summary_dict(result), indent=1, allow_nan=False))
-    paths["md"].write_text(render_markdown(result))
-    paths["html"].write_text(render_html(result), encoding="utf-8")
+    atomic.write_text(paths["json"], json.dumps(summary_dict(result), indent=1, allow_nan=False))
+    atomic.write_text(paths["md"], render_markdown(result))
+    atomic.write_text(paths["html"], render_html(result))
     return paths

@@ -40,8 +40,8 @@ def overturns(backend: str, scene, omega: float, amplitude: float, settings=None
     'unstable' and 'undecided' runs count as not overturned; their status is
     returned so callers can flag them.
     """
-    from engines import get_backend
-    traj = get_backend(backend).simulate(scene, Pulse(amplitude, omega, kind), settings)
+    from .runs import simulate
+    traj = simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
     return traj.overturned, traj.verdict.status, traj.verdict.mode
 
 

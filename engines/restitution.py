@@ -198,7 +198,8 @@ def measure_restitution(backend_name: str, scene, theta0: float, settings=None,
     else:
         t_max = times[-1] + 0.5
     run_settings = _prepare_settings(backend_name, backend, settings, theta0, psi0, t_max)
-    traj = backend.simulate(scene, Still(), run_settings)
+    from compare.runs import simulate as run_simulate  # the run store (issue 12)
+    traj = run_simulate(backend_name, scene, Still(), run_settings)
 
     b, h, mu, gamma, j, l, g = scene.model_args()
     impacts = traj.impacts[:n_impacts]

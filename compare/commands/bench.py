@@ -11,6 +11,8 @@ import importlib
 import sys
 from pathlib import Path
 
+from ._common import add_store_args, use_store
+
 ROOT = Path(__file__).resolve().parents[2]
 ENGINES = ("pybullet", "pymunk")
 
@@ -30,6 +32,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              f"[{','.join(ENGINES)}]")
     parser.add_argument("--no-analytic", action="store_true",
                         help="skip the analytic paths")
+    add_store_args(parser)  # the untimed analytic references only; timed runs always run
     return parser
 
 
@@ -58,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out is not None else None
     if out is not None and out.exists() and not out.is_dir():
         raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
+    use_store(args)
     bench = _load_bench()
     bench.run(quick=args.quick, out=out, engines=engines, analytic=not args.no_analytic)
     return 0

@@ -10,9 +10,12 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 
 from engines import ENGINES
 from scenes import scene_path
+
+from ._common import add_store_args, use_store
 
 
 def add_parser(subparsers) -> None:
@@ -28,6 +31,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--workers", type=int, default=2, help="parallel processes, >= 1 [2]")
     p.add_argument("--dt", type=float, default=None,
                    help="override every engine's time step [s] (default: calibrated)")
+    add_store_args(p, scheduler=True)
 
 
 def parse_engines(text: str) -> tuple[str, ...]:
@@ -41,6 +45,7 @@ def parse_engines(text: str) -> tuple[str, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from compare import atomic, runs
     from compare.campaign import CampaignConfig, run_campaign
     from compare.report_html import write_report
 
@@ -50,9 +55,15 @@ def run(args: argparse.Namespace) -> int:
     changes = dict(scene=args.scene, engines=parse_engines(args.engines), workers=args.workers,
                    engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
+    if Path(args.out).is_file():
+        raise ValueError(f"--out must be a directory, got the file {args.out!r}")
+    use_store(args)
     t0 = time.perf_counter()
-    result = run_campaign(config)
-    paths = write_report(result, args.out)
+    with atomic.output_lock(args.out):  # a second report into the same --out: clear error
+        result = run_campaign(config)
+        with atomic.report_dir(args.out, lock=False) as tmp:  # swapped in whole
+            paths = {k: Path(args.out) / p.name for k, p in write_report(result, tmp).items()}
+    print(runs.stats_line(), file=sys.stderr)
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"
           f"{len(result.verdicts)} verdicts pass, {time.perf_counter() - t0:.0f} s)",

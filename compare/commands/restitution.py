@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import add_scene_args, clean_nan, print_json, scene_from_args
+from ._common import (add_scene_args, add_store_args, clean_nan, print_json, scene_from_args,
+                      use_store)
 
 # Half the static overturning angle: large, clean impacts far from toppling.
 DEFAULT_THETA0_FRACTION = 0.5
@@ -29,6 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--n-impacts", type=int, default=None,
                         help="impacts to measure, in [1, 50] [4]")
     parser.add_argument("--json", action="store_true", help="print a JSON object")
+    add_store_args(parser)
     return parser
 
 
@@ -38,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     theta0 = args.theta0 if args.theta0 is not None else DEFAULT_THETA0_FRACTION * scene.alpha
     n = args.n_impacts if args.n_impacts is not None else DEFAULT_N_IMPACTS
+    use_store(args)
     result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0)
     if args.json:
         print_json(clean_nan(result.to_dict()))

@@ -71,7 +71,8 @@ def _plot(traj, scene, path: str) -> None:
         axes[1, 0].set_ylabel(r"$\psi$ [rad]")
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    from compare.atomic import savefig
+    savefig(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -84,7 +85,9 @@ def run(args: argparse.Namespace) -> int:
     settings = _settings(backend, args.criterion, args.t_max)
     traj = backend.simulate(scene, pulse, settings)
     if args.csv:
-        traj.to_csv(args.csv)
+        from compare.atomic import atomic_path
+        with atomic_path(args.csv) as tmp:
+            traj.to_csv(tmp)
     if args.plot:
         _plot(traj, scene, args.plot)
     if args.json:
