@@ -244,6 +244,15 @@ def _execute(jobs: list, workers: int) -> list:
             bar.close()
 
 
+def _memo(kind: str, scene, config: CampaignConfig, compute):
+    """A model-side result (reference spectrum, chosen frequencies) through the run
+    store, keyed by the scene and the config (but its worker count: no number
+    depends on it)."""
+    from .store import scene_dict
+    described = {k: v for k, v in config.to_dict().items() if k != "workers"}
+    return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute)
+
+
 def _case(pendulum: bool) -> str:
     return "pendulum" if pendulum else "no_pendulum"
 
@@ -304,14 +313,17 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     # Reference spectra first (in this process: the compiled kernels are then
     # inherited by the forked workers).
     t0 = time.perf_counter()
-    ref_spectra = {pend: reference_spectrum(sc, config) for pend, sc in scenes.items()
+    ref_spectra = {pend: _memo("reference-spectrum", sc, config,
+                               lambda sc=sc: reference_spectrum(sc, config))
+                   for pend, sc in scenes.items()
                    if _case(pend) in (*config.spectrum_cases, *config.jump_cases)}
     result.timings["reference_spectra"] = time.perf_counter() - t0
 
     jobs, labels = [], []
     for pend, spec in ref_spectra.items():
         sc = scenes[pend]
-        freqs = choose_frequencies(spec, config, sc) if _case(pend) in config.spectrum_cases else []
+        freqs = _memo("frequencies", sc, config, lambda: choose_frequencies(spec, config, sc)) \
+            if _case(pend) in config.spectrum_cases else []
         for omega, a_ref, mode in freqs:
             for name in config.engines:
                 jobs.append(("threshold", (name, sc, omega, a_ref, mode, config)))
@@ -358,7 +370,9 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
             ref_spectra[pend].setdefault("engines", {}).setdefault(name, []).append(out.to_dict())
         elif kind == "jump":
             ref_spectra[pend].setdefault("jump_shifts", {})[name] = out.to_dict()
-    for (point, pend, name), traj in sorted(result.histories.items(), key=str):
+    # Sorted by the key's text (str of the whole item would print every array).
+    for (point, pend, name), traj in sorted(result.histories.items(),
+                                            key=lambda kv: str(kv[0])):
         ref = result.histories.get((point, pend, config.reference))
         if name == config.reference or ref is None:
             continue

@@ -74,7 +74,9 @@ def _history_figure(result, point: str) -> str:
     amp, omega = POINTS[point]
     for col, pend in enumerate(cases):
         scene = result.scene if pend else result.scene.without_pendulum()
-        for (pt, p, name), traj in sorted(result.histories.items(), key=str):
+        # Sorted by the key's text (str of the whole item would print every array).
+        for (pt, p, name), traj in sorted(result.histories.items(),
+                                          key=lambda kv: str(kv[0])):
             if pt != point or p != pend:
                 continue
             style = dict(color=_COLORS.get(name), lw=1.0, label=name,
