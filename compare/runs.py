@@ -250,10 +250,13 @@ def _run_local(payloads, workers: int, on_done):
         if finished:
             ex.shutdown(wait=True)
         else:  # Ctrl-C, an error, or the caller stopped early: stop now, not at the end
-            ex.shutdown(wait=False, cancel_futures=True)
-            for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            # The executor has no public kill (3.14's terminate_workers); take its
+            # processes before shutdown() forgets them, else exit waits for them.
+            procs = list((getattr(ex, "_processes", None) or {}).values())
+            for proc in procs:
                 proc.kill()
-            for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            ex.shutdown(wait=False, cancel_futures=True)
+            for proc in procs:
                 proc.join(timeout=1.0)
 
 

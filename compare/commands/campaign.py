@@ -75,9 +75,9 @@ def run(args: argparse.Namespace) -> int:
         jobs = threshold_jobs(study, references)
         est = _estimates(study, jobs, store)
         print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
-              f"points, {len(jobs)} engine threshold jobs; estimated {sum(est) / 60:.0f} "
-              f"CPU-min at most (~{sum(est) / 60 / workers:.0f} min on {workers} workers; "
-              "jobs already in the store cost nothing)", file=sys.stderr)
+              f"points, {len(jobs)} engine threshold jobs; at most {_duration(sum(est))} of "
+              f"CPU, ~{_duration(sum(est) / workers)} on {workers} workers (jobs already in "
+              "the store cost nothing)", file=sys.stderr, flush=True)
         if args.estimate:
             return 0
         bar = _bar(sum(est))
@@ -95,6 +95,12 @@ def run(args: argparse.Namespace) -> int:
     print(f"campaign written to {out / 'index.html'} ({len(rows)} jobs, "
           f"{sum('error' in r for r in rows)} errors, {time.perf_counter() - t0:.0f} s)")
     return 0
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
 
 
 def _bar(total: float):
