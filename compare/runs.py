@@ -37,6 +37,10 @@ _ACTIVE: RunStore | None = None
 _SCHEDULER: str | None = None
 # Hits and computations in this process (plus those reported back by workers).
 STATS: Counter = Counter()
+# Backends whose runs cost less than a lookup: an analytic-fast trajectory takes
+# ~0.15 ms, a store hit ~0.35 ms and a miss ~1.1 ms of store work (68 kB to
+# write; benchmarks/bench_store.py), so they are always recomputed.
+UNSTORED = frozenset({"analytic-fast"})
 # Polling period of the parent's wait: Ctrl-C is acted on within it.
 _POLL_S = 0.2
 
@@ -81,7 +85,7 @@ def simulate(name: str, scene, excitation, settings=None):
 
     backend = get_backend(name)
     store = _ACTIVE
-    if store is None:
+    if store is None or name in UNSTORED:
         return backend.simulate(scene, excitation, settings)
     resolved = backend.Settings() if settings is None else settings
     key = run_key(name, scene, excitation, resolved)

@@ -67,9 +67,10 @@ def store(tmp_path):
     s.close()
 
 
-@pytest.mark.parametrize("backend", ["analytic-fast", "pymunk"])
+@pytest.mark.parametrize("backend", ["analytic", "pymunk"])
 def test_hit_is_bit_identical_to_fresh(store, fig5, backend):
-    settings = _pymunk_settings() if backend == "pymunk" else None
+    settings = (_pymunk_settings() if backend == "pymunk"
+                else get_backend("analytic").Settings(t_max=1.0))
     pulse = Pulse(25.0, 11.0)
     first = runs.simulate(backend, fig5, pulse, settings)
     assert store.count() == 1
