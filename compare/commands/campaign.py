@@ -10,6 +10,7 @@ come from the store.  ``--estimate`` prints the job count and the expected time
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -36,22 +37,32 @@ def add_parser(subparsers) -> None:
     add_store_args(p, scheduler=True)
 
 
-def _estimates(study, jobs, store) -> list[float]:
-    """Expected cost [s] of each threshold job: runs per job x the mean run cost
-    measured in the store for that engine and step (a prior when none is)."""
+def _run_cost(engine: str, dt: float, costs: dict) -> float:
+    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: calibrated):
+    the mean measured in the store at that step, else the measured step nearest
+    to it scaled by the step ratio (steps per simulated second), else a prior."""
+    from engines import get_backend
+
+    dt = dt or getattr(get_backend(engine).Settings(), "dt", 1e-4)
+    measured = {}
+    for label, (mean, _n) in costs.items():
+        name, _, step = label.partition(" dt=")
+        if name == engine and step:
+            measured[float(step)] = mean
+    if not measured:
+        return PRIOR_RUN_COST
+    if dt in measured:
+        return measured[dt]
+    near = min(measured, key=lambda s: abs(math.log(s / dt)))
+    return measured[near] * near / dt
+
+
+def _estimates(jobs, store) -> list[float]:
+    """Expected cost [s] of each threshold job: runs per job x the run cost."""
     from compare.study import JOB_RUNS
 
     costs = store.mean_costs("run") if store is not None else {}
-    out = []
-    for job in jobs:
-        engine, dt = job[6], job[7]
-        label = f"{engine} dt={dt:g}" if dt else None
-        mean = costs.get(label, (None, 0))[0] if label else None
-        if mean is None:  # calibrated step: any measured run of the engine
-            same = [m for lab, (m, n) in costs.items() if lab.startswith(engine + " ")]
-            mean = sum(same) / len(same) if same else PRIOR_RUN_COST
-        out.append(JOB_RUNS * mean)
-    return out
+    return [JOB_RUNS * _run_cost(job[6], job[7], costs) for job in jobs]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -73,17 +84,19 @@ def run(args: argparse.Namespace) -> int:
         references = dict(zip(ref_jobs, runs.run_many(run_reference, ref_jobs,
                                                        workers=workers)))
         jobs = threshold_jobs(study, references)
-        est = _estimates(study, jobs, store)
+        unique, index = distinct(jobs)
+        est = _estimates(unique, store)
         print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
-              f"points, {len(jobs)} engine threshold jobs; at most {_duration(sum(est))} of "
+              f"points, {len(jobs)} engine threshold jobs ({len(unique)} distinct); at most {_duration(sum(est))} of "
               f"CPU, ~{_duration(sum(est) / workers)} on {workers} workers (jobs already in "
               "the store cost nothing)", file=sys.stderr, flush=True)
         if args.estimate:
             return 0
         bar = _bar(sum(est))
-        rows = list(runs.run_many(run_threshold, jobs, workers=workers,
+        done = list(runs.run_many(run_threshold, unique, workers=workers,
                                   on_done=lambda i, r: bar.update(est[i])))
         bar.close()
+        rows = [{**done[i], "scene": job[0], "case": job[1]} for job, i in zip(jobs, index)]
         doc = {"study": study.describe(), "references": [
             {"scene": n, "case": c, "pulse": p, "omega": w, "a_reference": a, "mode": m}
             for (n, c, p, w), (a, m) in references.items()], "rows": rows,
@@ -95,6 +108,24 @@ def run(args: argparse.Namespace) -> int:
     print(f"campaign written to {out / 'index.html'} ({len(rows)} jobs, "
           f"{sum('error' in r for r in rows)} errors, {time.perf_counter() - t0:.0f} s)")
     return 0
+
+
+def distinct(jobs: list) -> tuple[list, list[int]]:
+    """The jobs with distinct store keys, and for each job the index of its
+    distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
+    the scene name is a label)."""
+    from compare.store import digest
+    from compare.study import threshold_description
+
+    seen: dict[str, int] = {}
+    unique, index = [], []
+    for job in jobs:
+        key = digest(threshold_description(job))
+        if key not in seen:
+            seen[key] = len(unique)
+            unique.append(job)
+        index.append(seen[key])
+    return unique, index
 
 
 def _duration(seconds: float) -> str:
