@@ -212,11 +212,26 @@ def _run_one(item):
     not sink a 10-minute campaign; the verdict table then reports it unmeasured)."""
     kind, args = item
     t0 = time.perf_counter()
-    try:
-        out = _JOBS[kind](*args)
+    try:  # through the store: a finished job is not redone (compare/ code in its key)
+        out = runs.memo("campaign-job", _job_description(item), lambda: _JOBS[kind](*args),
+                        code=runs.ALL_CODE)
     except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
         out = _JobError(f"{type(exc).__name__}: {exc}")
     return out, time.perf_counter() - t0
+
+
+def _job_description(item) -> dict:
+    kind, args = item
+    config = next((a for a in args if isinstance(a, CampaignConfig)), None)
+    described = None if config is None else {k: v for k, v in config.to_dict().items()
+                                             if k != "workers"}
+    return {"kind": kind, "args": _describe_args(args), "config": described}
+
+
+def _lookup(item):
+    """A finished job from the store (its wall time here: 0), or None."""
+    out = runs.lookup("campaign-job", _job_description(item), code=runs.ALL_CODE)
+    return None if out is None else (out, 0.0)
 
 
 @dataclass(frozen=True)
@@ -237,7 +252,7 @@ def _execute(jobs: list, workers: int) -> list:
     """Run ``jobs`` ((kind, args) pairs); results in job order."""
     bar = _progress(len(jobs))
     try:
-        return list(runs.run_many(_run_one, jobs, workers=workers,
+        return list(runs.run_many(_run_one, jobs, workers=workers, lookup=_lookup,
                                   on_done=None if bar is None else lambda i, r: bar.update()))
     finally:
         if bar is not None:
@@ -250,7 +265,8 @@ def _memo(kind: str, scene, config: CampaignConfig, compute):
     depends on it)."""
     from .store import scene_dict
     described = {k: v for k, v in config.to_dict().items() if k != "workers"}
-    return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute)
+    return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute,
+                     code=runs.ALL_CODE)
 
 
 def _case(pendulum: bool) -> str:

@@ -29,7 +29,7 @@ from concurrent.futures import FIRST_COMPLETED, wait
 
 from .store import RunStore, digest, project_version, run_key, source_digest
 
-__all__ = ["simulate", "memo", "run_many", "activate", "active", "using", "set_scheduler",
+__all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
            "STATS", "stats_line"]
 
 _ACTIVE: RunStore | None = None
@@ -102,15 +102,35 @@ def simulate(name: str, scene, excitation, settings=None):
     return traj
 
 
-def memo(kind: str, description: dict, compute, label: str = ""):
+MODEL_CODE = ("analytic", "engines")
+# Results computed by compare/ itself (campaign jobs, chosen frequencies).
+ALL_CODE = ("analytic", "engines", "compare")
+
+
+def memo_key(kind: str, description: dict, code: tuple = MODEL_CODE) -> str:
+    return digest({"kind": kind, "what": description, "project": project_version(),
+                   "code": source_digest(code)})
+
+
+def lookup(kind: str, description: dict, code: tuple = MODEL_CODE):
+    """The stored result of :func:`memo` (counted as a hit), or None."""
+    if _ACTIVE is None:
+        return None
+    value = _ACTIVE.get(memo_key(kind, description, code))
+    if value is not None:
+        STATS["hits"] += 1
+    return value
+
+
+def memo(kind: str, description: dict, compute, label: str = "",
+         code: tuple = MODEL_CODE):
     """``compute()`` through the active store, keyed by ``kind``, ``description``
     (everything that determines the result, as plain data), the project version
-    and the model/engine sources."""
+    and the sources of the ``code`` packages."""
     store = _ACTIVE
     if store is None:
         return compute()
-    key = digest({"kind": kind, "what": description, "project": project_version(),
-                  "code": source_digest(("analytic", "engines"))})
+    key = memo_key(kind, description, code)
     value = store.get(key)
     if value is not None:
         STATS["hits"] += 1
@@ -180,7 +200,7 @@ def _call(payload):
 
 # ------------------------------------------------------------------- the map
 def run_many(fn, items, *, workers: int = 1, scheduler: str | None = None,
-             on_done=None):
+             on_done=None, lookup=None):
     """``fn(item)`` for every item; yields the results in submission order.
 
     Parameters
@@ -197,6 +217,9 @@ def run_many(fn, items, *, workers: int = 1, scheduler: str | None = None,
     on_done : callable, optional
         ``on_done(index, result)`` in this process as each item finishes (in
         completion order; for progress bars).
+    lookup : callable, optional
+        ``lookup(item)`` -> the stored ``fn(item)`` or None, tried here first:
+        only the items it misses go to workers (a warm rerun starts no pool).
 
     Ctrl-C (KeyboardInterrupt) cancels what is pending, kills running local
     workers at once and re-raises; so does closing the generator early.
@@ -204,6 +227,19 @@ def run_many(fn, items, *, workers: int = 1, scheduler: str | None = None,
     items = list(items)
     if not (isinstance(workers, int) and workers >= 1):
         raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    if lookup is not None and _ACTIVE is not None:
+        found = [lookup(item) for item in items]
+        todo = [i for i, f in enumerate(found) if f is None]
+        rest = run_many(fn, [items[i] for i in todo], workers=workers, scheduler=scheduler,
+                        on_done=None if on_done is None else
+                        (lambda j, out: on_done(todo[j], out)))
+        for i, value in enumerate(found):
+            if value is None:
+                value = next(rest)
+            elif on_done is not None:
+                on_done(i, value)
+            yield value
+        return
     scheduler = _SCHEDULER if scheduler is None else scheduler
     store_dir = str(_ACTIVE.directory) if _ACTIVE is not None else None
     payloads = [(fn, item, store_dir) for item in items]

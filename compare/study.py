@@ -211,7 +211,7 @@ def run_threshold(job: tuple) -> dict:
            "a_reference": a_ref, "mode_reference": mode}
     try:
         point = runs.memo("threshold", threshold_description(job), compute,
-                          label=f"threshold {e} dt={dt:g}")
+                          label=f"threshold {e} dt={dt:g}", code=runs.ALL_CODE)
     except Exception as exc:  # noqa: BLE001 - one bad run must not sink hours of work
         return {**row, "error": f"{type(exc).__name__}: {exc}"}
     return {**row, "a_engine": point.a_engine, "a_low": point.a_low,
