@@ -36,15 +36,20 @@ def _strip(obj):
     return obj
 
 
-def _report(out: Path, *store_args: str) -> tuple[float, dict]:
+def _report(out: Path, *store_args: str) -> tuple[float, float, dict]:
+    """Wall time, CPU time (the command and its waited-for workers) and summary."""
+    import resource
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "compare.cli", "report", "--quick", "--out",
                            str(out), *store_args], cwd=ROOT, capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
     if proc.returncode != 0:
         raise RuntimeError(f"report failed: {proc.stderr[-2000:]}")
-    return wall, _strip(json.loads((out / "summary.json").read_text()))
+    return wall, cpu, _strip(json.loads((out / "summary.json").read_text()))
 
 
 def per_run_overhead() -> dict:
@@ -94,9 +99,9 @@ def per_run_overhead() -> dict:
 def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        t_plain, s_plain = _report(tmp / "r0", "--no-cache")
-        t_cold, s_cold = _report(tmp / "r1", "--cache", str(tmp / "cache"))
-        t_warm, s_warm = _report(tmp / "r2", "--cache", str(tmp / "cache"))
+        t_plain, c_plain, s_plain = _report(tmp / "r0", "--no-cache")
+        t_cold, c_cold, s_cold = _report(tmp / "r1", "--cache", str(tmp / "cache"))
+        t_warm, c_warm, s_warm = _report(tmp / "r2", "--cache", str(tmp / "cache"))
     same = s_plain == s_cold == s_warm
     speedup, overhead = t_cold / t_warm, t_cold / t_plain
     runs_ = per_run_overhead()
@@ -104,12 +109,17 @@ def main() -> int:
           f"{t_warm:.1f} s: warm speed-up {speedup:.1f}x (target >= {TARGET_SPEEDUP:g}), "
           f"cold-with-store / no-store {overhead:.3f}; summaries "
           f"{'identical' if same else 'DIFFER'}")
+    # CPU time does not count other processes' load on a shared machine.
+    print(f"  CPU time: no store {c_plain:.1f} s, cold {c_cold:.1f} s, warm {c_warm:.1f} s: "
+          f"speed-up {c_cold / c_warm:.1f}x, cold-with-store / no-store "
+          f"{c_cold / c_plain:.3f}; load average {os.getloadavg()[0]:.1f}")
     for name, r in runs_.items():
         print(f"  {name}: run {r['run_ms']:.2f} ms; store work on a miss "
               f"{r['miss_overhead_ms']:.3f} ms ({100 * r['miss_overhead_rel']:.1f} % of the run),"
               f" a hit {r['hit_ms']:.3f} ms; {r['blob_kB']:.0f} kB stored")
     write("store", {"machine": machine(), "report_quick_s": {
-        "no_cache": t_plain, "cold": t_cold, "warm": t_warm}, "warm_speedup": speedup,
+        "no_cache": t_plain, "cold": t_cold, "warm": t_warm}, "report_quick_cpu_s": {
+        "no_cache": c_plain, "cold": c_cold, "warm": c_warm}, "warm_speedup": speedup,
         "cold_overhead_ratio": overhead, "summaries_identical": same, "per_run": runs_})
     return 0 if same and speedup >= TARGET_SPEEDUP else 1
 

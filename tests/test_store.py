@@ -209,3 +209,17 @@ def test_second_writer_of_an_output_gets_a_clear_error(tmp_path):
                 pass
     with atomic.report_dir(out):  # released: fine again
         pass
+
+
+def test_run_many_lookup_sends_only_missing_items(store):
+    calls = []
+
+    def fn(x):
+        calls.append(x)
+        return runs.memo("demo", {"x": x}, lambda: x * 10)
+    assert list(runs.run_many(fn, [1, 2], workers=1)) == [10, 20]
+    calls.clear()
+    seen = []
+    out = list(runs.run_many(fn, [1, 2, 3], workers=1, on_done=lambda i, r: seen.append(i),
+                             lookup=lambda x: runs.lookup("demo", {"x": x})))
+    assert out == [10, 20, 30] and calls == [3] and sorted(seen) == [0, 1, 2]
