@@ -45,6 +45,7 @@ survival rules, a certain overturn ends the run) with the criterion and
 """
 from __future__ import annotations
 
+import functools
 import math
 import multiprocessing
 import time
@@ -328,7 +329,11 @@ _JOB: dict = {}
 
 
 def _one_frequency(omega: float) -> tuple:
-    scene, ss = _JOB["scene"], _JOB["settings"]
+    return _frequency(_JOB["scene"], _JOB["settings"], omega)
+
+
+def _frequency(scene: Scene, ss: SpectrumSettings, omega: float) -> tuple:
+    """Both curves at one frequency: ``(no-pendulum result, pendulum result)``."""
     np_res = first_overturn_amplitude(scene.without_pendulum(), omega, ss)
     if scene.gamma == 0.0:
         return np_res, np_res
@@ -336,7 +341,7 @@ def _one_frequency(omega: float) -> tuple:
 
 
 def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None = None,
-                         workers: int = 1, progress: bool = False) -> Spectrum:
+                         workers: int = 1, progress: bool = False, map_fn=None) -> Spectrum:
     """Both curves of the overturning spectrum of ``scene`` over ``omegas``.
 
     Parameters
@@ -351,6 +356,10 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
         Processes (fork); results are ordered as ``omegas`` whatever the count.
     progress : bool
         Show a tqdm bar (on stderr, only once the run has lasted 1 s).
+    map_fn : callable, optional
+        ``map_fn(fn, omegas)`` -> ``fn(omega)`` for each, in order: the caller's
+        parallel map (e.g. :func:`compare.runs.run_many` with a run store or a
+        Dask cluster); replaces ``workers``.
     """
     ss = SpectrumSettings() if settings is None else settings
     if not isinstance(ss, SpectrumSettings):
@@ -373,7 +382,12 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
         bar = tqdm(total=int(w.size), unit="freq", desc="spectrum", delay=1.0)
     results = []
     try:
-        if workers == 1 or w.size == 1:
+        if map_fn is not None:
+            for res in map_fn(functools.partial(_frequency, scene, ss), [float(x) for x in w]):
+                results.append(res)
+                if bar is not None:
+                    bar.update(1)
+        elif workers == 1 or w.size == 1:
             for omega in w:
                 results.append(_one_frequency(float(omega)))
                 if bar is not None:

@@ -25,6 +25,8 @@ import sys
 import time
 from pathlib import Path
 
+from compare import atomic
+
 from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
     plot_work_precision, write_json
 
@@ -88,7 +90,7 @@ def write_outputs(points: list[Point], machine: dict, meta: dict, out: Path, log
     write_json(out / "workprecision.json", machine, points, meta)
     for metric, (title, ylabel) in METRICS.items():
         plot_work_precision(points, metric, out / f"workprecision_{metric}.png", title, ylabel)
-    (out / "workprecision.md").write_text(markdown_tables(points, machine, meta))
+    atomic.write_text(out / "workprecision.md", markdown_tables(points, machine, meta))
     log(f"wrote {out}/workprecision.json, .md and plots ({meta['elapsed_s']:.0f} s of measuring)")
     for line in default_report(points):
         log(line)

@@ -23,6 +23,7 @@ import numpy as np
 from analytic import Scene, Pulse, fast
 from analytic.simulate import Settings as AccSettings
 from analytic.simulate import simulate as simulate_acc
+from compare import runs  # untimed references only: through the run store (issue 12)
 
 from .workprecision_common import Point, bisect_threshold, timed
 
@@ -57,8 +58,9 @@ def run_analytic(quick: bool, log=print) -> list[Point]:
     fast.warm_up()
     c = GRID_CASE
     pulse = Pulse(c["amplitude"], c["omega"])
-    ref = simulate_acc(SCENE, pulse, AccSettings(rtol=REF_RTOL, atol=REF_ATOL, t_max=c["t_max"],
-                                                 sample_dt=c["sample_dt"]))
+    ref = runs.simulate("analytic", SCENE, pulse,
+                        AccSettings(rtol=REF_RTOL, atol=REF_ATOL, t_max=c["t_max"],
+                                    sample_dt=c["sample_dt"]))
     ref_grid = _grid(ref, c["sample_dt"], c["t_max"])
     alpha = SCENE.alpha
     rtols = [1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9,
@@ -80,7 +82,7 @@ def run_analytic(quick: bool, log=print) -> list[Point]:
 
     th = THRESHOLD_CASE
     a_ref, n_ref = bisect_threshold(
-        lambda A: simulate_acc(SCENE, Pulse(A, th["omega"]),
+        lambda A: runs.simulate("analytic", SCENE, Pulse(A, th["omega"]),
                                AccSettings(rtol=REF_RTOL, atol=REF_ATOL, sample_dt=None)).overturned,
         th["lo"], th["hi"], th["rel_tol"])
     log(f"  reference threshold A = {a_ref:.10g} m/s^2 at Omega = {th['omega']} rad/s "
@@ -97,7 +99,7 @@ def run_analytic(quick: bool, log=print) -> list[Point]:
         for rtol in thr_rtols:
             # The work is one whole bisection (~30 runs, itself an average); median of 3
             # for the cheap fast path, one for the accurate path.
-            (a_thr, runs), wall = timed(
+            (a_thr, n_runs), wall = timed(
                 lambda: bisect_threshold(lambda A: verdict(A, rtol), th["lo"], th["hi"],
                                          th["rel_tol"]),
                 repeats=3 if family.startswith("analytic-fast") else 1,
@@ -105,8 +107,8 @@ def run_analytic(quick: bool, log=print) -> list[Point]:
             err = abs(a_thr - a_ref) / a_ref
             points.append(Point(family, "threshold", err, wall, {"rtol": rtol, "atol": rtol * 1e-2},
                                 default=math.isclose(rtol, default_rtol),
-                                extra={"A_thr": a_thr, "A_ref": a_ref, "runs": runs,
+                                extra={"A_thr": a_thr, "A_ref": a_ref, "runs": n_runs,
                                        "bracket_rel": th["rel_tol"]}))
             log(f"  {family:20s} rtol={rtol:.0e}  threshold err={err:.2e}  t={wall:.2f} s "
-                f"({runs} runs)")
+                f"({n_runs} runs)")
     return points

@@ -20,6 +20,8 @@ from typing import Callable
 
 from compare.jsonable import plain
 
+from compare import atomic
+
 __all__ = ["Point", "timed", "pareto_front", "mark_front", "bisect_threshold", "machine_info",
            "write_json", "plot_work_precision", "OUT_DIR"]
 
@@ -174,7 +176,7 @@ def machine_info() -> dict:
 def write_json(path: Path, machine: dict, points: list[Point], meta: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"machine": machine, "meta": meta, "points": [p.to_dict() for p in points]}
-    path.write_text(json.dumps(plain(payload), indent=1, allow_nan=False))
+    atomic.write_text(path, json.dumps(plain(payload), indent=1, allow_nan=False))
 
 
 
@@ -214,5 +216,5 @@ def plot_work_precision(points: list[Point], metric: str, path: Path, title: str
     ax.legend(fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    atomic.savefig(fig, path, dpi=110)
     plt.close(fig)

@@ -31,7 +31,7 @@ import numpy as np
 
 from analytic import Pulse, Scene
 from analytic.simulate import Settings as AccSettings
-from analytic.simulate import simulate as simulate_acc
+from compare import runs  # untimed references only: through the run store (issue 12)
 from engines import get_backend
 from compare.restitution import measure_restitution
 
@@ -99,14 +99,14 @@ class _Reference:
     def __init__(self, quick: bool) -> None:
         c = RMS_CASE
         self.pulse = Pulse(c["amplitude"], c["omega"])
-        tr = simulate_acc(SCENE, self.pulse, AccSettings(sample_dt=1e-4, t_max=3.0))
+        tr = runs.simulate("analytic", SCENE, self.pulse, AccSettings(sample_dt=1e-4, t_max=3.0))
         impacts = [e.t for e in tr.events if e.kind == "impact"]
         self.t_impact = impacts[0]
         self.t_ref, self.theta_ref = tr.t, tr.theta
         th = THR_CASE
         self.a_thr, _ = bisect_threshold(
-            lambda A: simulate_acc(SCENE, Pulse(A, th["omega"]),
-                                   AccSettings(t_max=th["t_max"], sample_dt=None)).overturned,
+            lambda A: runs.simulate("analytic", SCENE, Pulse(A, th["omega"]),
+                                    AccSettings(t_max=th["t_max"], sample_dt=None)).overturned,
             2.0, 3.5, 1e-8)
         self.thr_tol = 0.02 if quick else 0.001
 

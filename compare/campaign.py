@@ -10,24 +10,25 @@
   (bisection bracketed by the analytic spectrum) and the jump frequency shift;
 * a verdict table (metric, backend, value, tolerance, passed, reason).
 
-Independent runs go to a process pool (fork; results in submission order, so
-the numbers do not depend on scheduling).  Progress bar on a terminal only.
+Independent runs go to :func:`compare.runs.run_many` (local processes or a Dask
+cluster; results in submission order, so the numbers do not depend on
+scheduling), every engine run through the run store (:mod:`compare.runs`).
+Progress bar on a terminal only.
 """
 from __future__ import annotations
 
 import math
-import multiprocessing as mp
 import sys
 import time
 from dataclasses import dataclass, field
 
 from analytic.excitation import Pulse
-from engines import ENGINES, configure, get_backend
+from engines import ENGINES, configure
 from scenes import POINTS, load_scene
 
 from engines._common import required_friction
 
-from . import metrics
+from . import metrics, runs
 from .restitution import RestitutionResult, measure_restitution
 from .spectra import choose_frequencies, reference_spectrum
 from .thresholds import engine_jump_frequency, engine_threshold
@@ -138,7 +139,7 @@ def backend_settings(name: str, config: CampaignConfig, **options):
 def _job_history(name, scene, point, config):
     amp, omega = POINTS[point]
     settings = backend_settings(name, config)
-    return get_backend(name).simulate(scene, Pulse(amp, omega), settings)
+    return runs.simulate(name, scene, Pulse(amp, omega), settings)
 
 
 def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = None
@@ -207,11 +208,26 @@ def _run_one(item):
     not sink a 10-minute campaign; the verdict table then reports it unmeasured)."""
     kind, args = item
     t0 = time.perf_counter()
-    try:
-        out = _JOBS[kind](*args)
+    try:  # through the store: a finished job is not redone (compare/ code in its key)
+        out = runs.memo("campaign-job", _job_description(item), lambda: _JOBS[kind](*args),
+                        code=runs.ALL_CODE)
     except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
         out = _JobError(f"{type(exc).__name__}: {exc}")
     return out, time.perf_counter() - t0
+
+
+def _job_description(item) -> dict:
+    kind, args = item
+    config = next((a for a in args if isinstance(a, CampaignConfig)), None)
+    described = None if config is None else {k: v for k, v in config.to_dict().items()
+                                             if k != "workers"}
+    return {"kind": kind, "args": _describe_args(args), "config": described}
+
+
+def _lookup(item):
+    """A finished job from the store (its wall time here: 0), or None."""
+    out = runs.lookup("campaign-job", _job_description(item), code=runs.ALL_CODE)
+    return None if out is None else (out, 0.0)
 
 
 @dataclass(frozen=True)
@@ -231,30 +247,22 @@ def _progress(total: int):
 def _execute(jobs: list, workers: int) -> list:
     """Run ``jobs`` ((kind, args) pairs); results in job order."""
     bar = _progress(len(jobs))
-    results = [None] * len(jobs)
     try:
-        if workers <= 1 or len(jobs) <= 1:
-            for i, job in enumerate(jobs):
-                results[i] = _run_one(job)
-                if bar is not None:
-                    bar.update()
-        else:
-            ctx = mp.get_context("fork")
-            with ctx.Pool(workers) as pool:
-                indexed = pool.imap_unordered(_indexed, list(enumerate(jobs)))
-                for i, res in indexed:
-                    results[i] = res
-                    if bar is not None:
-                        bar.update()
+        return list(runs.run_many(_run_one, jobs, workers=workers, lookup=_lookup,
+                                  on_done=None if bar is None else lambda i, r: bar.update()))
     finally:
         if bar is not None:
             bar.close()
-    return results
 
 
-def _indexed(pair):
-    i, job = pair
-    return i, _run_one(job)
+def _memo(kind: str, scene, config: CampaignConfig, compute):
+    """A model-side result (reference spectrum, chosen frequencies) through the run
+    store, keyed by the scene and the config (but its worker count: no number
+    depends on it)."""
+    from .store import scene_dict
+    described = {k: v for k, v in config.to_dict().items() if k != "workers"}
+    return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute,
+                     code=runs.ALL_CODE)
 
 
 def _case(pendulum: bool) -> str:
@@ -317,14 +325,17 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     # Reference spectra first (in this process: the compiled kernels are then
     # inherited by the forked workers).
     t0 = time.perf_counter()
-    ref_spectra = {pend: reference_spectrum(sc, config) for pend, sc in scenes.items()
+    ref_spectra = {pend: _memo("reference-spectrum", sc, config,
+                               lambda sc=sc: reference_spectrum(sc, config))
+                   for pend, sc in scenes.items()
                    if _case(pend) in (*config.spectrum_cases, *config.jump_cases)}
     result.timings["reference_spectra"] = time.perf_counter() - t0
 
     jobs, labels = [], []
     for pend, spec in ref_spectra.items():
         sc = scenes[pend]
-        freqs = choose_frequencies(spec, config, sc) if _case(pend) in config.spectrum_cases else []
+        freqs = _memo("frequencies", sc, config, lambda: choose_frequencies(spec, config, sc)) \
+            if _case(pend) in config.spectrum_cases else []
         for omega, a_ref, mode in freqs:
             for name in config.engines:
                 jobs.append(("threshold", (name, sc, omega, a_ref, mode, config)))
@@ -371,7 +382,9 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
             ref_spectra[pend].setdefault("engines", {}).setdefault(name, []).append(out.to_dict())
         elif kind == "jump":
             ref_spectra[pend].setdefault("jump_shifts", {})[name] = out.to_dict()
-    for (point, pend, name), traj in sorted(result.histories.items(), key=str):
+    # Sorted by the key's text (str of the whole item would print every array).
+    for (point, pend, name), traj in sorted(result.histories.items(),
+                                            key=lambda kv: str(kv[0])):
         ref = result.histories.get((point, pend, config.reference))
         if name == config.reference or ref is None:
             continue

@@ -142,6 +142,8 @@ def main(argv: list[str] | None = None) -> int:
         os.close(devnull)
         return 1  # what Python itself does on EPIPE
     except KeyboardInterrupt:
+        print("interrupted: cancelled; finished runs are kept in the run store",
+              file=sys.stderr)
         return 130
 
 

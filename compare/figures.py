@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
+from compare import atomic
 from compare.jsonable import plain as clean_nan
 from scenes import load_scene
 
@@ -278,7 +279,7 @@ def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int) -> 
                 ax.set_ylabel(r"$A_s$ [m/s$^2$]")
     fig.suptitle(spec.caption, fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi, format=Path(path).suffix.lstrip(".").lower() or "png")
+    atomic.savefig(fig, path, dpi=dpi, format=Path(path).suffix.lstrip(".").lower() or "png")
     plt.close(fig)
 
 
@@ -334,6 +335,5 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     doc["n_undecided"] = int(sum(s.n_undecided for s in spectra.values()))
     doc["wall_time"] = time.perf_counter() - t0
     doc = clean_nan(doc)
-    with open(out / "figures.json", "w") as fh:
-        json.dump(doc, fh, indent=1, allow_nan=False)
+    atomic.write_text(out / "figures.json", json.dumps(doc, indent=1, allow_nan=False))
     return doc

@@ -19,6 +19,7 @@ import json
 import math
 from pathlib import Path
 
+from . import atomic
 from . import report_plots as plots
 from scenes import POINTS
 
@@ -424,7 +425,7 @@ def write_report(result, out_dir, provenance: dict | None = None) -> dict[str, P
     doc = summary_dict(result, provenance)
     alphas = {True: result.scene.alpha, False: result.scene.without_pendulum().alpha}
     paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md"}
-    paths["json"].write_text(json.dumps(doc, indent=1, allow_nan=False))
-    paths["md"].write_text(render_markdown(doc))
-    paths["html"].write_text(render_html(doc, result.histories, alphas), encoding="utf-8")
+    atomic.write_text(paths["json"], json.dumps(doc, indent=1, allow_nan=False))
+    atomic.write_text(paths["md"], render_markdown(doc))
+    atomic.write_text(paths["html"], render_html(doc, result.histories, alphas))
     return paths

@@ -178,7 +178,7 @@ def history_figure(histories: dict, point: str, alphas: dict, reference: str,
         top, bot = axes[0, col], axes[1, col]
         alpha = alphas[pend]
         ref = histories.get((point, pend, reference))
-        for (pt, p, name), traj in sorted(histories.items(), key=str):
+        for (pt, p, name), traj in sorted(histories.items(), key=lambda kv: str(kv[0])):
             if pt != point or p != pend:
                 continue
             is_ref = name == reference

@@ -212,7 +212,8 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
              else times[-1] + 0.5)
     run = configure(backend, settings, **options)
     run = configure(backend, run, theta0=theta0, psi0=psi0, t_max=t_max, early_stop=False)
-    traj = module.simulate(scene, Still(), run)
+    from .runs import simulate  # through the run store
+    traj = simulate(backend, scene, Still(), run)
     return RestitutionResult(
         engine=backend, version=module.version(), lam=scene.lam, mu=scene.mu,
         gamma=scene.gamma, theta0=theta0, psi0=psi0, n_requested=n_impacts,

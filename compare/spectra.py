@@ -37,8 +37,14 @@ def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
     the compiled path, default :class:`~analytic.spectrum.SpectrumSettings`)."""
     from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
+    from . import runs
+    from .store import scene_dict
+
     ss = SpectrumSettings()
-    res = [first_overturn_amplitude(scene, float(w), ss) for w in omegas]
+    # One stored threshold point per frequency (the run store, issue 12).
+    res = [runs.memo("point", {"scene": scene_dict(scene), "omega": float(w),
+                               "settings": ss.describe()},
+                     lambda w=w: first_overturn_amplitude(scene, float(w), ss)) for w in omegas]
     return [r[0] for r in res], [r[2] for r in res]
 
 
@@ -103,9 +109,10 @@ def model_valid_at(scene, omega: float, amplitude: float) -> bool:
     the engines (which let them) are no longer comparable to the model, and an
     engine-vs-model threshold error would blame the engine for the model."""
     from analytic.excitation import Pulse
-    from analytic.simulate import simulate
+    from .runs import simulate
 
-    return bool(simulate(scene, Pulse(amplitude, omega)).diagnostics.get("model_valid", True))
+    return bool(simulate("analytic", scene, Pulse(amplitude, omega)).diagnostics.get(
+        "model_valid", True))
 
 
 def locate_tongue_tip(scene, jump: dict, d_omega: float = 0.02, rel_da: float = 0.01) -> dict:

@@ -41,10 +41,11 @@ def overturns(backend: str, scene, omega: float, amplitude: float, settings=None
     status is returned so callers can flag them.  The run stops as soon as the
     verdict is certain (``verdict_only``).
     """
-    from engines import configure, get_backend
+    from engines import configure
+    from .runs import simulate
     # Only the verdict is needed: stop as soon as it is certain, overturning included.
     settings = configure(backend, settings, verdict_only=True)
-    traj = get_backend(backend).simulate(scene, Pulse(amplitude, omega, kind), settings)
+    traj = simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
     return traj.overturned, traj.verdict.status, traj.verdict.mode
 
 

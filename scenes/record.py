@@ -293,8 +293,10 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
     palette = gif_palette(frames)
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
               for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:], loop=0,
-                   duration=int(round(1000.0 / fps)), optimize=False)
+    from compare.atomic import atomic_path
+    with atomic_path(path, Path(path).suffix) as tmp:  # whole file or none
+        images[0].save(tmp, save_all=True, append_images=images[1:], loop=0,
+                       duration=int(round(1000.0 / fps)), optimize=False)
 
 
 def find_ffmpeg() -> str | None:
@@ -324,10 +326,14 @@ def write_mp4(frames: list[np.ndarray], path: Path, fps: float) -> None:
            "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
            # Pad to even sizes (yuv420p) and use the most widely playable pixel format.
            "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", str(path)]
-    proc = subprocess.run(cmd, input=b"".join(np.ascontiguousarray(f).tobytes() for f in frames),
-                          capture_output=True, check=False)
-    if proc.returncode != 0:
-        raise RuntimeError(f"ffmpeg failed: {proc.stderr.decode(errors='replace').strip()}")
+    from compare.atomic import atomic_path
+    with atomic_path(path, Path(path).suffix) as tmp:  # whole file or none
+        cmd[-1] = str(tmp)
+        proc = subprocess.run(cmd, input=b"".join(np.ascontiguousarray(f).tobytes()
+                                                  for f in frames),
+                              capture_output=True, check=False)
+        if proc.returncode != 0:
+            raise RuntimeError(f"ffmpeg failed: {proc.stderr.decode(errors='replace').strip()}")
 
 
 def record(scene: Scene, excitation, engine: str, out: str | Path,

@@ -2,13 +2,22 @@
 cached accurate-simulator run (several tests look at the same trajectories)."""
 from __future__ import annotations
 
+import atexit
 import functools
+import os
+import shutil
+import tempfile
 
 import pytest
 
 from analytic.excitation import Pulse
 from analytic.parameters import Scene
 from scenes import load_scene
+
+# Every CLI run of the suite (in process or a subprocess) uses a throwaway run
+# store, never the user's cache (issue 12).
+os.environ["TRILITH_CACHE"] = tempfile.mkdtemp(prefix="trilith-test-cache-")
+atexit.register(shutil.rmtree, os.environ["TRILITH_CACHE"], True)
 
 
 @pytest.fixture(scope="session")

@@ -367,3 +367,39 @@ def parse_omega_range(spec: str, option: str = "--omega"):
         raise ValueError(f"{option}: every frequency must be in [{lo:g}, {hi:g}] rad/s, "
                          f"got {spec!r}")
     return values
+
+
+# --- run store, scheduler and interruption (issue 12; appended by the store12 helper) ---
+def add_store_args(parser: argparse.ArgumentParser, scheduler: bool = False) -> None:
+    """``--cache DIR``, ``--no-cache`` and, with ``scheduler``, ``--scheduler ADDRESS``."""
+    from compare.store import default_cache_dir
+
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--cache", metavar="DIR", default=None,
+                       help="run store directory: finished runs are reused, a killed run "
+                            f"resumes [$TRILITH_CACHE or {default_cache_dir()}]")
+    group.add_argument("--no-cache", action="store_true",
+                       help="compute everything, store nothing")
+    if scheduler:
+        parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                            help="run on a Dask distributed cluster, e.g. tcp://host:8786 "
+                                 "(default: local processes)")
+
+
+def use_store(args: argparse.Namespace):
+    """Activate the run store (and scheduler) the options ask for; returns the store
+    (None with ``--no-cache``).  Call before any work: a bad ``--cache`` or
+    ``--scheduler`` is a usage error."""
+    from compare import runs
+    from compare.store import RunStore, default_cache_dir
+
+    address = getattr(args, "scheduler", None)
+    if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
+                                                        "ucx://")) and "://" in address):
+        raise ValueError(f"--scheduler must be an address like tcp://host:8786, got {address!r}")
+    runs.set_scheduler(address)
+    runs.STATS.clear()
+    store = None if getattr(args, "no_cache", False) else RunStore(
+        args.cache if getattr(args, "cache", None) else default_cache_dir())
+    runs.activate(store)
+    return store

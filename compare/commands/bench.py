@@ -14,7 +14,8 @@ import importlib
 import math
 from pathlib import Path
 
-from ._common import add_engine_list_arg, check_output_path, info, parse_engine_list
+from ._common import (add_engine_list_arg, add_store_args, check_output_path, info,
+                      parse_engine_list, use_store)
 
 ROOT = Path(__file__).resolve().parents[2]
 from engines import ENGINES  # every registered engine
@@ -35,6 +36,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="skip the analytic paths")
     parser.add_argument("--strict", action="store_true",
                         help="exit with code 1 when a default setting is dominated or failed")
+    add_store_args(parser)  # the untimed analytic references only; timed runs always run
     return parser
 
 
@@ -61,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     if not engines and args.no_analytic:
         raise ValueError("--engine none with --no-analytic leaves nothing to measure")
     out = check_output_path(args.out, "--out", directory=True) if args.out is not None else None
+    use_store(args)
     bench = _load_bench()
     payload = bench.run(quick=args.quick, out=out, engines=engines,
                         analytic=not args.no_analytic, log=info)

@@ -13,6 +13,7 @@ import argparse
 import math
 import sys
 import time
+from pathlib import Path
 
 from engines import ENGINES
 from scenes import load_scene
@@ -23,6 +24,8 @@ from ._common import (add_engine_list_arg, add_workers_arg, check_output_path, d
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
 # contacts creep, engines/pybullet_engine.py); above 1e-2 s the campaign refuses it.
 DT_RANGE = (1e-5, 1e-2)
+
+from ._common import add_store_args, use_store
 
 
 def add_parser(subparsers) -> None:
@@ -40,6 +43,7 @@ def add_parser(subparsers) -> None:
                         f"{DT_RANGE[1]:g}] (default: each engine's calibrated step)")
     p.add_argument("--strict", action="store_true",
                    help="exit with code 1 when a verdict fails (for CI)")
+    add_store_args(p, scheduler=True)
 
 
 def parse_engines(text: str) -> tuple[str, ...]:
@@ -57,17 +61,25 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--dt must be in [{DT_RANGE[0]:g}, {DT_RANGE[1]:g}] s, got {args.dt!r}")
     out = check_output_path(args.out, "--out", directory=True)
 
+    from compare import atomic, runs
     from compare.campaign import CampaignConfig, run_campaign
     from compare.provenance import collect
     from compare.report_html import write_report
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
+    if Path(args.out).is_file():
+        raise ValueError(f"--out must be a directory, got the file {args.out!r}")
+    use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started
-    result = run_campaign(config)
-    provenance["versions"].update(result.versions)
-    paths = write_report(result, out, provenance)
+    with atomic.output_lock(out):  # a second report into the same --out: clear error
+        result = run_campaign(config)
+        provenance["versions"].update(result.versions)
+        with atomic.report_dir(out, lock=False) as tmp:  # swapped in whole
+            paths = {k: Path(out) / p.name
+                     for k, p in write_report(result, tmp, provenance).items()}
+    detail(runs.stats_line())
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"
           f"{len(result.verdicts)} verdicts pass{' (QUICK run)' if args.quick else ''}, "

@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import (add_scene_args, clean_nan, detail, envelope, info, print_json,
-                      scene_from_args, sig)
+from ._common import (add_scene_args, add_store_args, clean_nan, detail, envelope, info,
+                      print_json, scene_from_args, sig, use_store)
 
 # Half the static overturning angle: large, clean impacts far from toppling.
 DEFAULT_THETA0_FRACTION = 0.5
@@ -30,6 +30,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--n-impacts", type=int, default=None, metavar="N",
                         help="impacts to measure, in [1, 50] (default: 4)")
     parser.add_argument("--json", action="store_true", help="print a JSON object")
+    add_store_args(parser)
     return parser
 
 
@@ -41,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     n = args.n_impacts if args.n_impacts is not None else DEFAULT_N_IMPACTS
     if not 1 <= n <= MAX_N_IMPACTS:
         raise ValueError(f"--n-impacts must be in [1, {MAX_N_IMPACTS}], got {n}")
+    use_store(args)
     result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0)
     if args.json:
         body = result.to_dict()

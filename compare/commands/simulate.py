@@ -73,7 +73,8 @@ def _plot(traj, scene, path: str) -> None:
         axes[1, 0].set_ylabel(r"$\psi$ [rad]")
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    from compare.atomic import savefig
+    savefig(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -101,7 +102,9 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     traj = backend.simulate(scene, excitation, settings)
     if args.csv is not None:
-        traj.to_csv(args.csv)
+        from compare.atomic import atomic_path
+        with atomic_path(args.csv) as tmp:
+            traj.to_csv(tmp)
     if args.plot is not None:
         _plot(traj, scene, args.plot)
     if args.json:

@@ -7,7 +7,8 @@ import sys
 
 from . import _common
 from ._common import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
-                      clean_nan, envelope, parse_omega_range, info, print_json, resolve_workers, scene_from_args)
+                      add_store_args, clean_nan, envelope, parse_omega_range, info, print_json, resolve_workers, scene_from_args,
+                      use_store)
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
 ENGINE = "analytic-fast"  # the spectra's backend (compiled model, same verdicts)
@@ -51,7 +52,30 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
+    add_store_args(parser, scheduler=True)
     return parser
+
+
+def _cached_frequency(payload):
+    """One frequency (both curves) through the run store: the key is the scene,
+    the search settings (pulse kind included) and Omega."""
+    from compare import runs
+    fn, description, omega = payload
+    return runs.memo("spectrum-point", {**description, "omega": omega}, lambda: fn(omega))
+
+
+def _map_fn(scene, settings, workers: int):
+    """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
+    through the store, on local processes or the ``--scheduler`` cluster."""
+    from compare import runs
+    from compare.store import scene_dict
+
+    description = {"scene": scene_dict(scene), "settings": settings.describe()}
+
+    def map_fn(fn, omegas):
+        return runs.run_many(_cached_frequency, [(fn, description, w) for w in omegas],
+                             workers=workers)
+    return map_fn
 
 
 def _settings(args: argparse.Namespace):
@@ -100,7 +124,8 @@ def plot_spectrum(spec, path) -> None:
     ax2.set_xlabel(r"$\Omega$ [rad/s]")
     ax2.set_ylabel(r"gain $\Delta$ [%]")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    from compare.atomic import savefig
+    savefig(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -111,6 +136,7 @@ def _number(value: float, width: int) -> str:
 def run(args: argparse.Namespace) -> int:
     from analytic.fast import version
     from analytic.spectrum import overturning_spectrum
+    from compare import atomic
 
     scene = scene_from_args(args)
     omegas = parse_omega_range(args.omega, "--omega")
@@ -123,11 +149,14 @@ def run(args: argparse.Namespace) -> int:
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
-    spec = overturning_spectrum(scene, omegas, settings, workers=workers, progress=progress)
+    use_store(args)
+    spec = overturning_spectrum(scene, omegas, settings, progress=progress,
+                                map_fn=_map_fn(scene, settings, workers))
     if engines_wanted:
         return _run_engines(args, scene, spec, engines_wanted, workers)
     if args.csv is not None:
-        spec.to_csv(args.csv)
+        with atomic.atomic_path(args.csv) as tmp:
+            spec.to_csv(tmp)
     if args.plot is not None:
         plot_spectrum(spec, args.plot)
     if args.json:

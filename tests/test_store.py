@@ -1,0 +1,225 @@
+"""The run store (compare/store.py, compare/runs.py) and atomic outputs (compare/atomic.py).
+
+Every store here lives in ``tmp_path``: tests never touch the user's cache.
+"""
+from __future__ import annotations
+
+import dataclasses
+import multiprocessing as mp
+import os
+import struct
+
+import numpy as np
+import pytest
+
+from analytic.excitation import Pulse, SampledRecord, Still
+from compare import atomic, runs
+from compare.store import RunStore, default_cache_dir, run_key
+from engines import get_backend
+
+# Short pymunk run (0.3 s of simulated time at 5e-4 s steps): milliseconds.
+SHORT = dict(t_max=0.3, dt=5e-4)
+
+
+def _pymunk_settings(**changes):
+    return dataclasses.replace(get_backend("pymunk").Settings(), **{**SHORT, **changes})
+
+
+def same(x, y) -> bool:
+    """Deep equality, bit for bit: arrays by bytes, floats by their 8 bytes (so NaN
+    equals NaN and -0.0 differs from 0.0), containers and dataclasses field by field."""
+    if type(x) is not type(y):
+        return False
+    if isinstance(x, np.ndarray):
+        return x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes()
+    if isinstance(x, float):
+        return struct.pack("<d", x) == struct.pack("<d", y)
+    if dataclasses.is_dataclass(x):
+        return all(same(getattr(x, f.name), getattr(y, f.name)) for f in dataclasses.fields(x))
+    if isinstance(x, dict):
+        return x.keys() == y.keys() and all(same(x[k], y[k]) for k in x)
+    if isinstance(x, (list, tuple)):
+        return len(x) == len(y) and all(same(a, b) for a, b in zip(x, y))
+    return x == y
+
+
+# Timings of a run (its cost, not its result): the only things a new run changes.
+TIMINGS = ("wall_time",)
+
+
+def assert_same_trajectory(a, b, timings: bool = True) -> None:
+    """Every field bit-identical; ``timings=False`` skips the wall times (the field
+    and the diagnostics entry), which differ between two computations."""
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if not timings and f.name in TIMINGS:
+            continue
+        if not timings and f.name == "diagnostics":
+            x, y = ({k: v for k, v in d.items() if k not in TIMINGS} for d in (x, y))
+        assert same(x, y), f.name
+
+
+@pytest.fixture()
+def store(tmp_path):
+    s = RunStore(tmp_path / "cache")
+    with runs.using(s):
+        yield s
+    s.close()
+
+
+@pytest.mark.parametrize("backend", ["analytic", "pymunk"])
+def test_hit_is_bit_identical_to_fresh(store, fig5, backend):
+    settings = (_pymunk_settings() if backend == "pymunk"
+                else get_backend("analytic").Settings(t_max=1.0))
+    pulse = Pulse(25.0, 11.0)
+    first = runs.simulate(backend, fig5, pulse, settings)
+    assert store.count() == 1
+    hit = runs.simulate(backend, fig5, pulse, settings)
+    assert store.count() == 1 and runs.STATS["hits"] >= 1
+    assert_same_trajectory(first, hit)  # the stored one, wall time included
+    fresh = get_backend(backend).simulate(fig5, pulse, settings)
+    assert_same_trajectory(fresh, hit, timings=False)  # a new run: only its cost differs
+
+
+def test_key_covers_everything_but_the_scene_name(fig5):
+    settings = get_backend("pymunk").Settings()
+    base = run_key("pymunk", fig5, Pulse(10.0, 9.0), settings)
+    assert run_key("pymunk", fig5.replace(name="other"), Pulse(10.0, 9.0), settings) == base
+    changed = [run_key("pymunk", fig5.replace(mu=1.5), Pulse(10.0, 9.0), settings),
+               run_key("pymunk", fig5, Pulse(10.0, 9.0, "cosine"), settings),
+               run_key("pymunk", fig5, Pulse(np.nextafter(10.0, 11.0), 9.0), settings),
+               run_key("pymunk", fig5, Still(), settings),
+               run_key("pymunk", fig5, Pulse(10.0, 9.0), dataclasses.replace(settings, dt=2e-4)),
+               run_key("pybullet", fig5, Pulse(10.0, 9.0), get_backend("pybullet").Settings())]
+    assert len({base, *changed}) == 1 + len(changed)
+    rec = SampledRecord((0.0, 0.1, 0.2), (0.0, 1.0, 0.0))
+    rec2 = SampledRecord((0.0, 0.1, 0.2), (0.0, 1.0 + 1e-15, 0.0))  # same summary, other samples
+    assert run_key("pymunk", fig5, rec, settings) != run_key("pymunk", fig5, rec2, settings)
+
+
+def test_memo_and_no_store(tmp_path):
+    calls = []
+
+    def compute():
+        calls.append(1)
+        return {"a": np.arange(3.0)}
+    assert runs.active() is None  # the library default: no store
+    runs.memo("demo", {"x": 1}, compute)
+    runs.memo("demo", {"x": 1}, compute)
+    assert len(calls) == 2
+    with runs.using(RunStore(tmp_path)):
+        first = runs.memo("demo", {"x": 1}, compute)
+        again = runs.memo("demo", {"x": 1}, compute)
+        runs.memo("demo", {"x": 2}, compute)
+    assert len(calls) == 4 and np.array_equal(first["a"], again["a"])
+
+
+def test_default_cache_dir(tmp_path):
+    assert default_cache_dir({"TRILITH_CACHE": str(tmp_path / "c")}) == tmp_path / "c"
+    assert default_cache_dir({"XDG_CACHE_HOME": str(tmp_path)}) == tmp_path / "trilith-xval"
+    assert default_cache_dir({"HOME": str(tmp_path)}) == tmp_path / ".cache" / "trilith-xval"
+    # CI with an unusable HOME (a file, so nothing can be created under it): temp dir.
+    (tmp_path / "file").write_text("")
+    fallback = default_cache_dir({"HOME": str(tmp_path / "file"), "CI": "true"})
+    assert fallback.parent == default_cache_dir({"HOME": "relative"}).parent
+    RunStore(fallback)  # and it works
+
+
+def test_not_a_store_is_a_clear_error(tmp_path):
+    (tmp_path / "runs.sqlite").write_bytes(b"not sqlite" * 100)
+    with pytest.raises(ValueError, match="not a usable run store"):
+        RunStore(tmp_path)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(ValueError, match="cannot create"):
+        RunStore(tmp_path / "file" / "sub")
+
+
+def _writer(directory, start, n):
+    s = RunStore(directory)
+    for i in range(start, start + n):
+        s.put(f"k{i % 150}", i % 150, kind="demo", label="demo", cost=0.0)
+
+
+def test_two_processes_share_a_store(tmp_path):
+    """Overlapping keys from two processes at once: no error, one entry each."""
+    ctx = mp.get_context("fork")
+    procs = [ctx.Process(target=_writer, args=(tmp_path, s, 200)) for s in (0, 100)]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(60)
+        assert p.exitcode == 0
+    s = RunStore(tmp_path)
+    assert s.count() == 150 and all(s.get(f"k{i}") == i for i in range(150))
+
+
+def _square(x):
+    return x * x, os.getpid()
+
+
+def test_run_many_order_and_workers():
+    out = list(runs.run_many(_square, range(12), workers=2))
+    assert [o[0] for o in out] == [i * i for i in range(12)]
+    assert os.getpid() not in {o[1] for o in out}
+    seen = []
+    list(runs.run_many(_square, range(5), workers=1, on_done=lambda i, r: seen.append(i)))
+    assert seen == list(range(5))
+    with pytest.raises(ValueError, match="workers"):
+        list(runs.run_many(_square, range(3), workers=0))
+
+
+# ------------------------------------------------------------------ atomic outputs
+def test_atomic_write_keeps_old_file_on_failure(tmp_path):
+    path = tmp_path / "out.csv"
+    atomic.write_text(path, "old\n")
+    with pytest.raises(RuntimeError):
+        with atomic.atomic_path(path) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("killed mid-write")
+    assert path.read_text() == "old\n"
+    assert os.listdir(tmp_path) == ["out.csv"]  # no temporary left behind
+    atomic.savetxt(path, np.eye(2), delimiter=",")
+    assert np.array_equal(np.loadtxt(path, delimiter=","), np.eye(2))
+
+
+def test_report_dir_is_swapped_whole(tmp_path):
+    out = tmp_path / "report"
+    with atomic.report_dir(out) as d:
+        (d / "index.html").write_text("old")
+        (d / "stale.md").write_text("old only")
+    with pytest.raises(RuntimeError):  # a build that dies halfway leaves the old report
+        with atomic.report_dir(out) as d:
+            (d / "index.html").write_text("new")
+            raise RuntimeError
+    assert sorted(os.listdir(out)) == ["index.html", "stale.md"]
+    assert (out / "index.html").read_text() == "old"
+    with atomic.report_dir(out) as d:
+        (d / "index.html").write_text("new")
+        (d / "summary.json").write_text("{}")
+    assert sorted(os.listdir(out)) == ["index.html", "summary.json"]  # nothing old mixed in
+    leftovers = [n for n in os.listdir(tmp_path) if n.startswith(".report.")]
+    assert leftovers == []
+
+
+def test_second_writer_of_an_output_gets_a_clear_error(tmp_path):
+    out = tmp_path / "report"
+    with atomic.output_lock(out):
+        with pytest.raises(ValueError, match="being written by another process"):
+            with atomic.report_dir(out):
+                pass
+    with atomic.report_dir(out):  # released: fine again
+        pass
+
+
+def test_run_many_lookup_sends_only_missing_items(store):
+    calls = []
+
+    def fn(x):
+        calls.append(x)
+        return runs.memo("demo", {"x": x}, lambda: x * 10)
+    assert list(runs.run_many(fn, [1, 2], workers=1)) == [10, 20]
+    calls.clear()
+    seen = []
+    out = list(runs.run_many(fn, [1, 2, 3], workers=1, on_done=lambda i, r: seen.append(i),
+                             lookup=lambda x: runs.lookup("demo", {"x": x})))
+    assert out == [10, 20, 30] and calls == [3] and sorted(seen) == [0, 1, 2]
