@@ -17,7 +17,6 @@ recording works without a display and never touches the GUI backend.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import shutil
 import subprocess
@@ -37,7 +36,7 @@ __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", 
 
 # ``--engine all``: the accurate analytic reference and every physics engine
 # (``analytic-fast`` is the same model as ``analytic``; a panel for it adds nothing).
-ALL_ENGINES = ("analytic", "pybullet", "pymunk")
+ALL_ENGINES = ("analytic", "pybullet", "pymunk", "mujoco")  # the model and every engine
 FORMATS = (".gif", ".mp4")
 # The paper integrates to at least ten pulse periods (Sec. 5.1): the default length.
 DEFAULT_PERIODS = 10.0
@@ -139,44 +138,26 @@ def resolve_engines(engine: str) -> tuple[str, ...]:
 
 
 def load_backend(name: str):
-    """The backend module, or a ValueError saying it is not in this checkout yet."""
-    from engines import BACKENDS, get_backend
-
-    try:
-        return get_backend(name)
-    except ModuleNotFoundError as exc:
-        if exc.name and BACKENDS[name].startswith(exc.name):
-            raise ValueError(f"backend {name!r} is not available in this checkout "
-                             f"(module {BACKENDS[name]} is missing)") from None
-        raise
+    """The backend module (:func:`engines.get_backend`; ValueError if unknown)."""
+    from engines import get_backend
+    return get_backend(name)
 
 
-def backend_settings(module, duration: float, **changes):
-    """The backend's default Settings, set to run for the whole recorded span.
+def backend_settings(name: str, duration: float):
+    """Backend ``name``'s calibrated settings, run for the whole recorded span.
 
-    ``t_max`` is the span; an engine's run monitor (``monitor`` field) would stop
-    a run as soon as survival is certain (energy below the barrier, or at rest),
-    which freezes the picture while the pendulum still swings: for a recording
-    those early stops are switched off, so every backend runs to ``t_max``
-    (or until it overturns).
+    ``early_stop=False``: a run would otherwise stop as soon as survival is
+    certain (energy below the barrier, or at rest), which freezes the picture
+    while the pendulum still swings; every backend runs to ``t_max`` (or until it
+    overturns).
     """
-    settings = module.Settings()
-    names = {f.name for f in dataclasses.fields(settings)}
-    if "t_max" in names:
-        changes["t_max"] = duration
-    monitor = getattr(settings, "monitor", None)
-    if "monitor" in names and dataclasses.is_dataclass(monitor):
-        monitor_names = {f.name for f in dataclasses.fields(monitor)}
-        early = {"energy_rule": False, "rest_hold": duration}
-        changes.setdefault("monitor", dataclasses.replace(
-            monitor, **{k: v for k, v in early.items() if k in monitor_names}))
-    return dataclasses.replace(settings, **{k: v for k, v in changes.items() if k in names})
+    from engines import configure
+    return configure(name, t_max=duration, early_stop=False)
 
 
 def run_backend(name: str, scene: Scene, excitation, duration: float) -> Trajectory:
     """Simulate ``scene`` in backend ``name`` up to ``duration`` seconds."""
-    module = load_backend(name)
-    return module.simulate(scene, excitation, backend_settings(module, duration))
+    return load_backend(name).simulate(scene, excitation, backend_settings(name, duration))
 
 
 def shown_duration(trajectories: dict[str, Trajectory], duration: float,
