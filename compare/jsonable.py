@@ -23,12 +23,12 @@ def plain(value):
     >>> plain({"a": (1.0, float("nan")), "b": np.float64(2.5), "c": np.arange(2)})
     {'a': [1.0, None], 'b': 2.5, 'c': [0, 1]}
     """
+    if isinstance(value, np.generic):  # before float: np.float64 is a float subclass
+        return plain(value.item())
     if isinstance(value, float):
         return value if math.isfinite(value) else None
     if isinstance(value, (str, int, bool)) or value is None:
         return value
-    if isinstance(value, np.generic):
-        return plain(value.item())
     if isinstance(value, np.ndarray):
         return [plain(v) for v in value.tolist()]
     if isinstance(value, dict):

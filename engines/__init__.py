@@ -23,7 +23,7 @@ Examples
 >>> engines.configure("analytic", dt=1e-4)
 Traceback (most recent call last):
 ...
-ValueError: analytic has no option 'dt'; its options: atol, criterion, early_stop, max_events, method, psi0, psi_dot0, rest_step_fraction, rest_velocity, rtol, sample_dt, t_cap, t_max, theta0, theta_dot0
+ValueError: analytic has no option 'dt'; its options: atol, criterion, early_stop, ...
 """
 from __future__ import annotations
 

@@ -151,7 +151,8 @@ def load_record(path, option: str | None = None) -> SampledRecord:
 
     Examples
     --------
-    >>> rec = load_record("scenes/records/sample.csv")  # doctest: +SKIP
+    >>> from scenes import SCENE_DIR
+    >>> rec = load_record(SCENE_DIR.parent / "records" / "sample.csv")
     >>> rec.end_time
     10.0
     """
