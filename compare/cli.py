@@ -145,6 +145,12 @@ def main(argv: list[str] | None = None) -> int:
         print("interrupted: cancelled; finished runs are kept in the run store",
               file=sys.stderr)
         return 130
+    finally:
+        # A command's run store and scheduler end with it (main() is also called
+        # in-process, by tests and scripts).
+        if "compare.runs" in sys.modules:
+            sys.modules["compare.runs"].activate(None)
+            sys.modules["compare.runs"].set_scheduler(None)
 
 
 if __name__ == "__main__":

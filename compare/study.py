@@ -74,7 +74,7 @@ def _list(table: dict, key: str, where: str) -> list:
 def load_study(path) -> Study:
     """Read and validate a campaign file; ``ValueError`` naming the key."""
     from analytic.excitation import PULSE_KINDS
-    from analytic.spectrum import parse_omega_range
+    from .grids import parse_omega_range
 
     path = Path(path)
     where = str(path)

@@ -128,9 +128,9 @@ def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, s
                 {"metric": "verdicts", "backend": "pymunk", "value": 0, "tolerance": 0,
                  "passed": True, "unit": "count"}]
     monkeypatch.setattr(compare.campaign, "run_campaign",
-                        lambda config: SimpleNamespace(verdicts=verdicts))
+                        lambda config: SimpleNamespace(verdicts=verdicts, versions={}))
     monkeypatch.setattr(compare.report_html, "write_report",
-                        lambda result, out: {"html": Path(out) / "index.html"})
+                        lambda result, out, provenance=None: {"html": Path(out) / "index.html"})
     argv = ["report", "--quick", "--out", str(tmp_path / "r")] + (["--strict"] if strict else [])
     assert main(argv) == (1 if strict else 0)
     out = capsys.readouterr().out

@@ -83,7 +83,7 @@ def test_coarse_time_step_fails_a_verdict(tiny_report):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["report", "--engine", "mujoco"], "--engine"),
+    (["report", "--engine", "havok"], "--engine"),
     (["report", "--scene", "no_such_scene"], "unknown scene"),
     (["report", "--workers", "0"], "--workers"),
     (["report", "--dt", "-1"], "--dt"),
