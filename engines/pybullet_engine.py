@@ -117,6 +117,8 @@ class Settings(EngineSettings):
     friction: float | None = None  # auto: max(1, required_friction), see default_friction
     solver_iterations: int = 50  # PyBullet default; 10 or 200 measured no better
     contact_erp: float = 0.2  # PyBullet default; acts only beyond the slop
+    friction_erp: float | None = None  # auto: contact_erp * min(1, dt / 1e-4), see pybullet_scene
+    solver_residual_threshold: float | None = None  # (m/s)^2; auto: 1e-7 * min(1, dt / 1e-4)^2
     contact_slop: float | None = None  # m; auto: min(1e-4, dt * 1 m/s), see pybullet_scene.effective_slop
     contact_breaking_threshold: float | None = None  # auto 1 % of b; 0.02 m no better
     friction_anchor: bool = True  # DESIGN.md; without anchors errors reach 9 %
@@ -134,6 +136,11 @@ class Settings(EngineSettings):
         check_real(o, "contact_erp", self.contact_erp, 0.0, 1.0, lo_open=False)
         if self.contact_slop is not None:
             check_real(o, "contact_slop", self.contact_slop, 0.0, 0.1, lo_open=False)
+        if self.friction_erp is not None:
+            check_real(o, "friction_erp", self.friction_erp, 0.0, 1.0, lo_open=False)
+        if self.solver_residual_threshold is not None:
+            check_real(o, "solver_residual_threshold", self.solver_residual_threshold, 0.0, 1.0,
+                       lo_open=False)
         if self.contact_breaking_threshold is not None:
             check_real(o, "contact_breaking_threshold", self.contact_breaking_threshold, 0.0, 1.0)
         if not isinstance(self.friction_anchor, bool):
@@ -144,6 +151,8 @@ class Settings(EngineSettings):
     def describe(self) -> dict:
         out = super().describe()
         out["contact_slop_effective"] = ps.effective_slop(self)
+        out["friction_erp_effective"] = ps.effective_friction_erp(self)
+        out["solver_residual_threshold_effective"] = ps.effective_residual_threshold(self)
         return out
 
 

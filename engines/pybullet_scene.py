@@ -40,7 +40,18 @@ if TYPE_CHECKING:  # annotation only: the adapter imports this module
     from engines.pybullet_engine import Settings
 
 __all__ = ["Bodies", "World", "build_scene", "initial_poses", "column_angle",
-           "pendulum_state", "lintel_state", "effective_slop"]
+           "pendulum_state", "lintel_state", "effective_slop", "effective_friction_erp",
+           "effective_residual_threshold", "DT_CALIBRATED"]
+
+# The step [s] the per-step solver settings were calibrated at; below it they are
+# scaled so that they mean the same in time (docs/engine-trust.md, "PyBullet at
+# small steps"); at and above it they are used as calibrated.
+DT_CALIBRATED = 1e-4
+
+
+def _step_ratio(settings) -> float:
+    """``min(1, dt / DT_CALIBRATED)``: exactly 1.0 at the calibrated step."""
+    return min(1.0, settings.dt / DT_CALIBRATED)
 
 
 def effective_slop(settings) -> float:
@@ -50,6 +61,28 @@ def effective_slop(settings) -> float:
     if settings.contact_slop is not None:
         return settings.contact_slop
     return min(1e-4, settings.dt * 1.0)
+
+
+def effective_friction_erp(settings) -> float:
+    """Bullet's ``frictionERP`` for ``settings``: the given ``friction_erp``, else
+    ``contact_erp * min(1, dt / 1e-4)``.  With friction anchors Bullet pulls a
+    drifted anchor back at ``frictionERP * drift / dt`` (btMultiBodyConstraintSolver):
+    a fixed fraction per step is a relaxation time ``dt / erp`` that shrinks with
+    the step; scaled, it stays the calibrated 0.5 ms."""
+    if settings.friction_erp is not None:
+        return settings.friction_erp
+    return settings.contact_erp * _step_ratio(settings)
+
+
+def effective_residual_threshold(settings) -> float:
+    """Bullet's ``solverResidualThreshold`` [(m/s)^2] for ``settings``: the given
+    ``solver_residual_threshold``, else ``1e-7 * min(1, dt / 1e-4)^2``.  The
+    solver stops iterating when the largest squared velocity change of an
+    iteration falls below it; a step's velocity changes scale with ``dt``, so a
+    fixed threshold stops a small step's solver after fewer iterations."""
+    if settings.solver_residual_threshold is not None:
+        return settings.solver_residual_threshold
+    return 1e-7 * _step_ratio(settings) ** 2
 
 
 def column_angle(client: int, body: int) -> tuple[float, float, tuple, tuple]:
@@ -112,12 +145,12 @@ class World:
         pb.resetSimulation(physicsClientId=c)
         pb.setPhysicsEngineParameter(
             fixedTimeStep=s.dt, numSubSteps=0, numSolverIterations=s.solver_iterations,
-            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=s.contact_erp,
+            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=effective_friction_erp(s),
             useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
             contactBreakingThreshold=cbt, restitutionVelocityThreshold=0.2,
             contactSlop=effective_slop(s), enableConeFriction=0, deterministicOverlappingPairs=1,
             globalCFM=0.0,
-            solverResidualThreshold=1e-7, warmStartingFactor=0.85,
+            solverResidualThreshold=effective_residual_threshold(s), warmStartingFactor=0.85,
             physicsClientId=c)
 
         self.moving = s.base_motion == "ground"
