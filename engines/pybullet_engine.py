@@ -104,6 +104,13 @@ class Settings(EngineSettings):
       error is 2.7 %.  With ``slop = dt * 1 m/s`` (the default below 1e-4 s):
       0.05 % at 5e-5 s, 1.2 % at 2e-5 s, 12 % at 1e-5 s, and no creep
       (lam 3, 5, 7, mu 1, release at alpha/2, 3 impacts; one run, 2026-11-22).
+    * Below 1e-4 s ``friction_erp`` scales with ``dt`` and
+      ``solver_residual_threshold`` with ``dt^2`` (both per-step quantities in
+      Bullet; fixed, they made PyBullet worse at smaller steps: at 2.5e-5 s
+      restitution +3.3 % (lam 3) and +1.2 % (lam 5), and an out-of-plane blow-up
+      at Omega 24 / A 60; scaled: <= 0.02 % and none; docs/engine-trust.md,
+      ``benchmarks/pybullet_small_step.py``).  At >= 1e-4 s they are the
+      calibrated 0.2 and 1e-7 (m/s)^2, so results there are unchanged.
     * ``dt`` 5e-5 s is no better (10 % of impacts beyond 0.5 %) at twice the cost.
     * ``solver_iterations`` 10 or 200 and ``solverResidualThreshold`` 0: no gain.
     * ``friction`` 2: 10 % of impacts beyond 0.5 % (the same lottery); 25
