@@ -104,6 +104,13 @@ class Settings(EngineSettings):
       error is 2.7 %.  With ``slop = dt * 1 m/s`` (the default below 1e-4 s):
       0.05 % at 5e-5 s, 1.2 % at 2e-5 s, 12 % at 1e-5 s, and no creep
       (lam 3, 5, 7, mu 1, release at alpha/2, 3 impacts; one run, 2026-11-22).
+    * Below 1e-4 s ``friction_erp`` scales with ``dt`` and
+      ``solver_residual_threshold`` with ``dt^2`` (both per-step quantities in
+      Bullet; fixed, they made PyBullet worse at smaller steps: at 2.5e-5 s
+      restitution +3.3 % (lam 3) and +1.2 % (lam 5), and an out-of-plane blow-up
+      at Omega 24 / A 60; scaled: <= 0.02 % and none; docs/engine-trust.md,
+      ``benchmarks/pybullet_small_step.py``).  At >= 1e-4 s they are the
+      calibrated 0.2 and 1e-7 (m/s)^2, so results there are unchanged.
     * ``dt`` 5e-5 s is no better (10 % of impacts beyond 0.5 %) at twice the cost.
     * ``solver_iterations`` 10 or 200 and ``solverResidualThreshold`` 0: no gain.
     * ``friction`` 2: 10 % of impacts beyond 0.5 % (the same lottery); 25
@@ -117,6 +124,8 @@ class Settings(EngineSettings):
     friction: float | None = None  # auto: max(1, required_friction), see default_friction
     solver_iterations: int = 50  # PyBullet default; 10 or 200 measured no better
     contact_erp: float = 0.2  # PyBullet default; acts only beyond the slop
+    friction_erp: float | None = None  # auto: contact_erp * min(1, dt / 1e-4), see pybullet_scene
+    solver_residual_threshold: float | None = None  # (m/s)^2; auto: 1e-7 * min(1, dt / 1e-4)^2
     contact_slop: float | None = None  # m; auto: min(1e-4, dt * 1 m/s), see pybullet_scene.effective_slop
     contact_breaking_threshold: float | None = None  # auto 1 % of b; 0.02 m no better
     friction_anchor: bool = True  # DESIGN.md; without anchors errors reach 9 %
@@ -134,6 +143,11 @@ class Settings(EngineSettings):
         check_real(o, "contact_erp", self.contact_erp, 0.0, 1.0, lo_open=False)
         if self.contact_slop is not None:
             check_real(o, "contact_slop", self.contact_slop, 0.0, 0.1, lo_open=False)
+        if self.friction_erp is not None:
+            check_real(o, "friction_erp", self.friction_erp, 0.0, 1.0, lo_open=False)
+        if self.solver_residual_threshold is not None:
+            check_real(o, "solver_residual_threshold", self.solver_residual_threshold, 0.0, 1.0,
+                       lo_open=False)
         if self.contact_breaking_threshold is not None:
             check_real(o, "contact_breaking_threshold", self.contact_breaking_threshold, 0.0, 1.0)
         if not isinstance(self.friction_anchor, bool):
@@ -144,6 +158,8 @@ class Settings(EngineSettings):
     def describe(self) -> dict:
         out = super().describe()
         out["contact_slop_effective"] = ps.effective_slop(self)
+        out["friction_erp_effective"] = ps.effective_friction_erp(self)
+        out["solver_residual_threshold_effective"] = ps.effective_residual_threshold(self)
         return out
 
 

@@ -40,7 +40,18 @@ if TYPE_CHECKING:  # annotation only: the adapter imports this module
     from engines.pybullet_engine import Settings
 
 __all__ = ["Bodies", "World", "build_scene", "initial_poses", "column_angle",
-           "pendulum_state", "lintel_state", "effective_slop"]
+           "pendulum_state", "lintel_state", "effective_slop", "effective_friction_erp",
+           "effective_residual_threshold", "DT_CALIBRATED"]
+
+# The step [s] the per-step solver settings were calibrated at; below it they are
+# scaled so that they mean the same in time (docs/engine-trust.md, "PyBullet at
+# small steps"); at and above it they are used as calibrated.
+DT_CALIBRATED = 1e-4
+
+
+def _step_ratio(settings) -> float:
+    """``min(1, dt / DT_CALIBRATED)``: exactly 1.0 at the calibrated step."""
+    return min(1.0, settings.dt / DT_CALIBRATED)
 
 
 def effective_slop(settings) -> float:
@@ -50,6 +61,28 @@ def effective_slop(settings) -> float:
     if settings.contact_slop is not None:
         return settings.contact_slop
     return min(1e-4, settings.dt * 1.0)
+
+
+def effective_friction_erp(settings) -> float:
+    """Bullet's ``frictionERP`` for ``settings``: the given ``friction_erp``, else
+    ``contact_erp * min(1, dt / 1e-4)``.  With friction anchors Bullet pulls a
+    drifted anchor back at ``frictionERP * drift / dt`` (btMultiBodyConstraintSolver):
+    a fixed fraction per step is a relaxation time ``dt / erp`` that shrinks with
+    the step; scaled, it stays the calibrated 0.5 ms."""
+    if settings.friction_erp is not None:
+        return settings.friction_erp
+    return settings.contact_erp * _step_ratio(settings)
+
+
+def effective_residual_threshold(settings) -> float:
+    """Bullet's ``solverResidualThreshold`` [(m/s)^2] for ``settings``: the given
+    ``solver_residual_threshold``, else ``1e-7 * min(1, dt / 1e-4)^2``.  The
+    solver stops iterating when the largest squared velocity change of an
+    iteration falls below it; a step's velocity changes scale with ``dt``, so a
+    fixed threshold stops a small step's solver after fewer iterations."""
+    if settings.solver_residual_threshold is not None:
+        return settings.solver_residual_threshold
+    return 1e-7 * _step_ratio(settings) ** 2
 
 
 def column_angle(client: int, body: int) -> tuple[float, float, tuple, tuple]:
@@ -95,29 +128,56 @@ def lintel_state(client: int, bodies: Bodies) -> tuple[tuple, tuple, tuple, tupl
     return st[0], st[1], st[6], st[7]
 
 
+# Idle DIRECT clients kept for the next World: connecting costs 10-20 ms, about
+# a tenth of a short run (benchmarks/bench_overhead.py).  Every World resets its
+# client (resetSimulation, every engine parameter set again), so a reused client
+# gives the same numbers, bit for bit, as a new one (tests/test_pybullet_small_step.py).
+_IDLE_CLIENTS: list[int] = []
+_MAX_IDLE_CLIENTS = 2
+
+
+def _acquire_client(mode: int) -> int:
+    """An idle DIRECT client if one is left, else a new connection."""
+    while mode == pb.DIRECT and _IDLE_CLIENTS:
+        client = _IDLE_CLIENTS.pop()
+        if pb.isConnected(physicsClientId=client):
+            return client
+    return pb.connect(mode)
+
+
+def _release_client(client: int, mode: int) -> None:
+    """Keep a DIRECT client for the next World (up to 2), else disconnect it."""
+    if mode == pb.DIRECT and len(_IDLE_CLIENTS) < _MAX_IDLE_CLIENTS:
+        _IDLE_CLIENTS.append(client)
+    else:
+        pb.disconnect(physicsClientId=client)
+
+
 class World:
     """One PyBullet client with the scene built; steps it and reads its state.
 
     ``s`` is an :class:`engines.pybullet_engine.Settings` (validated by the
     caller); ``friction`` the contact coefficient (each body gets its square
-    root: Bullet multiplies the two bodies' values).
+    root: Bullet multiplies the two bodies' values).  A DIRECT client is taken
+    from the idle ones left by closed Worlds when there is one, and reset.
     """
 
     def __init__(self, scene, excitation, s: Settings, friction: float, mode: int = pb.DIRECT):
         self.scene, self.excitation, self.s = scene, excitation, s
-        self.client = pb.connect(mode)
+        self.mode = mode
+        self.client = _acquire_client(mode)
         c = self.client
         cbt = s.contact_breaking_threshold or 0.01 * scene.b
         # Every parameter set explicitly: some are process-global in Bullet.
         pb.resetSimulation(physicsClientId=c)
         pb.setPhysicsEngineParameter(
             fixedTimeStep=s.dt, numSubSteps=0, numSolverIterations=s.solver_iterations,
-            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=s.contact_erp,
+            contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=effective_friction_erp(s),
             useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
             contactBreakingThreshold=cbt, restitutionVelocityThreshold=0.2,
             contactSlop=effective_slop(s), enableConeFriction=0, deterministicOverlappingPairs=1,
             globalCFM=0.0,
-            solverResidualThreshold=1e-7, warmStartingFactor=0.85,
+            solverResidualThreshold=effective_residual_threshold(s), warmStartingFactor=0.85,
             physicsClientId=c)
 
         self.moving = s.base_motion == "ground"
@@ -138,7 +198,10 @@ class World:
             self._set_ground(0)
 
     def close(self) -> None:
-        pb.disconnect(physicsClientId=self.client)
+        """Hand the client back (idempotent): kept for the next World or disconnected."""
+        if self.client is not None:
+            client, self.client = self.client, None
+            _release_client(client, self.mode)
 
     # ---------------------------------------------------------------- stepping
     def _set_ground(self, n: int) -> None:
@@ -157,14 +220,19 @@ class World:
         n, dt, c = self.step_index, self.s.dt, self.client
         accel, minus_g = self.excitation.acceleration, -self.scene.g
         set_gravity, step = pb.setGravity, pb.stepSimulation
-        for k in range(n, n + count):
-            if self.moving:
+        if self.moving:
+            for k in range(n, n + count):
                 self._set_ground(k)
-            else:
+                step(physicsClientId=c)
+                self.step_index = k + 1
+            return
+        try:
+            for k in range(n, n + count):
                 # Mid-step load: the step's velocity change is then second-order accurate.
                 set_gravity(-accel((k + 0.5) * dt), 0.0, minus_g, physicsClientId=c)
-            step(physicsClientId=c)
-            self.step_index = k + 1
+                step(physicsClientId=c)
+        finally:  # the steps taken, even if one raised
+            self.step_index = k + 1 if count > 0 else n
 
     # ----------------------------------------------------------------- reading
     def _pose(self, body: int) -> tuple[tuple, tuple, tuple]:
@@ -173,16 +241,16 @@ class World:
         pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
         return pos, quat, pb.getBaseVelocity(body, physicsClientId=self.client)[0]
 
-    def _bottom_corners(self, body: int, pos=None, quat=None) -> tuple[float, float]:
-        """World x of a column's bottom-left and bottom-right edge midpoints
-        (``pos``, ``quat``: its pose if already read at this instant)."""
+    def _bottom_corners(self, body: int, pos=None, quat=None,
+                        which: tuple[int, ...] = (0, 1)) -> tuple[float, ...]:
+        """World x of a column's bottom-left (0) and bottom-right (1) edge
+        midpoints, those in ``which`` (``pos``, ``quat``: its pose if already
+        read at this instant)."""
         if pos is None:
             pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=self.client)
         hb, hh = 0.5 * self.scene.b, 0.5 * self.scene.h
-        out = []
-        for dx in (-hb, hb):
-            out.append(pb.multiplyTransforms(pos, quat, (dx, 0.0, -hh), (0, 0, 0, 1))[0][0])
-        return out[0], out[1]
+        return tuple(pb.multiplyTransforms(pos, quat, ((-hb, hb)[i], 0.0, -hh), (0, 0, 0, 1))[0][0]
+                     for i in which)
 
     def ground_x(self) -> float:
         if not self.moving:
@@ -241,12 +309,12 @@ class World:
             problem = f"pendulum speed {abs(psi_dot) * bodies.length:.3g} m/s"
         if standing:
             for k, body in enumerate(bodies.columns):
-                corners = self._bottom_corners(body, cols[k][2], cols[k][3])
                 theta = cols[k][0]
                 # The pivot corner while rocking; both corners while at rest.
                 idx = ((0 if theta > 0 else 1,) if abs(theta) > self.s.monitor.uplift_angle
                        else (0, 1))
-                slide = max(abs(corners[i] - self.pivots0[k][i] - gx) for i in idx)
+                corners = self._bottom_corners(body, cols[k][2], cols[k][3], idx)
+                slide = max(abs(x - self.pivots0[k][i] - gx) for x, i in zip(corners, idx))
                 diag["pivot_sliding_max"] = max(diag["pivot_sliding_max"], slide)
             points = pb.getContactPoints(physicsClientId=c)
             if points:  # max of -distance = -(min distance), exactly
