@@ -39,7 +39,7 @@ import time
 import pybullet as pb
 
 import engines
-from analytic.excitation import Pulse, Still
+from analytic.excitation import Pulse
 from compare.jsonable import plain
 from compare.restitution import measure_restitution
 from engines import pybullet_engine as pbe

@@ -59,10 +59,13 @@ class MonitorSettings:
         the engines' pivots slide < 1e-5 m at the paper's points A-D (docs/
         engine-trust.md); a slide of 1 % of ``b`` changes the model's lever arm
         by 1 %.  Beyond it: 'collapsed'.
-    max_lintel_rotation : largest lintel rotation [in units of alpha] while both
-        columns stand.  0.1: the model's lintel translates without rotating (it
-        rests on both column tops); engines keep it within ~1e-5 rad at A-D.
-        Beyond it the lintel rocks on the columns: 'collapsed'.
+    max_lintel_rotation : largest lintel rotation, and (3D engines) largest
+        out-of-plane rotation of any body [in units of alpha] while both columns
+        stand.  0.1: the model's lintel translates without rotating (it rests on
+        both column tops) and every body stays in its plane; engines keep both
+        within ~1e-5 rad at A-D (PyBullet's out-of-plane roll 2e-6 rad).  Beyond
+        it: 'collapsed' (PyBullet's 18 m columns at lam 30 roll out of their
+        plane by 0.35 rad, docs/engine-trust.md).
 
     Whether the run stops as soon as the verdict is certain is the run option
     ``early_stop`` (:class:`analytic.options.RunOptions`), not a monitor setting.
@@ -280,6 +283,11 @@ class RunMonitor:
         if slide > cfg.max_sliding * b:
             self.mark_collapsed(t, f"a pivot slid {slide:.3g} m (> {cfg.max_sliding:g} b) "
                                    f"while the columns stood: the model's pivots do not slide")
+            return True
+        roll = diag.get("out_of_plane_rotation_max", 0.0)  # 3D engines only
+        if roll > cfg.max_lintel_rotation * self._alpha:
+            self.mark_collapsed(t, f"a body rotated {roll:.3g} rad out of the plane "
+                                   f"(> {cfg.max_lintel_rotation:g} alpha): the model is planar")
             return True
         rot = diag.get("lintel_rotation_max", 0.0)
         if rot > cfg.max_lintel_rotation * self._alpha:
