@@ -142,20 +142,6 @@ def test_tilted_start_rests_on_its_pivots_and_rocks_to_the_other_side(sign):
     assert tr.diagnostics["pivot_sliding_max"] < 1e-5
 
 
-def test_pendulum_sign_matches_eq1():
-    """psi0 > 0 (bob to the right, CCW from the downward vertical) on a trilith at
-    rest swings back through zero like the free pendulum psi0 cos(w t)."""
-    scene = load_scene("fig5")
-    psi0 = 0.1
-    tr = me.simulate(scene, Still(), me.Settings(psi0=psi0, t_max=1.0,
-                                                 early_stop=False))
-    assert tr.max_abs_theta < 1e-4  # the trilith stayed down
-    omega = math.sqrt(scene.g / scene.pendulum_length)
-    # Small-angle reference: its own error is ~psi0^2/16 = 6e-4 of the phase per period.
-    assert np.max(np.abs(tr.psi - psi0 * np.cos(omega * tr.t))) < 5e-3
-    assert tr.psi[0] == psi0
-
-
 def test_mujoco_reset_warning_ends_the_run_as_unstable(monkeypatch):
     """A velocity beyond MuJoCo's limit (1e10) makes mj_step reset the state and
     warn; the run must stop as 'unstable' then, not carry on from the reset."""

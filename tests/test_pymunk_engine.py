@@ -21,7 +21,7 @@ from compare.restitution import measure_restitution
 
 # ---------------------------------------------------------------- restitution
 # The acceptance bound of the engine contract.  Measured at the defaults, first
-# four impacts from theta0 = alpha/2: at most 0.15 % on this grid (errors grow as
+# four impacts from theta0 = alpha/2: at most 0.24 % on this grid (errors grow as
 # the rocking slows, ~0.5 % by the 11th impact of lam = 3).
 RESTITUTION_TOL = 5e-3
 

@@ -65,7 +65,7 @@ def test_verdict_values_come_from_the_measurements(tiny_report):
     # Recompute one impact's error from its measured and predicted ratio.
     imp = result.restitution[0]["impacts"][0]
     assert imp["rel_error"] == pytest.approx(imp["measured"] / imp["predicted"] - 1.0)
-    # Calibrated Pymunk passes the 0.5 % (engine tests measure <= 0.15 %).
+    # Calibrated Pymunk passes the 0.5 % (tests/test_backends.py measures <= 0.24 %).
     assert rest["passed"]
 
 
