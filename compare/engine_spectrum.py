@@ -102,12 +102,13 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
     from analytic.excitation import Pulse
     from analytic.reactions import check_model
 
-    if not point.bracketed:
-        return "no-bracket", "no overturning amplitude found within the widened bracket", ()
-    a_top = max(point.a_reference, point.a_engine)
+    # The model's own assumptions first: where they fail, no engine is to blame.
+    a_top = max(point.a_reference, point.a_engine) if point.bracketed else point.a_reference
     model = check_model(scene, Pulse(a_top, omega, kind), friction=settings.friction)
     if not model["valid"]:
         return "model", model["reason"], ()
+    if not point.bracketed:
+        return "no-bracket", "no overturning amplitude found within the widened bracket", ()
     if near_jump:
         return "jump", "a mode jump of the analytic curve lies within one grid step", ()
     rows = [{"dt": settings.dt, "iterations": _iterations(settings), "a_engine": point.a_engine,
@@ -189,8 +190,10 @@ def _point_job(args) -> EnginePoint:
         cause, detail, rows = classify(engine, scene, omega, p, settings, kind=kind, tol=tol,
                                        rel_tol=rel_tol, near_jump=near_jump,
                                        convergence=convergence)
-        if p.collapsed_below:
-            detail = "the frame collapsed below the threshold; " + detail
+        collapsed = [a for a, st, _ in p.probes if st == "collapsed"]
+        if collapsed:
+            detail = (f"the engine's frame collapsed (not overturned) from A = "
+                      f"{min(collapsed):.4g} m/s^2; " + detail)
     return EnginePoint(omega, a_ref, p.a_engine, p.a_survives, p.rel_error, mode_ref,
                        p.mode_engine, p.n_runs, p.collapsed_below, near_jump, cause, detail,
                        rows, p.probes)
