@@ -25,7 +25,7 @@ from analytic.trajectory import Trajectory
 
 from ._common import MonitorSettings, RunMonitor, required_friction
 
-__all__ = ["Backend", "World", "EngineSettings", "simulate_world", "CAPABILITIES",
+__all__ = ["Backend", "World", "EngineSettings", "simulate_world", "check_run", "CAPABILITIES",
            "BASE_MOTIONS"]
 
 # Optional features a backend may declare in its CAPABILITIES.
@@ -135,6 +135,26 @@ class EngineSettings(RunOptions):
                              f"without sliding in this scene and excitation (see "
                              f"required_friction), got {friction!r}")
         return value
+
+
+def check_run(name: str, settings_cls: type, s, scene, excitation,
+              friction: float | None = None) -> float:
+    """The checks every engine makes before building anything, with the scene and
+    excitation at hand; returns the friction coefficient to use (``friction``, by
+    default ``s.friction``).
+
+    Raises ``TypeError`` for settings of another backend, ``ValueError`` for a
+    massless lintel carrying a pendulum (the analytic model allows it, a body
+    cannot), a tilt beyond ``alpha`` or friction below the no-sliding bound.
+    """
+    if not isinstance(s, settings_cls):
+        raise TypeError(f"{name} settings must be {settings_cls.__module__}.Settings, "
+                        f"got {type(s).__name__}")
+    if scene.mu == 0.0 and scene.has_pendulum:
+        raise ValueError(f"{name}: mu must be > 0 when gamma > 0 (a massless lintel, which the "
+                         "analytic model allows, cannot carry the pendulum hinge in an engine)")
+    s.check_scene(scene)
+    return s.check_friction(s.friction if friction is None else friction, scene, excitation)
 
 
 def simulate_world(name: str, make_world: Callable[[], World], scene, excitation,

@@ -41,7 +41,7 @@ from analytic.options import check_real
 from analytic.trajectory import Trajectory
 from engines import mujoco_scene as ms
 from engines._common import MonitorSettings, required_friction
-from engines.base import BASE_MOTIONS, EngineSettings, simulate_world
+from engines.base import BASE_MOTIONS, EngineSettings, check_run, simulate_world
 
 __all__ = ["NAME", "Settings", "simulate", "version", "BASE_MOTIONS", "INTEGRATORS", "CONES",
            "SOLVERS"]
@@ -196,15 +196,8 @@ def _check_own(s: Settings) -> None:
 
 
 def _validate(scene, excitation, s: Settings) -> None:
-    """Checks that need the scene, before any model is built."""
-    if not isinstance(s, Settings):
-        raise TypeError(f"mujoco settings must be engines.mujoco_engine.Settings, "
-                        f"got {type(s).__name__}")
-    if scene.mu == 0.0 and scene.has_pendulum:
-        raise ValueError("mujoco: mu must be > 0 when gamma > 0 (a massless lintel, which the "
-                         "analytic model allows, cannot carry the pendulum hinge in an engine)")
-    s.check_scene(scene)
-    s.check_friction(s.friction, scene, excitation)
+    """Checks that need the scene, before anything is built."""
+    check_run(NAME, Settings, s, scene, excitation)
 
 
 def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:

@@ -44,7 +44,7 @@ from analytic.options import check_real
 from analytic.trajectory import Trajectory
 from engines._common import required_friction
 from engines import pybullet_scene as ps
-from engines.base import BASE_MOTIONS, EngineSettings, simulate_world
+from engines.base import BASE_MOTIONS, EngineSettings, check_run, simulate_world
 
 __all__ = ["NAME", "Settings", "simulate", "version", "render_frames", "view",
            "required_friction", "default_friction", "BASE_MOTIONS", "CAPABILITIES"]
@@ -179,14 +179,9 @@ def default_friction(scene, excitation) -> float:
 
 def _validate(scene, excitation, s: Settings) -> float:
     """Checks that need the scene, before any stepping; returns the friction to use."""
-    if not isinstance(s, Settings):
-        raise TypeError(f"settings must be a pybullet_engine.Settings, got {type(s).__name__}")
-    s.check_scene(scene)
-    if scene.mu == 0.0 and scene.has_pendulum:
-        raise ValueError("mu must be > 0 when gamma > 0: the pendulum hangs on the lintel "
-                         "and a massless lintel cannot exist in PyBullet")
-    friction = default_friction(scene, excitation) if s.friction is None else s.friction
-    return s.check_friction(friction, scene, excitation)
+    own = s.friction if isinstance(s, Settings) else None  # check_run refuses other types
+    friction = default_friction(scene, excitation) if own is None else own
+    return check_run(NAME, Settings, s, scene, excitation, friction)
 
 
 def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:

@@ -41,7 +41,7 @@ import pymunk
 from analytic.options import check_real
 from analytic.trajectory import Trajectory
 from engines._common import required_friction
-from engines.base import BASE_MOTIONS, EngineSettings, simulate_world
+from engines.base import BASE_MOTIONS, EngineSettings, check_run, simulate_world
 # Scene building lives in engines.pymunk_scene; _World is re-exported because
 # tests and benchmarks/bench_overhead.py build bare worlds through this module.
 from engines.pymunk_scene import World, _World  # noqa: F401
@@ -137,15 +137,8 @@ class Settings(EngineSettings):
 
 
 def _validate(scene, excitation, s: Settings) -> None:
-    """Checks that need the scene, before any stepping."""
-    if not isinstance(s, Settings):
-        raise TypeError(f"pymunk settings must be engines.pymunk_engine.Settings, "
-                        f"got {type(s).__name__}")
-    if scene.mu == 0.0 and scene.has_pendulum:
-        raise ValueError("pymunk: mu must be > 0 when gamma > 0 (a massless lintel, which the "
-                         "analytic model allows, cannot carry the pendulum hinge in an engine)")
-    s.check_scene(scene)
-    s.check_friction(s.friction, scene, excitation)
+    """Checks that need the scene, before anything is built."""
+    check_run(NAME, Settings, s, scene, excitation)
 
 
 # -------------------------------------------------------------------------- simulate
