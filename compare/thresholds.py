@@ -105,7 +105,7 @@ class ThresholdPoint:
 def engine_threshold(backend: str, scene, omega: float, a_reference: float, settings=None, *,
                      kind: str = "sine", mode_reference: str | None = None,
                      rel_bracket: float = 0.03, rel_tol: float = 2e-3,
-                     max_expand: int = 5) -> ThresholdPoint:
+                     max_expand: int = 5, guard: float = 0.0) -> ThresholdPoint:
     """Bisect ``backend``'s overturning threshold at ``omega`` around ``a_reference``.
 
     Parameters
@@ -114,17 +114,24 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         Initial half-width of the bracket relative to ``a_reference``, in (0, 0.5).
         3 %: engines agree with the model within ~1-2 % away from jumps.
     rel_tol : float
-        Final bracket width relative to ``a_reference``, in (0, rel_bracket).
+        Final bracket width relative to ``a_reference``, in (0, 0.5).  With
+        ``2 rel_bracket <= rel_tol`` the first two runs already decide a point where
+        the engine agrees (the engine spectrum does this).
         0.2 %: a tenth of the 2 % acceptance tolerance.
     max_expand : int
         Widenings (doubling the step) allowed on each side before giving up.
+    guard : float
+        If larger than ``rel_bracket``: first probe ``a_reference (1 - guard)``; if
+        the engine overturns there already, search downwards from it, else it is a
+        known survivor that bounds the downward search (one run, so that a narrow
+        bracket cannot hide an overturn up to ``guard`` below the model).
     """
     omega = _check_positive("omega", omega)
     a_ref = _check_positive("a_reference", a_reference)
     if not 0.0 < rel_bracket < 0.5:
         raise ValueError(f"rel_bracket must be in (0, 0.5), got {rel_bracket!r}")
-    if not 0.0 < rel_tol < rel_bracket:
-        raise ValueError(f"rel_tol must be in (0, rel_bracket={rel_bracket:g}), got {rel_tol!r}")
+    if not 0.0 < rel_tol < 0.5:
+        raise ValueError(f"rel_tol must be in (0, 0.5), got {rel_tol!r}")
     t0 = time.perf_counter()
     runs = irregular = 0
     modes: dict[float, str | None] = {}
@@ -140,11 +147,21 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         return over
 
     lo, hi = a_ref * (1.0 - rel_bracket), a_ref * (1.0 + rel_bracket)
-    ok, moved_down = True, False
+    ok, moved_down, survivor = True, False, None
     step = rel_bracket
+    if guard > rel_bracket:
+        g = a_ref * (1.0 - guard)
+        if probe(g):  # overturns well below the model: search downwards from there
+            hi, step, moved_down = g, 2.0 * guard, True
+            ok, lo = step < 0.95, a_ref * (1.0 - 2.0 * guard)
+        else:
+            survivor = g
     while ok and probe(lo):  # lo overturns: the engine's threshold is lower
         hi, step, moved_down = lo, 2.0 * step, True
-        ok = step <= rel_bracket * 2 ** max_expand and step < 0.95
+        if survivor is not None and step >= guard:
+            lo = survivor  # known to survive: bisect between it and hi
+            break
+        ok = step <= max(rel_bracket * 2 ** max_expand, 2.0 * guard) and step < 0.95
         lo = a_ref * (1.0 - step)
     step = rel_bracket
     while ok and not moved_down and not probe(hi):  # hi survives: threshold is higher
