@@ -60,8 +60,9 @@ class RunOptions:
         pulse, past ``alpha`` with the energy below the overturning barrier the
         trilith can never return (the same exact rule as the analytic survival
         rule, mirrored).  The verdict's time is then when it became certain, not
-        when the columns topple, and the trajectory ends there: for threshold
-        probes, which need only the verdict.
+        when the columns topple, the trajectory ends there and engines do not
+        measure impact velocities (they count the impacts): for threshold probes,
+        which need only the verdict.
 
     Examples
     --------

@@ -355,7 +355,9 @@ class RunMonitor:
         events: list[Event] = []
         if self._uplift is not None:
             events.append(Event("uplift", self._uplift))
-        impacts = self.measured_impacts()
+        # A verdict-only run (a threshold probe) needs no impact velocities: the
+        # propagation across each impact is skipped, the impacts are still counted.
+        impacts = [] if self.verdict_only else self.measured_impacts()
         if self.verdict.overturned:
             impacts = [e for e in impacts if e.t <= self.verdict.time]
         events.extend(impacts)

@@ -79,8 +79,8 @@ class Settings(EngineSettings):
         How the base excitation is imposed (see the module docstring).  They
         agree within 0.07 % of the peak angle (point B, pendulum, 1.5 s).
     sample_every : int
-        Steps between state reads.  20 (2 ms), as the other engines: impacts
-        are measured away from them, reading state costs harness time.
+        Steps between state reads: the shared default (4 ms, see
+        :class:`engines.base.EngineSettings`).
     monitor : MonitorSettings
         Shared stop rules, with ``impact_window`` 5e-3 rad: a soft contact is
         still relaxing its impact penetration ~1 ms after the impact, so the

@@ -272,6 +272,10 @@ def _state_reader(world):
 
 
 def _peak_ground_speed(excitation) -> float:
+    """A bound of ``max |xg_dot|`` [m/s] (it only scales the blow-up speed limit)."""
+    from analytic.excitation import Pulse
+    if isinstance(excitation, Pulse):  # integral of one sine/cosine lobe: <= 2 A / Omega
+        return 2.0 * abs(excitation.amplitude) / excitation.omega
     if excitation.end_time <= 0.0:
         return 0.0
     ts = [excitation.end_time * k / 400.0 for k in range(401)]
