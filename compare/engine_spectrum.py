@@ -41,8 +41,8 @@ from engines import configure, supports
 
 from .thresholds import ThresholdPoint, engine_threshold
 
-__all__ = ["EnginePoint", "engine_spectrum", "classify", "CAUSES", "DEFAULT_TOL",
-           "DEFAULT_REL_TOL"]
+__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "classify", "CAUSES",
+           "DEFAULT_TOL", "DEFAULT_REL_TOL"]
 
 CAUSES = ("agrees", "model", "jump", "window", "discretisation", "contact", "unknown",
           "no-bracket")
@@ -127,6 +127,12 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
     island = _model_island(scene, omega, point, kind)
     if island is not None:
         return "window", island, ()
+    collapsed = [a for a, st, _ in point.probes if st == "collapsed" and a < point.a_engine]
+    if abs(point.rel_error) <= tol and collapsed:
+        # The threshold agrees, but the engine's frame broke just below it while the
+        # model stays valid: the engine's contacts, not its step.
+        return "contact", _contact_detail(engine, scene, omega, min(collapsed), settings,
+                                          kind), ()
     if near_jump:
         return "jump", "a mode jump of the analytic curve lies within one grid step", ()
     rows = [{"dt": settings.dt, "iterations": _iterations(settings), "a_engine": point.a_engine,
@@ -164,7 +170,8 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
         return ("discretisation", f"error {steps} at dt, dt/2, dt/4 (observed order {order:.2g}); "
                 f"dt <= {meets:.3g} s would meet {100 * tol:g} % (extrapolated){iters}",
                 tuple(rows))
-    return "contact", _contact_detail(engine, scene, omega, point, settings, kind), tuple(rows)
+    return "contact", _contact_detail(engine, scene, omega, point.a_engine, settings, kind), \
+        tuple(rows)
 
 
 def _model_island(scene, omega, point, kind, n: int = 40) -> str | None:
@@ -208,16 +215,19 @@ _NOISE = {"pivot_sliding_max": 1e-5, "penetration_max": 1e-4, "lintel_rotation_m
           "column_mismatch_max": 1e-5}
 
 
-def _contact_detail(engine, scene, omega, point, settings, kind) -> str:
-    """The diagnostic of a run at the engine's threshold farthest beyond its noise."""
+def _contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
+    """The diagnostic farthest beyond its noise level in a run at ``amplitude``
+    (and the verdict's own reason when that run collapsed)."""
     from analytic.excitation import Pulse
     from engines import get_backend
     run = configure(engine, settings, verdict_only=True)
-    tr = get_backend(engine).simulate(scene, Pulse(point.a_engine, omega, kind), run)
+    tr = get_backend(engine).simulate(scene, Pulse(amplitude, omega, kind), run)
     ratios = {k: tr.diagnostics.get(k, 0.0) / n for k, n in _NOISE.items()}
     key = max(ratios, key=ratios.get)
-    return (f"error does not shrink with the step; {key} = {tr.diagnostics.get(key, 0.0):.3g} "
-            f"({ratios[key]:.3g}x its noise level) in the run at A = {point.a_engine:.4g}")
+    what = (f"at A = {amplitude:.4g} the run {tr.verdict.status}"
+            + (f" ({tr.verdict.reason})" if tr.verdict.status == "collapsed" else ""))
+    return (f"{what}; {key} = {tr.diagnostics.get(key, 0.0):.3g} ({ratios[key]:.3g}x its "
+            f"noise level); the error does not shrink with the step")
 
 
 def _point_job(args) -> EnginePoint:
@@ -324,67 +334,3 @@ def _map(fn, items: list, workers: int) -> list:
     import multiprocessing as mp
     with mp.get_context("fork").Pool(workers) as pool:
         return pool.map(fn, items, chunksize=1)
-
-
-CSV_FIELDS = ("engine", "curve", "omega", "a_analytic", "a_engine", "a_survives", "rel_error",
-              "mode_analytic", "mode_engine", "runs", "collapsed_below", "near_jump", "cause",
-              "cause_detail")
-
-
-def write_csv(spectra: list[EngineSpectrum], path) -> None:
-    """One row per engine, curve and frequency (:data:`CSV_FIELDS`)."""
-    import csv
-    import io
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(CSV_FIELDS)
-    for es in spectra:
-        for curve, points in es.curves.items():
-            for p in points:
-                d = p.to_dict()
-                w.writerow([es.engine, curve] + [d[k] for k in CSV_FIELDS[2:]])
-    from pathlib import Path
-    Path(path).write_text(buf.getvalue())
-
-
-def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TOL) -> None:
-    """The analytic curves with every engine's points, and the relative error vs
-    Omega below (tolerance band, mode jumps shaded)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (top, low) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.4),
-                                   gridspec_kw={"height_ratios": [2, 1]})
-    top.plot(reference.omega, reference.a_pendulum, "k-", lw=1.2, label="model, pendulum")
-    top.plot(reference.omega, reference.a_no_pendulum, "k--", lw=1.2, label="model, no pendulum")
-    for jump in reference.mode_jumps():
-        for ax in (top, low):
-            ax.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0)
-    markers = {"pendulum": "o", "no_pendulum": "s"}
-    for k, es in enumerate(spectra):
-        color = f"C{k}"
-        for curve, points in es.curves.items():
-            w = [p.omega for p in points]
-            fill = "full" if curve == "pendulum" else "none"
-            top.plot(w, [p.a_engine for p in points], markers[curve], color=color, ms=4,
-                     fillstyle=fill, label=f"{es.engine}, {curve.replace('_', ' ')}")
-            low.plot(w, [100 * p.rel_error for p in points], markers[curve] + "-", color=color,
-                     ms=4, lw=0.7, fillstyle=fill)
-            for p in points:
-                if p.cause not in ("agrees",):
-                    low.annotate(p.cause[:4], (p.omega, 100 * p.rel_error), fontsize=6,
-                                 xytext=(2, 2), textcoords="offset points")
-    low.axhspan(-100 * tol, 100 * tol, color="C2", alpha=0.12, lw=0)
-    low.axhline(0.0, color="0.5", lw=0.6)
-    top.set_ylabel(r"first overturning $A_s$ [m/s$^2$]")
-    low.set_ylabel("engine error [%]")
-    low.set_xlabel(r"$\Omega$ [rad/s]")
-    top.legend(fontsize=7, ncol=2)
-    sc = reference.scene
-    top.set_title(f"{reference.settings.pulse} pulse, $\\lambda$={sc.lam:g}, b={sc.b:g} m, "
-                  f"$\\gamma$={sc.gamma:g}, $\\mu$={sc.mu:g}; band: $\\pm${100 * tol:g} %",
-                  fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)

@@ -212,15 +212,21 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
 
 
 def _run_engines(args, scene, spec, names, workers: int) -> int:
+    from pathlib import Path
+
+    from compare import atomic
     from compare import engine_spectrum as es
+    from compare import engine_spectrum_files as files
 
     options = {} if args.dt is None else {"dt": args.dt}
     results = [es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
                                   convergence=args.convergence, **options) for name in names]
     if args.csv:
-        es.write_csv(results, args.csv)
+        with atomic.atomic_path(args.csv) as tmp:
+            files.write_csv(results, tmp)
     if args.plot:
-        es.plot(spec, results, args.plot)
+        with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
+            files.plot(spec, results, tmp)
     if args.json:
         print_json({"analytic": spec.to_dict(), "engines": {r.engine: r.to_dict() for r in results}})
         return 0
