@@ -51,13 +51,16 @@ ENGINE_SWEEPS = {
     "pybullet": {"solver_iterations": [10, 25, 100], "contact_erp": [0.05, 0.8],
                  "contact_slop": [1e-5, 1e-3]},
     "pymunk": {"iterations": [10, 60], "slop_fraction": [1e-5, 1e-3, 1e-2]},
+    "mujoco": {"timeconst_steps": [2.0, 10.0], "dampratio": [1.0, 6.0], "iterations": [10]},
 }
 DTS_FULL = [2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5]
 DTS_QUICK = [1e-3, 1e-4]
 # Threshold bisections (8-10 runs of ~4 s of rocking): below 1e-4 only Pymunk is
 # affordable (PyBullet at 5e-5 took 126 s under load).
-THR_DTS_FULL = {"pymunk": [1e-3, 5e-4, 2e-4, 1e-4, 5e-5], "pybullet": [1e-3, 5e-4, 2e-4, 1e-4]}
-THR_DTS_QUICK = {"pymunk": [1e-4], "pybullet": []}  # quick: PyBullet's bisection is ~30 s
+THR_DTS_FULL = {"pymunk": [1e-3, 5e-4, 2e-4, 1e-4, 5e-5], "pybullet": [1e-3, 5e-4, 2e-4, 1e-4],
+                "mujoco": [1e-3, 5e-4, 2e-4, 1e-4]}
+# quick: PyBullet's bisection is ~30 s, MuJoCo's ~15 s
+THR_DTS_QUICK = {"pymunk": [1e-4], "pybullet": [], "mujoco": []}
 
 
 def _settings(backend, **changes):
@@ -126,7 +129,8 @@ def _restitution_error(name: str, st) -> tuple[float, dict]:
     worst, extra = 0.0, {}
     for scene in RESTITUTION_SCENES:
         res = measure_restitution(name, scene, THETA0_FRACTION * scene.alpha, st, n_impacts=2)
-        if not res.complete or not res.rel_errors or any(math.isnan(e) for e in res.rel_errors):
+        errors = [i.rel_error for i in res.impacts]
+        if not res.complete or not errors or any(math.isnan(e) for e in errors):
             return math.inf, {"scene": scene.name, "status": res.status,
                               "n_impacts": res.n_impacts}
         extra[f"{scene.name}_max_rel_error"] = res.max_rel_error
@@ -160,7 +164,7 @@ def _configs(name: str, quick: bool):
     if quick:
         return
     fields = {f.name for f in dataclasses.fields(get_backend(name).Settings)}
-    for key, values in ENGINE_SWEEPS[name].items():
+    for key, values in ENGINE_SWEEPS.get(name, {}).items():
         if key not in fields:  # a setting this engine version does not have
             continue
         for v in values:
@@ -175,7 +179,7 @@ def run_engines(quick: bool, engines=("pybullet", "pymunk"), log=print) -> list[
     for name in engines:
         backend = get_backend(name)
         backend.simulate(SCENE, Pulse(0.5, 6.0), _settings(backend, t_max=0.05))  # warm-up
-        thr_dts = THR_DTS_QUICK[name] if quick else THR_DTS_FULL[name]
+        thr_dts = (THR_DTS_QUICK if quick else THR_DTS_FULL).get(name, [])
         for family, params in _configs(name, quick):
             st = _settings(backend, **params)
             default = _is_default(backend, st)

@@ -314,8 +314,11 @@ def test_engine_grid(name, point):
     tr = backend.simulate(scene, pulse, st)
     for arr in (tr.t, tr.theta, tr.theta_dot, tr.psi, tr.psi_dot):
         assert arr.size > 0 and np.all(np.isfinite(arr))
-    # t_max is set: a run that neither overturns nor blows up is 'survived'.
-    assert tr.verdict.status in ("survived", "overturned", "unstable"), tr.verdict
+    # t_max is set: a run ends survived, overturned, collapsed (the frame broke: the
+    # extreme grid slides pivots by centimetres, a diagnostic named) or unstable.
+    assert tr.verdict.status in ("survived", "overturned", "collapsed", "unstable"), tr.verdict
+    if tr.verdict.status == "collapsed":
+        assert any(k in tr.verdict.reason for k in ("slid", "out of step", "rotated")), tr.verdict
     for e in tr.impacts:
         assert math.isfinite(e.theta_dot_before) and math.isfinite(e.theta_dot_after)
 
