@@ -328,9 +328,8 @@ def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", worker
 
 
 def _map(fn, items: list, workers: int) -> list:
-    """``[fn(x) for x in items]``, in order, on ``workers`` processes."""
-    if workers <= 1 or len(items) <= 1:
-        return [fn(x) for x in items]
-    import multiprocessing as mp
-    with mp.get_context("fork").Pool(workers) as pool:
-        return pool.map(fn, items, chunksize=1)
+    """``[fn(x) for x in items]``, in order, through :func:`compare.runs.run_many`:
+    local workers that die with their parent and stop at Ctrl-C, or the Dask
+    cluster of ``--scheduler``; each engine run inside goes through the run store."""
+    from .runs import run_many
+    return list(run_many(fn, items, workers=max(1, workers)))

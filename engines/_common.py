@@ -300,9 +300,14 @@ class RunMonitor:
     def _overturn_certain(self, theta, theta_dot, psi, psi_dot) -> bool:
         """After the pulse (inertial base, energy never increases): past ``alpha``
         with the energy below the barrier the trilith cannot return across
-        ``alpha``, where the potential has its top: it falls."""
+        ``alpha``, where the potential has its top: it falls.  Without a pendulum,
+        past ``alpha`` and moving outwards is certain too: beyond ``alpha`` the
+        potential only falls outwards, so nothing can turn the motion round
+        (docs/overturn-maps.md; with a pendulum the swinging mass could)."""
         if abs(theta) <= self._alpha:
             return False
+        if not self.scene.has_pendulum and theta * theta_dot > 0.0:
+            return True
         b, h, mu, gamma, j, l, g = self.args
         side = 1 if theta > 0 else -1
         return eq.energy(theta, theta_dot, psi, psi_dot, side, b, h, mu, gamma, j, l, g) \

@@ -33,3 +33,27 @@ def test_overturn_threshold_and_mode():
     assert not mon.record(0.02, -0.01, -0.01, -1.0)  # sign change: an impact
     assert mon.record(0.5, 1.6, 1.6, -3.0)
     assert mon.verdict.overturned and mon.verdict.mode == "after-impact"
+
+
+def test_overturn_certain_rules_after_the_pulse():
+    """Without a pendulum, past alpha after the pulse and moving outwards is a
+    certain fall; moving back inwards with energy above the barrier is not (it can
+    cross alpha again).  With a pendulum only the energy rule applies."""
+    from analytic import equations as eq
+
+    bare = Scene(gamma=0.0)
+    a = bare.alpha
+    pulse = Pulse(20.0, 10.0)  # ends at 0.628 s
+    probe = RunMonitor(bare, pulse, EngineSettings(verdict_only=True))
+    assert not probe.record(0.5, 1.2 * a, 1.2 * a, 2.0)  # during the pulse: never certain
+    fast_in = -3.0  # rad/s back towards alpha: energy far above the barrier
+    args = bare.model_args()
+    assert eq.energy(1.2 * a, fast_in, 0.0, 0.0, 1, *args) > eq.overturn_energy_barrier(
+        *args[:4], args[6])
+    assert not probe.record(0.7, 1.2 * a, 1.2 * a, fast_in)
+    assert probe.record(0.8, 1.3 * a, 1.3 * a, 0.5)  # outwards: certain
+    assert probe.verdict.status == "overturned" and "certain" in probe.verdict.reason
+
+    pend = Scene()
+    with_pendulum = RunMonitor(pend, pulse, EngineSettings(verdict_only=True))
+    assert not with_pendulum.record(0.7, 1.2 * pend.alpha, 1.2 * pend.alpha, 3.0)
