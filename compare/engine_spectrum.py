@@ -88,7 +88,7 @@ def _threshold(engine, scene, omega, a_ref, mode_ref, settings, kind, rel_tol) -
     # from hiding an overturn up to 3 % below the model (a window of the engine's).
     return engine_threshold(engine, scene, omega, a_ref, settings, kind=kind,
                             mode_reference=mode_ref, rel_bracket=0.45 * rel_tol,
-                            rel_tol=rel_tol, max_expand=9, guard=GUARD)
+                            rel_tol=rel_tol, max_expand=9, guard=GUARD, stop_on_collapse=True)
 
 
 def _pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str, **options):

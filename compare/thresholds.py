@@ -105,7 +105,8 @@ class ThresholdPoint:
 def engine_threshold(backend: str, scene, omega: float, a_reference: float, settings=None, *,
                      kind: str = "sine", mode_reference: str | None = None,
                      rel_bracket: float = 0.03, rel_tol: float = 2e-3,
-                     max_expand: int = 5, guard: float = 0.0) -> ThresholdPoint:
+                     max_expand: int = 5, guard: float = 0.0,
+                     stop_on_collapse: bool = False) -> ThresholdPoint:
     """Bisect ``backend``'s overturning threshold at ``omega`` around ``a_reference``.
 
     Parameters
@@ -125,6 +126,10 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         the engine overturns there already, search downwards from it, else it is a
         known survivor that bounds the downward search (one run, so that a narrow
         bracket cannot hide an overturn up to ``guard`` below the model).
+    stop_on_collapse : bool
+        Stop widening upwards at the first 'collapsed' run: above it the engine's
+        bodies are no longer the model's mechanism, so there is no threshold of
+        the model's to find (the point is reported unbracketed, with the collapse).
     """
     omega = _check_positive("omega", omega)
     a_ref = _check_positive("a_reference", a_reference)
@@ -165,6 +170,9 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         lo = a_ref * (1.0 - step)
     step = rel_bracket
     while ok and not moved_down and not probe(hi):  # hi survives: threshold is higher
+        if stop_on_collapse and probes[-1][1] == "collapsed":
+            ok = False  # the frame broke above the model's threshold: nothing to bracket
+            break
         lo, step = hi, 2.0 * step
         ok = step <= rel_bracket * 2 ** max_expand
         hi = a_ref * (1.0 + step)
