@@ -43,10 +43,19 @@ def test_brackets_are_honest_when_rerun_independently(fig5_ref):
 def test_cli_engine_spectrum_json_csv_plot(tmp_path, capsys):
     csv, png = tmp_path / "s.csv", tmp_path / "s.png"
     code = main(["spectrum", "--engine", "pymunk,pybullet", "--omega", "13:14:1", "--json",
-                 "--csv", str(csv), "--plot", str(png), "--workers", "2"])
+                 "--csv", str(csv), "--plot", str(png), "--workers", "2", "--no-cache"])
     assert code == 0
-    doc = json.loads(capsys.readouterr().out)
+    text = capsys.readouterr().out
+    doc = json.loads(text)
+    assert doc["schema_version"] and doc["inputs"]["engine"] == ["pymunk", "pybullet"]
+    assert set(doc["engine_version"]) == {"analytic", "pymunk", "pybullet"}
+    assert list(doc)[-1] == "timings"  # wall times apart from the results
     assert set(doc["engines"]) == {"pymunk", "pybullet"}
+    # A rerun gives the same document up to the timings (the run store is off).
+    assert main(["spectrum", "--engine", "pymunk,pybullet", "--omega", "13:14:1", "--json",
+                 "--no-cache", "--workers", "2"]) == 0
+    again = capsys.readouterr().out
+    assert again.split('"timings"')[0] == text.split('"timings"')[0]
     for name, spec in doc["engines"].items():
         assert spec["settings"]["dt"] == 1e-4  # the calibrated step, carried in the JSON
         for key in ("pendulum", "no_pendulum"):

@@ -218,9 +218,15 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
     from compare import engine_spectrum as es
     from compare import engine_spectrum_files as files
 
+    import time
+
     options = {} if args.dt is None else {"dt": args.dt}
-    results = [es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
-                                  convergence=args.convergence, **options) for name in names]
+    results, walls = [], {}
+    for name in names:
+        t0 = time.perf_counter()
+        results.append(es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
+                                          convergence=args.convergence, **options))
+        walls[name] = time.perf_counter() - t0
     if args.csv:
         with atomic.atomic_path(args.csv) as tmp:
             files.write_csv(results, tmp)
@@ -228,7 +234,18 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
             files.plot(spec, results, tmp)
     if args.json:
-        print_json({"analytic": spec.to_dict(), "engines": {r.engine: r.to_dict() for r in results}})
+        from analytic.fast import version
+        analytic = spec.to_dict()
+        timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
+                   "workers": workers}
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+                  "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
+                  "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
+                  "convergence": args.convergence}
+        body = {"engine": list(names),
+                "engine_version": {"analytic": version(), **{r.engine: r.version for r in results}},
+                "analytic": analytic, "engines": {r.engine: r.to_dict() for r in results}}
+        print_json(envelope("spectrum", inputs, body, timings))
         return 0
     for r in results:
         print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, bracket "
