@@ -41,8 +41,7 @@ __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra"
            "check_output_options", "plain_text",
            "FORMATS", "DEFAULT_DPI"]
 
-FORMATS = ("png", "pdf", "svg")
-DEFAULT_DPI = 300  # print resolution of journals
+from compare.figure_options import DEFAULT_DPI, FORMATS, check_output_options  # noqa: F401
 SINGLE_COLUMN, DOUBLE_COLUMN = 3.5, 7.0  # in: one and two journal columns
 
 
@@ -225,14 +224,6 @@ def figure_size(spec: FigureSpec) -> tuple[float, float]:
     if spec.name == "fig5":
         return SINGLE_COLUMN, 4.2
     return DOUBLE_COLUMN, 1.9 * spec.nrows + 0.7
-
-
-def check_output_options(dpi: int, fmt: str) -> None:
-    """ValueError naming ``--dpi``/``--format`` when out of range."""
-    if isinstance(dpi, bool) or not isinstance(dpi, int) or not 50 <= dpi <= 1200:
-        raise ValueError(f"--dpi must be an integer in [50, 1200], got {dpi!r}")
-    if fmt not in FORMATS:
-        raise ValueError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
 
 
 def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path,

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ._common import add_workers_arg, check_output_path, info, resolve_workers
-from compare.figures import DEFAULT_DPI, FORMATS
+from compare.figure_options import DEFAULT_DPI, FORMATS
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
