@@ -16,13 +16,13 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from analytic import equations as eq
 from analytic.excitation import Pulse
-from analytic.parameters import Scene
+from analytic.parameters import LENGTH_RANGE, Scene
 
 # Common hypothesis profile: deterministic, no deadline; example counts per test.
 CHEAP = settings(max_examples=300, deadline=None, derandomize=True,
@@ -48,7 +48,9 @@ def scenes(draw, with_pendulum: bool | None = None) -> Scene:
     b = draw(widths)
     gamma = draw(gammas) if with_pendulum is None else (draw(st.floats(0.01, 1.0))
                                                          if with_pendulum else 0.0)
-    return Scene(b=b, lam=lam, mu=draw(mus), gamma=gamma, l=draw(l_fracs) * lam * b)
+    l = draw(l_fracs) * lam * b
+    assume(l <= LENGTH_RANGE[1])  # Scene's documented range (a pendulum <= 100 m)
+    return Scene(b=b, lam=lam, mu=draw(mus), gamma=gamma, l=l)
 
 
 def _scale(scene: Scene) -> float:
