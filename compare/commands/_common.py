@@ -269,9 +269,13 @@ def check_run_budget(engine: str, settings, excitation, option: str = "--t-max",
     exceed :data:`MAX_RUN_STEPS`; returns the count.  ``length`` overrides the
     run length (recordings run a fixed duration)."""
     if length is None:
+        # analytic: settings.t_cap; engines: settings.monitor.t_cap; a backend with
+        # neither gets the longest cap of the others (120 s, analytic/events.py).
         t_cap = getattr(settings, "t_cap", None)
         if t_cap is None:
-            t_cap = settings.monitor.t_cap
+            t_cap = getattr(getattr(settings, "monitor", None), "t_cap", None)
+        if t_cap is None:
+            t_cap = 120.0
         length = run_length(excitation, settings.t_max, t_cap)
     dt = getattr(settings, "dt", None) or getattr(settings, "sample_dt", None)
     if not dt:
