@@ -169,7 +169,12 @@ class World:
     def __init__(self, scene, excitation, s: Settings, friction: float) -> None:
         self.scene, self.excitation, self.s = scene, excitation, s
         self.xml = mjcf(scene, s, friction)
-        self.model = m = mujoco.MjModel.from_xml_string(self.xml)
+        try:
+            self.model = m = mujoco.MjModel.from_xml_string(self.xml)
+        except ValueError as exc:  # e.g. a body below MuJoCo's mass/inertia floor (1e-15)
+            raise ValueError(f"mujoco cannot model this scene: {str(exc).splitlines()[0]} "
+                             f"(scene {scene.name!r}: column_mass, gamma and l set the "
+                             f"smallest body)") from None
         self.data = d = mujoco.MjData(m)
         self.moving = s.base_motion == "ground"
 

@@ -9,6 +9,7 @@ parameter.
 """
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
