@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-__all__ = ["lintel_load", "lintel_force_from_accelerations", "lintel_extrema", "violations"]
+__all__ = ["lintel_load", "top_corner_acceleration", "lintel_force_from_accelerations", "lintel_extrema", "violations"]
 
 
 def lintel_load(mu: float, gamma: float) -> float:
@@ -47,6 +47,18 @@ def lintel_load(mu: float, gamma: float) -> float:
     rest with the pendulum hanging still.
     """
     return mu + gamma
+
+
+def top_corner_acceleration(theta, theta_dot, theta_ddot, side, b: float, h: float):
+    """``r_ddot`` of the column-top corner ``r = R(theta) (side b, h)`` that carries
+    the lintel (Eq. 5), relative to the pivot: ``theta_ddot e_z x r - theta_dot^2 r``.
+    The columns' centres move with ``r / 2``.  Scalars or equal-shape arrays."""
+    sb = side * b
+    st, ct = np.sin(theta), np.cos(theta)
+    px = sb * ct - h * st
+    py = sb * st + h * ct
+    w2 = theta_dot * theta_dot
+    return -theta_ddot * py - w2 * px, theta_ddot * px - w2 * py
 
 
 def lintel_force_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot, psi_ddot,
@@ -83,14 +95,10 @@ def lintel_force_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot, 
     >>> float(fx), float(fy)
     (2.0, 9.81)
     """
-    sb = side * b
-    st, ct = np.sin(theta), np.cos(theta)
-    px = sb * ct - h * st  # top corner relative to the pivot (Eq. 5)
-    py = sb * st + h * ct
-    w2 = theta_dot * theta_dot
+    ax, ay = top_corner_acceleration(theta, theta_dot, theta_ddot, side, b, h)
     load = lintel_load(mu, gamma)
-    fx = load * (xg_ddot - theta_ddot * py - w2 * px)
-    fy = load * (g + theta_ddot * px - w2 * py)
+    fx = load * (xg_ddot + ax)
+    fy = load * (g + ay)
     if gamma > 0.0:
         sp, cp = np.sin(psi), np.cos(psi)
         v2 = psi_dot * psi_dot

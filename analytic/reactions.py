@@ -43,7 +43,7 @@ import numpy as np
 
 from . import equations as eq
 from .contact_forces import (lintel_extrema, lintel_force_from_accelerations, lintel_load,
-                             violations)
+                             top_corner_acceleration, violations)
 
 __all__ = ["system_mass", "reaction_from_accelerations", "ground_reaction", "lintel_force",
            "sample_sides", "reaction_history", "lintel_history", "validity_diagnostics",
@@ -64,21 +64,13 @@ def reaction_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot, psi_
     ``side = 0`` (rest) needs ``theta = theta_dot = theta_ddot = 0`` and then only
     adds the bodies' weight, the base's inertial load and the bob's motion.
     """
-    sb = side * b
-    st, ct = np.sin(theta), np.cos(theta)
-    px = sb * ct - h * st  # top corner relative to the pivot (Eq. 5)
-    py = sb * st + h * ct
-    w2 = theta_dot * theta_dot
-    big_m = eq.total_mass(mu, gamma)  # lintel + bob ride on r; two columns at r/2
-    m_s = system_mass(mu, gamma)
-    rx = m_s * xg_ddot + big_m * (-theta_ddot * py - w2 * px)
-    ry = m_s * g + big_m * (theta_ddot * px - w2 * py)
-    if gamma > 0.0:
-        sp, cp = np.sin(psi), np.cos(psi)
-        v2 = psi_dot * psi_dot
-        rx = rx + gamma * l * (psi_ddot * cp - v2 * sp)
-        ry = ry + gamma * l * (psi_ddot * sp + v2 * cp)
-    return rx, ry
+    # The ground carries the lintel and bob (their force on the column tops) plus
+    # the two columns, whose centres move with half the top corner r (Eq. 5):
+    # 2 m1 (xg_ddot + r_ddot_x / 2, g + r_ddot_y / 2), per m1.
+    fx, fy = lintel_force_from_accelerations(theta, theta_dot, psi, psi_dot, theta_ddot,
+                                             psi_ddot, xg_ddot, side, b, h, mu, gamma, l, g)
+    ax, ay = top_corner_acceleration(theta, theta_dot, theta_ddot, side, b, h)
+    return fx + 2.0 * xg_ddot + ax, fy + 2.0 * g + ay
 
 
 def _accelerations(theta: float, theta_dot: float, psi: float, psi_dot: float,
