@@ -26,7 +26,6 @@ from analytic.excitation import Pulse
 from engines import ENGINES, configure
 from scenes import POINTS, load_scene
 
-from engines._common import required_friction
 
 from . import metrics, runs
 from .restitution import RestitutionResult, measure_restitution
@@ -152,16 +151,11 @@ def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = N
 
 
 def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omega: float):
-    """Calibrated settings, with the friction raised where a fixed default is below
-    the engine's own no-sliding bound for the largest pulse of the job (the
-    high-frequency thresholds need peaks beyond the Fig. 5 points)."""
-    settings = backend_settings(name, config)
-    # Every engine has a friction (None: the engine's own default for each run).
-    if settings.friction is not None:
-        need = required_friction(scene, Pulse(a_max, omega))
-        if settings.friction < 1.2 * need:  # 20 % above the bound, as the defaults keep
-            settings = configure(name, settings, friction=1.2 * need)
-    return settings
+    """Calibrated settings (with the campaign's ``engine_dt``) and the friction raised
+    for the largest pulse of the job (:func:`compare.engine_spectrum.pulse_settings`)."""
+    from .engine_spectrum import pulse_settings
+    options = {"dt": config.engine_dt} if config.engine_dt is not None else {}
+    return pulse_settings(name, scene, a_max, omega, **options)
 
 
 @dataclass(frozen=True)

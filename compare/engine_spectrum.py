@@ -41,7 +41,8 @@ from engines import configure, supports
 
 from .thresholds import ThresholdPoint, engine_threshold
 
-__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "classify", "CAUSES",
+__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "classify", "pulse_settings",
+           "CAUSES",
            "DEFAULT_TOL", "DEFAULT_REL_TOL"]
 
 CAUSES = ("agrees", "model", "jump", "window", "discretisation", "contact", "unknown",
@@ -91,10 +92,12 @@ def _threshold(engine, scene, omega, a_ref, mode_ref, settings, kind, rel_tol) -
                             rel_tol=rel_tol, max_expand=9, guard=GUARD, stop_on_collapse=True)
 
 
-def _pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str, **options):
-    """The engine's settings (``options`` applied) with the friction raised to 1.2x
-    the no-sliding bound of the largest pulse the bracket may try, where the engine's
-    own default is below it (as the campaign does)."""
+def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "sine",
+                   **options):
+    """The engine's settings (``options`` applied, :func:`engines.configure`) with a
+    fixed friction raised to 1.2x the no-sliding bound of the largest pulse a bracket
+    may try (20 % above it, as the calibrated defaults keep; a friction of None is the
+    engine's own default for each run).  The campaign and the spectra both use it."""
     from analytic.excitation import Pulse
     from engines._common import required_friction
     settings = configure(engine, **options)
@@ -233,7 +236,7 @@ def _contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
 def _point_job(args) -> EnginePoint:
     (engine, scene, omega, a_ref, mode_ref, near_jump, kind, options, tol, rel_tol,
      convergence) = args
-    settings = _pulse_settings(engine, scene, 2.2 * a_ref, omega, kind, **options)
+    settings = pulse_settings(engine, scene, 2.2 * a_ref, omega, kind, **options)
     p = _threshold(engine, scene, omega, a_ref, mode_ref, settings, kind, rel_tol)
     if p.bracketed and abs(p.rel_error) <= tol and not p.collapsed_below:
         cause, detail, rows = "agrees", f"within {100 * tol:g} %", ()
