@@ -64,8 +64,9 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
     integrating the fall to ``thr``.
 
     Returns ``(status, reason, t_verdict, n_impacts, samples, n_samples, events,
-    n_events, n_steps, e_end)`` (``e_end``: energy per m1 at the pulse end, NaN
-    when decided before it); ``samples`` rows are ``t, theta, theta_dot, psi, psi_dot``,
+    n_events, n_steps, e_out)`` (``e_out``: how near the run came to the
+    overturning barrier, energy per m1, NaN when decided before the pulse end;
+    see below); ``samples`` rows are ``t, theta, theta_dot, psi, psi_dot``,
     ``events`` rows ``kind, t, side, td-, td+, psi, pd-, pd+``.  With ``record``
     False the two buffers stay 1-row placeholders (verdict only).
     """
@@ -117,7 +118,18 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
     reason = -1
     t_verdict = math.nan
     n_steps = 0
-    e_end = math.nan  # energy at the pulse end (NaN: decided before it)
+    # How near the run came to the barrier (e_out): the largest of the frame's
+    # potential during the pulse (at its widest swing) and the energy carried out
+    # of the pulse.  That energy is the pulse-end energy, or, if the frame is then
+    # rocking inward, the larger of the energy with theta_dot set to 0 (continuous
+    # where the frame turns at the pulse end) and the energy just after its next
+    # impact (unless it turns outward first).  After the pulse the energy only
+    # drops, so an overturn needs e_out >= barrier.
+    e_out = math.nan
+    e_stay = math.nan
+    v_pulse = 0.0
+    th_peak = 0.0
+    await_impact = False
 
     while True:
         # -- pulse end: the excitation stops, energy can only decrease from now on
@@ -129,7 +141,33 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
                 en = _rest_energy(y[2], y[3], gamma, l, g)
             else:
                 en = _energy(y[0], y[1], y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
-            e_end = en
+            if th_peak < alpha:
+                v_pulse = g * (1.0 + mu + gamma) * (
+                    b * math.sin(th_peak) + h * math.cos(th_peak) - h)
+            else:
+                v_pulse = barrier
+            e_out = max(en, v_pulse)
+            await_impact = phase != 0 and phase * y[1] < 0.0
+            if await_impact:
+                e_stay = _energy(y[0], 0.0, y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
+            if gamma == 0.0 and await_impact and (abs(y[0]) < alpha or en > barrier) \
+                    and not record:
+                # No pendulum, rocking inward (back over alpha if past it: E > barrier):
+                # the energy is conserved down to the impact at theta = 0, which
+                # keeps r^2 of it (Eq. 20): e_out is known now, and so is the
+                # verdict unless it sits exactly on the barrier.  (A recorded run
+                # goes on: its reader wants the motion.)
+                r = _impact(1.0, 0.0, 0.0, float(-phase), b, h, mu, gamma, j, l)[0]
+                e_next = r * r * en
+                e_out = max(v_pulse, e_stay, e_next)
+                await_impact = False
+                if early and e_next < barrier:
+                    status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
+                    break
+                if certain and e_next > barrier:  # out of the impact past the barrier
+                    n_imp += 1
+                    status, reason, t_verdict = ST_OVERTURNED, R_CERTAIN, t
+                    break
             if early and en < barrier and abs(y[0]) < alpha:
                 status, reason, t_verdict = ST_SURVIVED, R_BARRIER, t
                 break
@@ -285,6 +323,10 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
                 y[c] = ynew[c]
                 k[0, c] = k[6, c]
             hstep = h_used * factor
+            if on and abs(y[0]) > th_peak:
+                th_peak = abs(y[0])
+            if await_impact and phase * y[1] >= 0.0:
+                await_impact = False  # turned outward before the impact: e_out stays
             # Without pendulum, past alpha moving outward is certain at any time
             # after the pulse (the energy test needs only the pulse end: the energy
             # is constant afterwards but for impacts, which happen inside alpha).
@@ -343,6 +385,14 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
             y[0] = 0.0
             y[2] = ytmp[2]
             y[3] = pdp
+            if await_impact:
+                await_impact = False
+                if abs(tdp) < rest_velocity:
+                    e_next = _rest_energy(y[2], y[3], gamma, l, g)
+                else:
+                    e_next = _energy(0.0, tdp, y[2], y[3], float(new_side), b, h, mu, gamma,
+                                     j, l, g)
+                e_out = max(v_pulse, e_stay, e_next)
             if abs(tdp) < rest_velocity:
                 y[1] = 0.0
                 phase = 0
@@ -370,7 +420,7 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
             samples, ns = _push(samples, ns, row)
         if status >= 0:
             break
-    return status, reason, t_verdict, n_imp, samples, ns, events, ne, n_steps, e_end
+    return status, reason, t_verdict, n_imp, samples, ns, events, ne, n_steps, e_out
 
 
 @njit(cache=True)
@@ -388,8 +438,8 @@ def verdict(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol,
 def verdicts(amps, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
              rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit):
     """:func:`verdict` for every amplitude of ``amps`` in one compiled loop (no
-    per-run dispatch): arrays ``(status, reason, t_verdict, n_impacts, e_end)``,
-    ``e_end`` the energy per m1 at the pulse end (see :func:`run`)."""
+    per-run dispatch): arrays ``(status, reason, t_verdict, n_impacts, e_out)``,
+    ``e_out`` how near each run came to the barrier (see :func:`run`)."""
     n = amps.shape[0]
     st = np.empty(n, dtype=np.int64)
     rs = np.empty(n, dtype=np.int64)

@@ -219,7 +219,7 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     t0 = time.perf_counter()
     # No early exit here: a trajectory shows the fall up to the threshold.
     args = kernel_args(scene, excitation.omega, excitation.kind, settings, certain_exit=False)
-    (st, rs, tv, ni, samples, ns, events, ne, n_steps, _e_end) = _k.run(
+    (st, rs, tv, ni, samples, ns, events, ne, n_steps, _e_out) = _k.run(
         excitation.amplitude, *args, True, settings.sample_dt)
     wall = time.perf_counter() - t0
     data = samples[:ns]

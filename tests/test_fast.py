@@ -259,3 +259,51 @@ def test_certain_overturn_exit_keeps_verdicts(fig5, run_analytic):
     d = fast.verdict_for(fig5, Pulse(*PAPER_POINTS["D"]))
     assert d.reason == fast.REASONS[kern.R_CERTAIN] and d.time == pytest.approx(
         Pulse(*PAPER_POINTS["D"]).end_time)
+
+
+def test_energy_out_of_the_pulse_without_pendulum(fig5, run_analytic):
+    """Without the pendulum the verdict kernel stops at the pulse end when the frame
+    rocks inward (back over alpha if past it): the energy is conserved down to the
+    impact at theta = 0, which keeps r^2 of it (Eq. 20).  The energy it reports carried out of
+    the pulse, max(potential at the pulse end, r^2 E), must be at least the recorded
+    run's energy just after that impact, and equal it where that term dominates;
+    the verdict must be the accurate path's."""
+    from analytic.equations import energy
+    scene = fig5.without_pendulum()
+    b, h, mu, gamma, j, l, g = scene.model_args()
+    rng = np.random.default_rng(20)
+    n_inward = n_after = n_past = 0
+    for amp, omega in zip(rng.uniform(3.0, 80.0, 50), rng.uniform(5.0, 30.0, 50)):
+        pulse = Pulse(float(amp), float(omega))
+        # The state at the pulse end, from a run stopped there (last sample <= 1 ms
+        # before it: theta_dot moves by < 1e-3 rad/s in that time, hence the 0.02).
+        upto = fast.simulate(scene, pulse, fast.Settings(t_max=pulse.end_time))
+        if upto.verdict.overturned:
+            continue  # fell during the pulse
+        assert pulse.end_time - upto.t[-1] <= 1e-3
+        th, td = upto.theta[-1], upto.theta_dot[-1]
+        if not (th * td < 0.0 and abs(td) > 0.02):
+            continue  # at rest or moving out at the pulse end
+        # A recorded fixed window integrates on through the impact.
+        tr = fast.simulate(scene, pulse, fast.Settings(t_max=pulse.end_time + 5.0))
+        first = next((e for e in tr.events if e.kind == "impact" and e.t > pulse.end_time),
+                     None)
+        if first is None:  # past alpha below the barrier: cannot come back
+            assert tr.verdict.overturned and abs(th) > scene.alpha
+            continue
+        n_inward += 1
+        n_past += abs(th) > scene.alpha
+        e_after = energy(0.0, first.theta_dot_after, 0.0, 0.0, first.side, b, h, mu, gamma,
+                         j, l, g)
+        args = fast.kernel_args(scene, float(omega), "sine", fast.Settings())
+        _st, _rs, tv, _ni, e_out = kern.verdicts(np.array([float(amp)]), *args)
+        # Both sides carry the DP5 local error (rtol 1e-8) over one free swing.
+        assert e_out[0] >= e_after * (1 - 1e-6), (amp, omega)
+        n_after += e_out[0] == pytest.approx(e_after, rel=1e-6)
+        assert tv[0] == pytest.approx(pulse.end_time)
+        ref = run_analytic(scene, float(amp), float(omega)).verdict
+        verdict = fast.verdict_for(scene, pulse)
+        assert (verdict.status, verdict.mode) == (ref.status, ref.mode), (amp, omega)
+    assert n_inward >= 8  # not vacuous: the pulse-end rule decided these runs
+    assert n_after >= 4  # and r^2 E, the closed form, was the larger term
+    assert n_past >= 2  # and some came back over alpha
