@@ -14,13 +14,17 @@ The search (``method='windows'``, default)
    :func:`analytic._fast_kernels.verdicts`).
 2. Window scan: every coarse interval below that hit is re-scanned in steps
    ``w(A) = max(window_step, window_rel_step A)`` (``window_step`` defaults to
-   ``tol``), lowest interval first, up to the first overturning run, *unless*
-   both of its ends are quiet survivors: decided at the pulse end with an energy
-   below ``(1 - energy_margin)`` times the overturning barrier, inside ``alpha``.
-   An overturn needs the pulse-end energy at the barrier or the frame past
-   ``alpha`` (after the pulse the energy only drops); a window inside a quiet
-   interval would need that energy to climb by ``energy_margin`` x barrier and
-   fall back within one coarse step.
+   ``tol``), lowest interval first, up to the first overturning run, *unless* it
+   is quiet: both ends survived with the same number of impacts and an energy
+   carried out of the pulse ``e_out`` below ``(1 - energy_margin)`` times the
+   overturning barrier.  ``e_out`` (:func:`analytic._fast_kernels.run`) is the
+   energy at the pulse end, or, if the frame then rocks inward, the larger of
+   that energy with ``theta_dot = 0`` and the energy after its next impact.  After
+   the pulse the energy only drops, so an overturn after the pulse needs
+   ``e_out >= barrier``; ``e_out`` is continuous in ``A`` while the sequence of
+   impacts stays the same (the count at both ends).  A window inside a quiet
+   interval would need ``e_out`` to climb by ``energy_margin`` x barrier and fall
+   back within one coarse step on one branch of impacts.
 3. Bisection of the last safe / first overturning pair down to ``tol``.
 
 Guarantee: every overturning window at least ``w(A)`` wide that lies in a
@@ -62,10 +66,23 @@ from .parameters import Scene
 from .trajectory import OverturnCriterion
 
 __all__ = ["SpectrumSettings", "Spectrum", "first_overturn_amplitude", "overturning_spectrum",
-           "METHODS"]
+           "METHODS", "SEARCH_RTOL", "SEARCH_ATOL", "search_run_settings"]
 
 METHODS = ("windows", "scan")
 _CHUNK = 16  # largest batch of coarse runs per compiled call (batches grow 2, 4, ... 16)
+
+# DP5 tolerances of the search's runs.  A verdict needs less than a trajectory
+# (analytic.fast's 1e-8): against runs at rtol 1e-10, the thresholds at 1e-6 stay
+# within tol on the Fig. 5 fine grid and six other scene/pulse grids (1850
+# searches, largest shift 0.0093 m/s^2: one bisection step); 1e-5 moves 6 of them
+# beyond tol, 1e-4 over 100 (docs/overturn-maps.md).  Half the time of 1e-8.
+SEARCH_RTOL, SEARCH_ATOL = 1e-6, 1e-8
+
+
+def search_run_settings(**options) -> fast.Settings:
+    """:class:`analytic.fast.Settings` of a search's runs: ``SEARCH_RTOL`` /
+    ``SEARCH_ATOL`` and ``options`` (criterion, t_max, ...)."""
+    return fast.Settings(**{"rtol": SEARCH_RTOL, "atol": SEARCH_ATOL, **options})
 
 
 @dataclass(frozen=True)
@@ -88,11 +105,13 @@ class SpectrumSettings:
     # Window scan step floor [m/s^2] (None: tol) and relative step.
     window_step: float | None = None
     window_rel_step: float = 0.003
-    # Coarse intervals whose ends both end the pulse below (1 - margin) x barrier
-    # are not re-scanned.
-    energy_margin: float = 0.3
+    # Coarse intervals whose ends both came no nearer than (1 - margin) x barrier,
+    # with the same impact count, are not re-scanned.  On one branch e_out grows
+    # about like A to A^2, 2-4 % per 2 % coarse step; 0.1 leaves 2.5x that
+    # (measured against an exhaustive scan in docs/overturn-maps.md).
+    energy_margin: float = 0.1
     # Integrator settings of every run (criterion, t_max, tolerances).
-    fast: fast.Settings = field(default_factory=fast.Settings)
+    fast: fast.Settings = field(default_factory=search_run_settings)
 
     def __post_init__(self) -> None:
         if self.pulse not in PULSE_KINDS:
@@ -152,10 +171,10 @@ class _Runner:
 
     def __call__(self, amps):
         """``(overturned, n_impacts, quiet)`` arrays for amplitudes ``amps``."""
-        st, _rs, _tv, ni, e_end = _k.verdicts(np.asarray(amps, dtype=float), *self.args)
+        st, _rs, _tv, ni, e_out = _k.verdicts(np.asarray(amps, dtype=float), *self.args)
         self.n_runs += len(st)
         self.n_und += int(np.sum((st == _k.ST_UNDECIDED) | (st == _k.ST_UNSTABLE)))
-        quiet = (st == _k.ST_SURVIVED) & (e_end < self.quiet_energy)
+        quiet = (st == _k.ST_SURVIVED) & (e_out < self.quiet_energy)
         return st == _k.ST_OVERTURNED, ni, quiet
 
 
@@ -181,12 +200,12 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
     """
     run = _Runner(scene, omega, ss)
     a0 = _a_start(scene, ss)
-    over, _, quiet0 = run([a0])
+    over, ni0, quiet0 = run([a0])
     if over[0]:  # nothing is known below the start: refuse to report a wrong "first"
         raise ValueError(f"a run overturns at the scan start A={a0:.4g} m/s^2 "
                          f"(Omega={omega:g}); lower start_fraction")
     # 1. coarse scan, in compiled batches
-    amps, quiet = [a0], [bool(quiet0[0])]
+    amps, quiet, impacts = [a0], [bool(quiet0[0])], [int(ni0[0])]
     hit = None
     batch = 2  # grows: few runs wasted past the first hit, few calls on a long scan
     while hit is None:
@@ -198,6 +217,7 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
         k = int(np.argmax(ov)) if ov.any() else len(grid)
         amps += grid[:k]
         quiet += [bool(q) for q in qu[:k]]
+        impacts += [int(n) for n in ni[:k]]
         if k < len(grid):
             hit = (grid[k], int(ni[k]))
     a_lo, (a_hi, n_hi) = amps[-1], hit
@@ -206,7 +226,7 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
         bounds = amps + [a_hi]
         for i in range(len(amps)):
             last = i == len(amps) - 1
-            if not last and quiet[i] and quiet[i + 1]:
+            if not last and quiet[i] and quiet[i + 1] and impacts[i] == impacts[i + 1]:
                 continue
             lo, hi = bounds[i], bounds[i + 1]
             fine = []

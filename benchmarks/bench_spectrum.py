@@ -30,7 +30,7 @@ COARSE = np.arange(3.0, 31.0, 1.0)
 FINE = np.round(np.arange(30, 301) * 0.1, 10)
 CHECK = np.array([3.0, 5.0, 7.0, 8.0, 10.0, 11.0, 17.0, 18.0])
 TARGET_COARSE_S, GOAL_COARSE_S, TARGET_FINE_S = 0.5, 0.5, 3.0
-OLD = SpectrumSettings(method="scan")  # the search before issue 16
+OLD = SpectrumSettings(method="scan", fast=fast.Settings())  # the search before issue 16 (rtol 1e-8)
 
 
 def main(argv: list[str] | None = None) -> int:

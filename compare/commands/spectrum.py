@@ -79,8 +79,7 @@ def _map_fn(scene, settings, workers: int):
 
 
 def _settings(args: argparse.Namespace):
-    from analytic.fast import Settings
-    from analytic.spectrum import SpectrumSettings
+    from analytic.spectrum import SpectrumSettings, search_run_settings
     from analytic.trajectory import OverturnCriterion
 
     if args.t_max is not None and not (math.isfinite(args.t_max) and 0 < args.t_max <= 1e5):
@@ -90,7 +89,7 @@ def _settings(args: argparse.Namespace):
     if args.scan_step is not None and not (math.isfinite(args.scan_step)
                                            and 1e-4 < args.scan_step <= 100):
         raise ValueError(f"--scan-step must be in (0.0001, 100] m/s^2, got {args.scan_step!r}")
-    fast = Settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
+    fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
     kw = {"pulse": args.pulse, "fast": fast}
     if args.tol is not None:
         kw["tol"] = args.tol
