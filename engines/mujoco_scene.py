@@ -26,10 +26,16 @@ Bodies:
 """
 from __future__ import annotations
 
+import logging
 import math
 from typing import TYPE_CHECKING
 
 import mujoco
+
+# MuJoCo appends its warnings to MUJOCO_LOG.TXT in the working directory; the
+# World reads the same warnings from its counters (d.warning) and reports them,
+# so send the text to logging instead of the user's folder.
+mujoco.set_mju_user_warning(logging.getLogger("engines.mujoco").debug)
 
 if TYPE_CHECKING:  # annotation only: the adapter imports this module
     from engines.mujoco_engine import Settings
