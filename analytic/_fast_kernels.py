@@ -18,39 +18,14 @@ from numba import njit
 from ._fast_numerics import (_MAX_FACTOR, _MIN_FACTOR, _SAFETY, _dense, _ellipk,  # noqa: F401
                              _push, _push_event, _samples_until)
 from ._fast_steps import (KIND_COSINE, KIND_SINE, _barrier, _deriv, _dp_step,  # noqa: F401
-                          _energy, _impact, _locate, _margin, _pendulum_period, _rest_energy,
-                          _xg)
+                          _energy, _frame_potential, _impact, _locate, _margin,
+                          _pendulum_period, _rest_energy, _xg, overturn_certain)
 
 # --- codes shared with analytic/fast.py --------------------------------------------
 ST_OVERTURNED, ST_SURVIVED, ST_UNSTABLE, ST_UNDECIDED = 0, 1, 2, 3
 EV_UPLIFT, EV_IMPACT, EV_REST, EV_OVERTURN, EV_UNSTABLE = 0, 1, 2, 3, 4
 (R_OVERTURN, R_BARRIER, R_REST_NO_PENDULUM, R_PENDULUM_PERIOD, R_T_MAX, R_T_CAP,
  R_NONFINITE, R_STEP_UNDERFLOW, R_STEP_BUDGET, R_CERTAIN) = range(10)
-
-
-@njit(cache=True)
-def overturn_certain(theta, theta_dot, energy, phase, barrier, alpha, b, h, mu, gamma, l, g):
-    """True when, after the pulse (inertial base), the run will reach any
-    threshold in ``(alpha, pi/2]`` whatever happens next (proof in
-    ``docs/overturn-maps.md``, "Early exit"):
-
-    * past ``alpha`` (``s*theta > alpha``) with ``energy < barrier``: the frame
-      cannot come back through ``alpha`` (the potential there is >= barrier),
-      and it cannot stay in ``(alpha, pi/2]`` either: the momentum conjugate to
-      the common shift of ``theta`` and ``psi`` (the kinetic energy depends on
-      ``theta - psi`` only) grows at a rate bounded below while the velocities
-      stay bounded, provided ``M R >= 2 gamma l`` (checked here);
-    * without pendulum, past ``alpha`` moving outward: ``theta_ddot > 0`` there.
-    """
-    if phase == 0:
-        return False
-    st = phase * theta
-    if st <= alpha:
-        return False
-    if gamma == 0.0 and phase * theta_dot >= 0.0:
-        return True
-    big_m = 1.0 + mu + gamma
-    return energy < barrier and big_m * math.hypot(b, h) >= 2.0 * gamma * l
 
 
 @njit(cache=True)
@@ -141,11 +116,7 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
                 en = _rest_energy(y[2], y[3], gamma, l, g)
             else:
                 en = _energy(y[0], y[1], y[2], y[3], float(phase), b, h, mu, gamma, j, l, g)
-            if th_peak < alpha:
-                v_pulse = g * (1.0 + mu + gamma) * (
-                    b * math.sin(th_peak) + h * math.cos(th_peak) - h)
-            else:
-                v_pulse = barrier
+            v_pulse = _frame_potential(th_peak, alpha, barrier, b, h, mu, gamma, g)
             e_out = max(en, v_pulse)
             await_impact = phase != 0 and phase * y[1] < 0.0
             if await_impact:

@@ -169,3 +169,37 @@ def _pendulum_period(psi, psi_dot, l, g):
     if e > sep:
         return 4.0 * l * _ellipk(sep / e) / math.sqrt(2.0 * e)
     return math.inf
+
+
+@njit(cache=True)
+def overturn_certain(theta, theta_dot, energy, phase, barrier, alpha, b, h, mu, gamma, l, g):
+    """True when, after the pulse (inertial base), the run will reach any
+    threshold in ``(alpha, pi/2]`` whatever happens next (proof in
+    ``docs/overturn-maps.md``, "Early exit"):
+
+    * past ``alpha`` (``s*theta > alpha``) with ``energy < barrier``: the frame
+      cannot come back through ``alpha`` (the potential there is >= barrier),
+      and it cannot stay in ``(alpha, pi/2]`` either: the momentum conjugate to
+      the common shift of ``theta`` and ``psi`` (the kinetic energy depends on
+      ``theta - psi`` only) grows at a rate bounded below while the velocities
+      stay bounded, provided ``M R >= 2 gamma l`` (checked here);
+    * without pendulum, past ``alpha`` moving outward: ``theta_ddot > 0`` there.
+    """
+    if phase == 0:
+        return False
+    st = phase * theta
+    if st <= alpha:
+        return False
+    if gamma == 0.0 and phase * theta_dot >= 0.0:
+        return True
+    big_m = 1.0 + mu + gamma
+    return energy < barrier and big_m * math.hypot(b, h) >= 2.0 * gamma * l
+
+
+@njit(cache=True)
+def _frame_potential(theta_peak, alpha, barrier, b, h, mu, gamma, g):
+    """Largest potential per m1 the frame reached swinging to ``|theta| = theta_peak``
+    (the pendulum hanging): rises to ``barrier`` at ``alpha``; past alpha, ``barrier``."""
+    if theta_peak >= alpha:
+        return barrier
+    return g * (1.0 + mu + gamma) * (b * math.sin(theta_peak) + h * math.cos(theta_peak) - h)

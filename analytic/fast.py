@@ -27,7 +27,7 @@ Phase semantics
 * Certain overturn (verdict-only entry points, ``t_max=None``): after the pulse,
   past ``alpha`` with the energy below the barrier (and ``M R >= 2 gamma l``),
   or without pendulum past ``alpha`` moving outward, the fall to the threshold
-  is certain (``_fast_kernels.overturn_certain``, proof in
+  is certain (``_fast_steps.overturn_certain``, proof in
   ``docs/overturn-maps.md``).  The run ends there: the verdict's ``time`` is then
   the instant the overturn became certain, not the instant ``|theta|`` reaches
   the threshold, and its ``reason`` says so.  :func:`simulate` never exits
