@@ -61,8 +61,29 @@ def test_cli_json_csv_plot(tmp_path, capsys):
     (["map", "--workers", "0"], "--workers"),
     (["map", "--engine", "nope"], "engine"),
     (["map", "--engine", "pymunk", "--max-engine-runs", "3"], "--max-engine-runs"),
+    # two engines share the budget: 2 x 2 x 2 = 8 runs > 7
+    (["map", "--engine", "pymunk,mujoco", "--engine-omega", "9:10:1", "--engine-amplitude",
+      "5:6:1", "--max-engine-runs", "7"], "8 runs"),
+    (["map", "--plot", "m.txt"], "--plot"),
 ])
 def test_cli_bad_input(argv, needle, capsys):
     assert cli_main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("error:") and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_engines_beside_the_analytic_map(tmp_path, capsys):
+    """--engine takes a list: one map per engine on its coarser grid, in the JSON,
+    the CSV and the plot (one panel each); every engine cell has a verdict."""
+    csv, png = tmp_path / "m.csv", tmp_path / "m.png"
+    assert cli_main(["map", "--omega", "9:11:1", "--amplitude", "2:20:2", "--engine",
+                     "pymunk,mujoco", "--engine-omega", "9:11:2", "--engine-amplitude", "4:16:12",
+                     "--workers", "2", "--json", "--csv", str(csv), "--plot", str(png)]) == 0
+    maps = json.loads(capsys.readouterr().out)["maps"]
+    assert [m["backend"] for m in maps] == ["analytic-fast", "pymunk", "mujoco"]
+    for m in maps[1:]:
+        assert m["omega"] == [9.0, 11.0] and m["amplitude"] == [4.0, 16.0]
+    rows = csv.read_text().splitlines()[1:]
+    assert len(rows) == 30 + 2 * 4
+    assert {r.split(",")[0] for r in rows} == {"analytic-fast", "pymunk", "mujoco"}
+    assert png.stat().st_size > 0

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import (add_scene_args, clean_nan, parse_omega_range, parse_range, print_json,
+from ._common import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
+                      clean_nan, parse_omega_range, parse_range, print_json, resolve_workers,
                       scene_from_args)
 
 DEFAULT_OMEGA = "3:30:0.5"
@@ -21,20 +22,21 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "first-overturning curve on it, as a PNG, JSON or CSV.")
     add_scene_args(parser)
     parser.add_argument("--pulse", choices=("sine", "cosine"), default="sine",
-                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse [sine]")
+                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
     parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
-                        help=f"frequencies [rad/s], STOP included [{DEFAULT_OMEGA}]")
+                        help="frequencies [rad/s], STOP included")
     parser.add_argument("--amplitude", default=DEFAULT_AMPLITUDE, metavar="A0:A1:dA",
-                        help=f"amplitudes [m/s^2], A1 included [{DEFAULT_AMPLITUDE}]")
-    parser.add_argument("--engine", default=None,
-                        help="also map this backend (pybullet, pymunk, ...) on a coarser grid")
+                        help="amplitudes [m/s^2], A1 included")
+    parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]",
+                        help="also map these engines (pybullet, pymunk, mujoco, or all), each "
+                             "on a coarser grid beside the analytic map")
     parser.add_argument("--engine-omega", default=None, metavar="START:STOP:STEP",
-                        help=f"engine frequencies [default: {ENGINE_POINTS} of --omega]")
+                        help=f"engine frequencies (default: {ENGINE_POINTS} of --omega)")
     parser.add_argument("--engine-amplitude", default=None, metavar="A0:A1:dA",
-                        help=f"engine amplitudes [default: {ENGINE_POINTS} of --amplitude]")
-    parser.add_argument("--max-engine-runs", type=int, default=100,
-                        help="refuse an engine grid with more runs than this [100]")
-    parser.add_argument("--workers", type=int, default=1, help="processes, in [1, 256] [1]")
+                        help=f"engine amplitudes (default: {ENGINE_POINTS} of --amplitude)")
+    parser.add_argument("--max-engine-runs", type=int, default=100, metavar="N",
+                        help="refuse engine grids with more runs than this in all")
+    add_workers_arg(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the cells as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
@@ -48,13 +50,13 @@ def _subsample(values, n: int):
     return values[np.unique(np.round(np.linspace(0, values.size - 1, n)).astype(int))]
 
 
-def _engine_grid(args, omegas, amps):
+def _engine_grid(args, omegas, amps, n_engines: int):
     w = (parse_omega_range(args.engine_omega, "--engine-omega") if args.engine_omega
          else _subsample(omegas, ENGINE_POINTS))
     a = (parse_range(args.engine_amplitude, "--engine-amplitude", "m/s^2")
          if args.engine_amplitude else _subsample(amps, ENGINE_POINTS))
-    if w.size * a.size > args.max_engine_runs:
-        raise ValueError(f"the engine grid needs {w.size * a.size} runs, more than "
+    if n_engines * w.size * a.size > args.max_engine_runs:
+        raise ValueError(f"the engine grids need {n_engines * w.size * a.size} runs, more than "
                          f"--max-engine-runs {args.max_engine_runs}: coarsen --engine-omega/"
                          f"--engine-amplitude or raise --max-engine-runs")
     return w, a
@@ -86,8 +88,12 @@ def plot_maps(maps, path) -> None:
                "overturned (after-impact)": "0.7", "unstable": "tab:red",
                "undecided": "tab:orange", "collapsed": "tab:purple"}
     first = maps[0]
-    fig, axes = plt.subplots(1, len(maps), figsize=(5.2 * len(maps), 4.6), squeeze=False)
-    for ax, m in zip(axes[0], maps):
+    ncols = min(2, len(maps))  # two panels a row: readable on a page or a phone
+    nrows = -(-len(maps) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 4.6 * nrows), squeeze=False)
+    for ax in axes.ravel()[len(maps):]:
+        ax.set_visible(False)
+    for ax, m in zip(axes.ravel(), maps):
         cols = [colours.get(lab, "tab:blue") for lab in m.labels]
         ax.pcolormesh(m.omega, m.amplitude, m.cells, cmap=ListedColormap(cols),
                       vmin=-0.5, vmax=len(cols) - 0.5, shading="nearest")
@@ -102,8 +108,14 @@ def plot_maps(maps, path) -> None:
         sc = m.scene
         ax.set_title(f"{m.backend}: {m.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
                      f"gamma={sc.gamma:g}", fontsize=9)
+    used = axes.ravel()[:len(maps)]
+    for get, set_ in (("get_xlim", "set_xlim"), ("get_ylim", "set_ylim")):
+        lims = [getattr(ax, get)() for ax in used]  # one extent: panels compare by eye
+        for ax in used:
+            getattr(ax, set_)(min(lo for lo, _ in lims), max(hi for _, hi in lims))
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    from compare.atomic import savefig
+    savefig(fig, path, dpi=120)
     plt.close(fig)
 
 
@@ -111,31 +123,33 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     omegas = parse_omega_range(args.omega, "--omega")
     amps = parse_range(args.amplitude, "--amplitude", "m/s^2")
-    if not (1 <= args.workers <= 256):
-        raise ValueError(f"--workers must be in [1, 256], got {args.workers}")
+    workers = resolve_workers(args.workers)
     if not (1 <= args.max_engine_runs <= 100_000):
         raise ValueError(f"--max-engine-runs must be in [1, 100000], got {args.max_engine_runs}")
-    eng_grid = None
+    if args.csv:
+        check_output_path(args.csv, "--csv")
+    if args.plot:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    engines, eng_grid = (), None
     if args.engine is not None:
-        from engines import get_backend
-        get_backend(args.engine)  # unknown name: ValueError before any work
-        eng_grid = _engine_grid(args, omegas, amps)
+        from engines import engine_list
+        engines = engine_list(args.engine)  # unknown name: ValueError before any work
+        eng_grid = _engine_grid(args, omegas, amps, len(engines))
     from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
     if omegas.size * amps.size > MAX_CELLS:
         raise ValueError(f"--omega x --amplitude gives {omegas.size * amps.size} cells, "
                          f"more than {MAX_CELLS}")
     maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
-                         workers=args.workers)]
-    if eng_grid is not None:
-        maps.append(verdict_map(_EngineRun(args.engine, scene, args.pulse), scene, *eng_grid,
-                                backend=args.engine, pulse=args.pulse, workers=args.workers))
+                         workers=workers)]
+    for name in engines:
+        maps.append(verdict_map(_EngineRun(name, scene, args.pulse), scene, *eng_grid,
+                                backend=name, pulse=args.pulse, workers=workers))
     if args.csv:
-        with open(args.csv, "w") as fh:
-            fh.write("backend,omega,amplitude,verdict\n")
-            for m in maps:
-                for w, a, lab in m.csv_rows():
-                    fh.write(f"{m.backend},{w:.12g},{a:.12g},{lab}\n")
+        from compare.atomic import write_text
+        rows = ["backend,omega,amplitude,verdict"] + [
+            f"{m.backend},{w:.12g},{a:.12g},{lab}" for m in maps for w, a, lab in m.csv_rows()]
+        write_text(args.csv, "\n".join(rows) + "\n")
     if args.plot:
         plot_maps(maps, args.plot)
     if args.json:
