@@ -132,7 +132,7 @@ def mass_matrix_rhs(side: int) -> tuple[sp.Matrix, sp.Matrix]:
     eqs = sp.Matrix(lagrange(side))
     mass = eqs.jacobian([thdd, psdd])
     rhs = -eqs.subs({thdd: 0, psdd: 0})
-    return mass.applyfunc(sp.simplify), rhs.applyfunc(sp.expand)
+    return mass.applyfunc(sp.expand), rhs.applyfunc(sp.expand)
 
 
 @functools.lru_cache(maxsize=None)
@@ -312,8 +312,9 @@ def impact_closed_form(new_side: int) -> tuple[sp.Expr, sp.Expr]:
     sol = _linear_solve(eqs, system["unknowns"])
     w1 = system["outputs"]["w1"].subs(sol)
     psi_plus = system["outputs"]["psi_dot_plus"].subs(zero).subs(sol)
-    ratio = sp.trigsimp(sp.factor(w1 / W_MINUS))
-    return ratio, sp.trigsimp(sp.factor(psi_plus))
+    # cancel (a gcd) rather than factor: sympy's multivariate factorisation picks
+    # random evaluation points and now and then lifts for minutes (seen: 16 min).
+    return sp.cancel(w1 / W_MINUS), sp.cancel(psi_plus)
 
 
 # ----------------------------------------------- forms to compare with (not derived)
