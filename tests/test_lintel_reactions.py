@@ -14,6 +14,7 @@ from analytic.excitation import Pulse
 from analytic.reactions import check_model, lintel_force, lintel_history
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
+from finite_differences import central_difference_force
 
 
 def _top_moment(scene, theta, psi, side):
@@ -37,28 +38,11 @@ def _top_moment(scene, theta, psi, side):
 
 
 def _fd_lintel_force(scene, pulse, tr):
-    """``F`` by central differences of the lintel and bob's mass moment on runs
-    of three equally spaced samples within one phase: (indices, F_fd[2, n])."""
-    t = tr.t
-    dt = np.diff(t)
-    idx, out = [], []
-    for i in range(1, len(t) - 1):
-        if not (dt[i - 1] > 0 and abs(dt[i] - dt[i - 1]) < 1e-12 * max(1.0, t[i])):
-            continue
-        th = tr.theta[i - 1:i + 2]
-        sides = np.sign(th)
-        side = sides[1]
-        if (side == 0 and np.any(th != 0.0)) or (side != 0 and np.any(sides != side)):
-            continue
-        end = pulse.end_time
-        if end in t[i - 1:i + 2] or t[i - 1] < end < t[i + 1]:
-            continue  # xg_ddot's derivative jumps there: the stencil straddles a kink
-        moment = _top_moment(scene, th, tr.psi[i - 1:i + 2], side if side else 1.0)
-        acc = (moment[:, 2] - 2.0 * moment[:, 1] + moment[:, 0]) / (dt[i] * dt[i])
-        load = scene.mu + scene.gamma
-        out.append(acc + load * np.array([pulse.acceleration(t[i]), scene.g]))
-        idx.append(i)
-    return np.array(idx), np.array(out).T
+    """``F`` by central differences of the lintel and bob's mass moment:
+    (indices, F_fd[2, n])."""
+    return central_difference_force(
+        scene, tr, pulse, lambda th, psi, side: _top_moment(scene, th, psi, side),
+        scene.mu + scene.gamma)
 
 
 def test_static_lintel_force_is_the_weight_of_lintel_and_bob(fig5, fig5_bare):

@@ -15,6 +15,7 @@ from analytic.excitation import Pulse
 from analytic.reactions import ground_reaction, reaction_history, system_mass
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
+from finite_differences import central_difference_force
 from compare.commands._common import clean_nan
 
 G = 9.81
@@ -46,31 +47,12 @@ def _mass_moment(scene, theta, psi, side):
     return g1 + g2 + mu * g3 + gamma * g4
 
 
-def _fd_reactions(scene, pulse, tr, side_of_rest=0):
-    """``R`` by central differences of the mass moment on runs of three equally
-    spaced samples within one phase; returns (indices, R_fd[2, n])."""
-    t = tr.t
-    dt = np.diff(t)
-    idx, out = [], []
-    for i in range(1, len(t) - 1):
-        if not (dt[i - 1] > 0 and abs(dt[i] - dt[i - 1]) < 1e-12 * max(1.0, t[i])):
-            continue
-        th = tr.theta[i - 1:i + 2]
-        sides = np.sign(th)
-        side = sides[1]
-        if side == 0:
-            if np.any(th != 0.0):
-                continue
-        elif np.any(sides != side):
-            continue
-        if tr.excitation.end_time in t[i - 1:i + 2] or t[i - 1] < tr.excitation.end_time < t[i + 1]:
-            continue  # xg_ddot's derivative jumps there: the stencil straddles a kink
-        moment = _mass_moment(scene, th, tr.psi[i - 1:i + 2], side if side else 1.0)
-        acc = (moment[:, 2] - 2.0 * moment[:, 1] + moment[:, 0]) / (dt[i] * dt[i])
-        m_s = 2.0 + scene.mu + scene.gamma
-        out.append(acc + m_s * np.array([pulse.acceleration(t[i]), scene.g]))
-        idx.append(i)
-    return np.array(idx), np.array(out).T
+def _fd_reactions(scene, pulse, tr):
+    """``R`` by central differences of the whole trilith's mass moment:
+    (indices, R_fd[2, n])."""
+    return central_difference_force(
+        scene, tr, pulse, lambda th, psi, side: _mass_moment(scene, th, psi, side),
+        2.0 + scene.mu + scene.gamma)
 
 
 @pytest.mark.parametrize("amplitude, omega, label", [
