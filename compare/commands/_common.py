@@ -96,9 +96,13 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     return scene
 
 
-def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
+def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--pulse", choices=PULSE_KINDS, default="sine",
                         help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
+
+
+def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
+    add_pulse_kind_arg(parser)
     parser.add_argument("--amplitude", "-A", type=float, required=required,
                         help="pulse amplitude A [m/s^2], |A| <= 1e4")
     parser.add_argument("--omega", "-w", type=float, required=required,

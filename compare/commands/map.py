@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
-                      clean_nan, parse_omega_range, parse_range, print_json, resolve_workers,
-                      scene_from_args)
+from ._common import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_workers_arg,
+                      check_output_path, clean_nan, parse_omega_range, parse_range,
+                      print_json, resolve_workers, scene_from_args)
 
 DEFAULT_OMEGA = "3:30:0.5"
 DEFAULT_AMPLITUDE = "0.5:100:0.5"
@@ -21,8 +21,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "without / after impact, survived, or an engine's other statuses), the "
                     "first-overturning curve on it, as a PNG, JSON or CSV.")
     add_scene_args(parser)
-    parser.add_argument("--pulse", choices=("sine", "cosine"), default="sine",
-                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
+    add_pulse_kind_arg(parser)
     parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
                         help="frequencies [rad/s], STOP included")
     parser.add_argument("--amplitude", default=DEFAULT_AMPLITUDE, metavar="A0:A1:dA",

@@ -6,8 +6,9 @@ import math
 import sys
 
 from . import _common
-from ._common import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
-                      add_store_args, clean_nan, envelope, parse_omega_range, info, print_json, resolve_workers, scene_from_args,
+from ._common import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
+                      add_workers_arg, check_output_path, clean_nan, envelope, info,
+                      parse_omega_range, print_json, resolve_workers, scene_from_args,
                       use_store)
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
@@ -24,8 +25,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "curves (with and without the pendulum), the gain "
                     "Delta = 100 (A_yp - A_np)/A_np and the overturning modes.")
     add_scene_args(parser)
-    parser.add_argument("--pulse", choices=("sine", "cosine"), default="sine",
-                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
+    add_pulse_kind_arg(parser)
     parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
                         help="frequencies [rad/s] in [0.1, 1e4], STOP included, or a comma "
                              "list; at most 100000")
