@@ -15,15 +15,14 @@ never imports an engine.
 from __future__ import annotations
 
 import math
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from . import _fast_kernels as _k
 from . import fast
+from ._workers import fork_pool
 from .parameters import Scene
 from .spectrum import SpectrumSettings, first_overturn_amplitude
 
@@ -111,8 +110,7 @@ def _verdict_cell(ij: tuple[int, int]) -> tuple[str, str | None]:
 def _pool_map(fn, items, workers: int) -> list:
     if workers == 1 or len(items) == 1:
         return [fn(x) for x in items]
-    ctx = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=ctx) as ex:
+    with fork_pool(min(workers, len(items))) as ex:
         return list(ex.map(fn, items, chunksize=max(1, len(items) // (4 * workers))))
 
 

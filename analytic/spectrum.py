@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import functools
 import math
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import fast
+from ._workers import fork_pool
 from .first_overturn import (METHODS, SEARCH_ATOL, SEARCH_RTOL, SpectrumSettings,
                              first_overturn_amplitude, search_run_settings)
 from .parameters import Scene
@@ -187,13 +187,12 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
                 if bar is not None:
                     bar.update(1)
         else:
-            ctx = multiprocessing.get_context("fork")
             # Highest frequencies first: they scan the most amplitudes, and starting
             # with them keeps both workers busy to the end.  Results are placed by
             # index, so the order (and every number) is the same for any count.
             order = np.argsort(-w, kind="stable")
             slots: list = [None] * int(w.size)
-            with ProcessPoolExecutor(max_workers=min(workers, int(w.size)), mp_context=ctx) as ex:
+            with fork_pool(min(workers, int(w.size))) as ex:
                 futures = {ex.submit(_one_frequency, float(w[i])): int(i) for i in order}
                 for fut in as_completed(futures):
                     slots[futures[fut]] = fut.result()

@@ -10,19 +10,16 @@ activates one unless ``--no-cache``) both just compute.
 Dask distributed cluster; results come back in submission order, so no number
 depends on scheduling, and every worker uses the same store as the caller.
 
-Local workers are forked (they inherit the imported engines and the compiled
-numba kernels: no second import of ~1 s per worker), ignore SIGINT (Ctrl-C is
-the parent's to handle, so a terminal shows one line, not one traceback per
-worker) and die with their parent (Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)``;
-elsewhere a watchdog thread polling the parent's pid).
+Local workers come from :func:`analytic._workers.fork_pool`: forked (they inherit
+the imported engines and the compiled numba kernels: no second import of ~1 s
+per worker), deaf to SIGINT (Ctrl-C is the parent's to handle, so a terminal
+shows one line, not one traceback per worker), dead with their parent (Linux
+``prctl(PR_SET_PDEATHSIG, SIGKILL)``; elsewhere a watchdog thread polling the
+parent's pid) and killed at once when the caller stops early.
 """
 from __future__ import annotations
 
 import contextlib
-import os
-import signal
-import sys
-import threading
 import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, wait
@@ -154,30 +151,6 @@ def stats_line() -> str:
 _WORKER: dict = {}
 
 
-def _die_with_parent(parent_pid: int) -> None:
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-            libc = ctypes.CDLL(None, use_errno=True)
-            if libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0:  # 1 = PR_SET_PDEATHSIG
-                if os.getppid() != parent_pid:  # the parent died before prctl
-                    os._exit(1)
-                return
-        except (OSError, AttributeError):
-            pass
-
-    def watch():
-        while os.getppid() == parent_pid:
-            time.sleep(0.5)
-        os._exit(1)
-    threading.Thread(target=watch, daemon=True, name="parent-watchdog").start()
-
-
-def _init_worker(parent_pid: int) -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _die_with_parent(parent_pid)
-
-
 def _call(payload):
     """Run ``fn(item)`` in a worker with the caller's store; return the result and
     the worker's hit/compute counts for it."""
@@ -273,31 +246,13 @@ def _ordered(futures, result_of, on_done, poll):
 
 
 def _run_local(payloads, workers: int, on_done):
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor
+    from analytic._workers import fork_pool
 
-    ctx = mp.get_context("fork")
-    ex = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker,
-                             initargs=(os.getpid(),))
-    finished = False
-    try:
+    with fork_pool(workers) as ex:
         futures = [ex.submit(_call, p) for p in payloads]
         yield from _ordered(futures, lambda f: f.result(), on_done,
                             lambda pending: wait(pending, timeout=_POLL_S,
                                                  return_when=FIRST_COMPLETED))
-        finished = True
-    finally:
-        if finished:
-            ex.shutdown(wait=True)
-        else:  # Ctrl-C, an error, or the caller stopped early: stop now, not at the end
-            # The executor has no public kill (3.14's terminate_workers); take its
-            # processes before shutdown() forgets them, else exit waits for them.
-            procs = list((getattr(ex, "_processes", None) or {}).values())
-            for proc in procs:
-                proc.kill()
-            ex.shutdown(wait=False, cancel_futures=True)
-            for proc in procs:
-                proc.join(timeout=1.0)
 
 
 def _run_dask(payloads, address: str, on_done):

@@ -1,5 +1,6 @@
-"""Kill safety of ``trilith campaign``: resume after SIGKILL, no orphan workers,
-prompt Ctrl-C.  Each test runs the CLI in a subprocess of its own session (so the
+"""Kill safety of ``trilith campaign`` (resume after SIGKILL, no orphan workers,
+prompt Ctrl-C) and of ``trilith map``'s own process pools (no orphans, prompt
+Ctrl-C).  Each test runs the CLI in a subprocess of its own session (so the
 whole process group can be inspected and cleaned up) on a tiny Pymunk study:
 coarse 5e-4 s steps, ~0.1 s of CPU per run.
 """
@@ -184,5 +185,35 @@ def test_ctrl_c_cancels_promptly_with_one_line(tmp_path):
         # The work was cancelled, not finished: far fewer runs than the study needs
         # (6 frequencies x ~6 runs).
         assert _runs(cache) < n_runs + 10
+    finally:
+        _cleanup(proc)
+
+
+# An engine map long enough to be interrupted: 9 x 10 Pymunk cells (~0.1 s each).
+MAP = ["map", "--omega", "3:20:1", "--amplitude", "1:40:1", "--engine", "pymunk",
+       "--engine-omega", "4:20:2", "--engine-amplitude", "2:38:4", "--max-engine-runs", "300",
+       "--workers", "2"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("how", ["kill -9 of the parent", "Ctrl-C"])
+def test_map_workers_stop_with_the_parent(how):
+    proc = _start(MAP)
+    try:
+        _wait_for(lambda: len(_children(proc.pid)) >= 2 or proc.poll() is not None,
+                  "two map workers")
+        assert proc.poll() is None, "finished before it could be stopped"
+        t0 = time.monotonic()
+        if how == "Ctrl-C":
+            os.killpg(proc.pid, signal.SIGINT)  # what a terminal does
+            _, err = proc.communicate(timeout=LIVENESS_S)
+            assert proc.returncode == 130
+            lines = [ln for ln in err.splitlines() if ln.strip()]
+            assert len(lines) == 1 and lines[0].startswith("interrupted"), err
+        else:
+            os.kill(proc.pid, signal.SIGKILL)
+            proc.communicate(timeout=LIVENESS_S)
+        _wait_for(lambda: not _group(proc.pid), "the map workers to exit", timeout=LIVENESS_S)
+        assert time.monotonic() - t0 < LIVENESS_S
     finally:
         _cleanup(proc)
