@@ -126,15 +126,20 @@ def check_output(path: str | Path) -> Path:
 
 
 def resolve_engines(engine: str) -> tuple[str, ...]:
-    """``'all'`` -> :data:`ALL_ENGINES`; a registered name -> itself; else ValueError."""
+    """``'all'`` -> :data:`ALL_ENGINES`; ``'a,b'`` -> ``('a', 'b')`` (registered
+    backends, each once, panels in that order); else ValueError."""
     from engines import backend_names
 
-    if engine == "all":
+    if engine.strip() == "all":
         return ALL_ENGINES
-    if engine not in backend_names():
-        raise ValueError(f"--engine must be one of {', '.join(backend_names())}, all; "
-                         f"got {engine!r}")
-    return (engine,)
+    names = tuple(n.strip() for n in engine.split(","))
+    for name in names:
+        if name not in backend_names():
+            raise ValueError(f"--engine must name backends from {', '.join(backend_names())} "
+                             f"(comma-separated) or all; got {name!r}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"--engine names a backend twice: {engine!r}")
+    return names
 
 
 def load_backend(name: str):

@@ -267,6 +267,19 @@ def test_all_backends_side_by_side(tmp_path):
         assert traj.overturned or traj.t[-1] >= 0.4 - 1e-3
 
 
+
+def test_a_list_of_backends_in_its_order(tmp_path):
+    """--engine takes a comma list: one panel per backend, in the order given."""
+    out = tmp_path / "two.gif"
+    settings = rec.RecordSettings(fps=10.0, duration=0.2, panel_width=128, panel_height=96)
+    result = rec.record(FIG5, Pulse(19.0, 15.0), "pymunk,analytic", out, settings)
+    assert list(result.trajectories) == ["pymunk", "analytic"]
+    assert read_gif(out)[0].shape == (96, 2 * 128, 3)
+    for bad, needle in (("pymunk,nope", "'nope'"), ("pymunk,pymunk", "twice"), (",", "''")):
+        with pytest.raises(ValueError, match=needle):
+            rec.resolve_engines(bad)
+
+
 # --- view ---------------------------------------------------------------------------
 def test_display_problem_detection():
     assert "DISPLAY" in display_problem({}, None)

@@ -14,9 +14,10 @@ from ._common import (add_pulse_args, add_record_arg, add_scene_args, check_outp
 def add_watch_args(parser: argparse.ArgumentParser) -> None:
     """Options shared by ``view`` and ``record``."""
     add_scene_args(parser)
-    parser.add_argument("--engine", default="analytic", metavar="NAME",
-                        help="backend: analytic, analytic-fast, pybullet, pymunk, or all "
-                             f"({', '.join(ALL_ENGINES)} side by side)")
+    parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
+                        help="backends side by side on one time base (analytic, "
+                             "analytic-fast, pybullet, pymunk, mujoco), or all "
+                             f"({', '.join(ALL_ENGINES)})")
     add_pulse_args(parser, required=False)
     parser.set_defaults(amplitude=None, omega=None)
     for action in parser._actions:  # the defaults live in scenes.record: show them
