@@ -10,6 +10,7 @@ come from the store.  ``--estimate`` prints the job count and the expected time
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import time
@@ -79,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
     store = use_store(args)
     t0 = time.perf_counter()
-    with atomic.output_lock(out):
+    # --estimate writes nothing: it leaves the output location (and its lock) alone.
+    with contextlib.nullcontext() if args.estimate else atomic.output_lock(out):
         ref_jobs = reference_jobs(study)
         references = dict(zip(ref_jobs, runs.run_many(run_reference, ref_jobs,
                                                        workers=workers)))
