@@ -35,7 +35,7 @@ import sys
 import time
 from dataclasses import replace
 
-import pybullet as pb
+from engines._quiet_pybullet import pybullet as pb
 import pymunk
 
 import engines

@@ -36,7 +36,7 @@ import math
 import sys
 import time
 
-import pybullet as pb
+from engines._quiet_pybullet import pybullet as pb
 
 import engines
 from analytic.excitation import Pulse

@@ -90,24 +90,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
 
 
 def import_pybullet_quietly() -> None:
-    """Import pybullet with fd 2 sent to /dev/null: its C library prints a
-    "pybullet build time: ..." banner to stderr on import, which would break
-    the one-line error contract and clutter every run.  Later imports (the
-    engines, forked workers) find the module loaded and print nothing."""
-    if "pybullet" in sys.modules:
-        return
-    saved = os.dup(2)
-    devnull = os.open(os.devnull, os.O_WRONLY)
+    """Import pybullet without its "pybullet build time" banner on stderr
+    (:mod:`engines._quiet_pybullet`); later imports find it loaded."""
     try:
-        os.dup2(devnull, 2)
-        try:
-            import pybullet  # noqa: F401
-        except ImportError:
-            pass
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(devnull)
+        import engines._quiet_pybullet  # noqa: F401
+    except ImportError:
+        pass
 
 
 def _uses_pybullet(args: argparse.Namespace) -> bool:

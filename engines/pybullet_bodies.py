@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import pybullet as pb
+from engines._quiet_pybullet import pybullet as pb
 
 __all__ = ["Bodies", "build_scene", "initial_poses", "NEGLIGIBLE_MASS_FRACTION",
            "GROUND_MASS_FACTOR"]

@@ -38,7 +38,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet as pb
+from engines._quiet_pybullet import pybullet as pb
 
 from analytic.options import check_real
 from analytic.trajectory import Trajectory

@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-import pybullet as pb
+from engines._quiet_pybullet import pybullet as pb
 
 # Body construction lives in engines.pybullet_bodies; re-exported here because
 # the adapter, tests and benchmarks import it through this module.
