@@ -50,10 +50,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import _fast_kernels as _k
-from . import fast
 from .equations import overturn_energy_barrier
 from .excitation import PULSE_KINDS
+from .fast_settings import Settings as FastSettings
 from .parameters import Scene
 from .trajectory import OverturnCriterion
 
@@ -71,10 +70,10 @@ _CHUNK = 16  # largest batch of coarse runs per compiled call (batches grow 2, 4
 SEARCH_RTOL, SEARCH_ATOL = 1e-6, 1e-8
 
 
-def search_run_settings(**options) -> fast.Settings:
+def search_run_settings(**options) -> FastSettings:
     """:class:`analytic.fast.Settings` of a search's runs: ``SEARCH_RTOL`` /
     ``SEARCH_ATOL`` and ``options`` (criterion, t_max, ...)."""
-    return fast.Settings(**{"rtol": SEARCH_RTOL, "atol": SEARCH_ATOL, **options})
+    return FastSettings(**{"rtol": SEARCH_RTOL, "atol": SEARCH_ATOL, **options})
 
 
 @dataclass(frozen=True)
@@ -103,7 +102,7 @@ class SpectrumSettings:
     # (measured against an exhaustive scan in docs/overturn-maps.md).
     energy_margin: float = 0.1
     # Integrator settings of every run (criterion, t_max, tolerances).
-    fast: fast.Settings = field(default_factory=search_run_settings)
+    fast: FastSettings = field(default_factory=search_run_settings)
 
     def __post_init__(self) -> None:
         if self.pulse not in PULSE_KINDS:
@@ -124,7 +123,7 @@ class SpectrumSettings:
                 raise ValueError(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
         if self.tol > self.scan_step:
             raise ValueError(f"tol ({self.tol:g}) must not exceed scan_step ({self.scan_step:g})")
-        if not isinstance(self.fast, fast.Settings):
+        if not isinstance(self.fast, FastSettings):
             raise ValueError("fast must be analytic.fast.Settings")
 
     @property
@@ -155,6 +154,8 @@ class _Runner:
     """Runs of one (scene, frequency): compiled verdicts plus counters."""
 
     def __init__(self, scene: Scene, omega: float, ss: SpectrumSettings):
+        from . import _fast_kernels, fast  # numba: imported when a run is made
+        self._k = _fast_kernels
         self.args = fast.kernel_args(scene, omega, ss.pulse, ss.fast)
         self.quiet_energy = (1.0 - ss.energy_margin) * overturn_energy_barrier(
             *scene.model_args()[:4], scene.g)
@@ -163,6 +164,7 @@ class _Runner:
 
     def __call__(self, amps):
         """``(overturned, n_impacts, quiet)`` arrays for amplitudes ``amps``."""
+        _k = self._k
         st, _rs, _tv, ni, e_out = _k.verdicts(np.asarray(amps, dtype=float), *self.args)
         self.n_runs += len(st)
         self.n_und += int(np.sum((st == _k.ST_UNDECIDED) | (st == _k.ST_UNSTABLE)))

@@ -22,7 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import fast
 from ._workers import fork_pool
 from .first_overturn import (METHODS, SEARCH_ATOL, SEARCH_RTOL, SpectrumSettings,
                              first_overturn_amplitude, search_run_settings)
@@ -167,7 +166,11 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     t0 = time.perf_counter()
-    fast.warm_up(record=False)  # compile (or load) once, before any fork
+    if map_fn is None:  # compile (or load) once, before any fork
+        from . import fast
+        fast.warm_up(record=False)
+    # (A caller's map_fn loads the kernels where runs are made: a store that
+    # already holds every frequency then needs no numba at all.)
     _JOB.update(scene=scene, settings=ss)
     bar = None
     if progress:

@@ -64,6 +64,14 @@ def _cached_frequency(payload):
     return runs.memo("spectrum-point", {**description, "omega": omega}, lambda: fn(omega))
 
 
+def _stored_frequency(payload):
+    """The stored result of :func:`_cached_frequency`, or None (looked up in this
+    process: a warm rerun starts no pool and loads no kernel)."""
+    from compare import runs
+    _fn, description, omega = payload
+    return runs.lookup("spectrum-point", {**description, "omega": omega})
+
+
 def _map_fn(scene, settings, workers: int):
     """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
     through the store, on local processes or the ``--scheduler`` cluster."""
@@ -74,7 +82,7 @@ def _map_fn(scene, settings, workers: int):
 
     def map_fn(fn, omegas):
         return runs.run_many(_cached_frequency, [(fn, description, w) for w in omegas],
-                             workers=workers)
+                             workers=workers, lookup=_stored_frequency)
     return map_fn
 
 
@@ -133,7 +141,7 @@ def _number(value: float, width: int) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from analytic.fast import version
+    from analytic.fast_settings import version
     from analytic.spectrum import overturning_spectrum
     from compare import atomic
 
@@ -233,7 +241,7 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
             files.plot(spec, results, tmp)
     if args.json:
-        from analytic.fast import version
+        from analytic.fast_settings import version
         analytic = spec.to_dict()
         timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
                    "workers": workers}
