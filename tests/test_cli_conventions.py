@@ -200,3 +200,21 @@ def test_record_line_numbers_are_file_lines(tmp_path):
     path.write_text("# comment\nt,a\n0,0\n0.5,1\n0.4,0\n")
     with pytest.raises(ValueError, match=r"r.csv, line 5: time 0.4 s does not increase"):
         load_record(path)
+
+
+def test_stored_spectrum_needs_no_numba(tmp_path):
+    """A rerun served by the run store looks its frequencies up in the calling
+    process: numba (about 0.6 s of start-up with the kernels) is never imported,
+    and the output is the first run's.  (One worker: the first run computes in
+    this process, so it must import numba.)"""
+    argv = ["spectrum", "--omega", "9:11:1", "--workers", "1", "--cache", str(tmp_path), "--json"]
+    code = (f"import sys; from compare.cli import main; main({argv!r}); "
+            "print('numba' in sys.modules, file=sys.stderr)")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    first, again = (subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env,
+                                   capture_output=True, text=True, timeout=300)
+                    for _ in range(2))
+    assert first.stderr.strip().endswith("True")  # it computed
+    assert again.stderr.strip().endswith("False")  # it did not load numba
+    strip = lambda out: {k: v for k, v in json.loads(out).items() if k != "timings"}  # noqa: E731
+    assert strip(first.stdout) == strip(again.stdout)
