@@ -160,7 +160,7 @@ def machine_info() -> dict:
         except Exception:  # noqa: BLE001 -- a missing optional library is reported, not fatal
             versions[mod] = "missing"
     try:
-        import pybullet
+        from engines._quiet_pybullet import pybullet
         versions["pybullet"] = f"API {pybullet.getAPIVersion()}"
     except Exception:  # noqa: BLE001
         versions["pybullet"] = "missing"

@@ -89,20 +89,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     return parser, modules
 
 
-def import_pybullet_quietly() -> None:
-    """Import pybullet without its "pybullet build time" banner on stderr
-    (:mod:`engines._quiet_pybullet`); later imports find it loaded."""
-    try:
-        import engines._quiet_pybullet  # noqa: F401
-    except ImportError:
-        pass
-
-
-def _uses_pybullet(args: argparse.Namespace) -> bool:
-    engine = str(getattr(args, "engine", "") or "")
-    return "pybullet" in engine or engine == "all"
-
-
 def main(argv: list[str] | None = None) -> int:
     parser, modules = build_parser()
     args = parser.parse_args(argv)
@@ -112,8 +98,6 @@ def main(argv: list[str] | None = None) -> int:
     from .commands import _common
     _common.VERBOSITY = args.verbosity
     try:
-        if _uses_pybullet(args):
-            import_pybullet_quietly()
         code = int(modules[args.command].run(args) or 0)
         sys.stdout.flush()  # a closed pipe fails here, inside the handler below
         for note in getattr(args, "deprecation_notes", None) or ():
