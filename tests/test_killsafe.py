@@ -144,14 +144,24 @@ def test_resume_after_sigkill(tmp_path):
     assert _strip(out1) == _strip(out2)
 
 
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-def test_workers_die_with_their_parent(tmp_path):
-    cache = tmp_path / "c"
+def _start_busy_campaign(tmp_path: Path, cache: Path) -> subprocess.Popen:
+    """A two-worker campaign, returned once both workers exist and a run is stored."""
     proc = _start(["campaign", str(_study(tmp_path, '"6:16:2"')), "--workers", "2",
                    "--cache", str(cache), "--out", str(tmp_path / "o")])
     try:
         _wait_for(lambda: len(_children(proc.pid)) >= 2 and _runs(cache) >= 1
                   or proc.poll() is not None, "two busy workers")
+    except BaseException:
+        _cleanup(proc)
+        raise
+    return proc
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_workers_die_with_their_parent(tmp_path):
+    cache = tmp_path / "c"
+    proc = _start_busy_campaign(tmp_path, cache)
+    try:
         assert proc.poll() is None, "finished before it could be killed"
         os.kill(proc.pid, signal.SIGKILL)  # the parent only, as the OOM killer would
         proc.communicate(timeout=LIVENESS_S)
@@ -164,11 +174,8 @@ def test_workers_die_with_their_parent(tmp_path):
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_ctrl_c_cancels_promptly_with_one_line(tmp_path):
     cache = tmp_path / "c"
-    proc = _start(["campaign", str(_study(tmp_path, '"6:16:2"')), "--workers", "2",
-                   "--cache", str(cache), "--out", str(tmp_path / "o")])
+    proc = _start_busy_campaign(tmp_path, cache)
     try:
-        _wait_for(lambda: len(_children(proc.pid)) >= 2 and _runs(cache) >= 1
-                  or proc.poll() is not None, "two busy workers")
         assert proc.poll() is None, "finished before Ctrl-C"
         n_runs = _runs(cache)
         os.killpg(proc.pid, signal.SIGINT)  # what a terminal does on Ctrl-C
