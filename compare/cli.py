@@ -114,8 +114,9 @@ def main(argv: list[str] | None = None) -> int:
         os.close(devnull)
         return 1  # what Python itself does on EPIPE
     except KeyboardInterrupt:
-        print("interrupted: cancelled; finished runs are kept in the run store",
-              file=sys.stderr)
+        runs = sys.modules.get("compare.runs")
+        kept = "; finished runs are kept in the run store" if runs and runs.active() else ""
+        print(f"interrupted: cancelled{kept}", file=sys.stderr)
         return 130
     finally:
         # A command's run store and scheduler end with it (main() is also called
