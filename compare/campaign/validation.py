@@ -33,7 +33,8 @@ from compare.measure import trajectories as metrics
 from compare.run import runs
 from compare.measure.restitution import RestitutionResult, measure_restitution
 from compare.measure.reference_spectra import choose_frequencies, reference_spectrum
-from compare.measure.thresholds import engine_jump_frequency, engine_threshold
+from compare.measure.jump_shift import engine_jump_frequency
+from compare.measure.thresholds import engine_threshold
 
 __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
            "free_rocking_restitution"]
