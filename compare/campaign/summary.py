@@ -71,13 +71,15 @@ class Probe:
     perturbation: str = ""
     cpu_s: float | None = None
     from_store: bool = False
+    sim_s: float | None = None
 
     @classmethod
     def from_dict(cls, d) -> "Probe":
         if isinstance(d, (list, tuple)):  # schema 2: [amplitude, status, mode]
             return cls(num(d[0]), d[1], d[2] if len(d) > 2 else None)
         return cls(num(d.get("amplitude")), d.get("status", ""), d.get("mode"),
-                   d.get("perturbation", ""), num(d.get("cpu_s")), bool(d.get("from_store")))
+                   d.get("perturbation", ""), num(d.get("cpu_s")), bool(d.get("from_store")),
+                   num(d.get("sim_s")))
 
 
 @dataclass(frozen=True)
@@ -134,7 +136,8 @@ class ThresholdResult:
     ``rel_error`` is ``(a_engine - a_reference)/a_reference``, known to
     ``rel_resolution`` (``(a_engine - a_survives)/a_reference``).  ``valid`` is
     None when the model was not checked.  ``cpu_s`` sums the CPU seconds of
-    every probe when it was computed; ``cpu_s_spent`` what this campaign spent
+    every probe (and cause reruns) when it was computed, ``cpu_per_sim_s`` is
+    the search's CPU seconds per simulated second; ``cpu_s_spent`` what this campaign spent
     (0 for a point served whole by the store, then ``from_store`` is True).
     """
 
@@ -163,6 +166,7 @@ class ThresholdResult:
     from_store: bool = False
     rel_tol: float | None = None
     probes: tuple = ()  # Probe
+    cpu_per_sim_s: float | None = None
     raw: Mapping = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -185,7 +189,7 @@ class ThresholdResult:
                    _tuple(d.get("validity"), Validity), tuple(d.get("convergence") or ()),
                    int(d.get("n_runs") or 0), num(d.get("cpu_s")), num(d.get("cpu_s_spent")),
                    bool(d.get("from_store")), num(d.get("rel_tol")),
-                   _tuple(d.get("probes"), Probe), d)
+                   _tuple(d.get("probes"), Probe), num(d.get("cpu_per_sim_s")), d)
 
 
 @dataclass(frozen=True)

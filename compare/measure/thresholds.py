@@ -69,7 +69,8 @@ class Probe:
     ``perturbation`` is '' for a probe of the search, else a key of
     :data:`PERTURBATIONS`; ``cpu_s`` the CPU seconds the run cost when it was
     computed (NaN if the backend does not report it); ``from_store`` True when
-    the run store served it (then it cost nothing now).
+    the run store served it (then it cost nothing now); ``sim_s`` the simulated
+    time [s] (a verdict-only run stops when its verdict is certain).
     """
 
     amplitude: float
@@ -78,6 +79,7 @@ class Probe:
     perturbation: str = ""
     cpu_s: float = math.nan
     from_store: bool = False
+    sim_s: float = math.nan
 
     @property
     def overturned(self) -> bool:
@@ -101,7 +103,8 @@ def overturns(backend: str, scene, omega: float, amplitude: float, settings=None
     traj = runs.simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
     cpu = traj.diagnostics.get("cpu_time", math.nan)
     return Probe(float(amplitude), traj.verdict.status, traj.verdict.mode, "",
-                 float(cpu) if cpu is not None else math.nan, runs.STATS["hits"] > hits)
+                 float(cpu) if cpu is not None else math.nan, runs.STATS["hits"] > hits,
+                 float(traj.t[-1]) if len(traj.t) else 0.0)
 
 
 @dataclass(frozen=True)
@@ -185,11 +188,22 @@ class ThresholdPoint:
     def from_store(self) -> bool:
         return bool(self.probes) and all(p.from_store for p in self.probes)
 
+    @property
+    def sim_s(self) -> float:
+        """Simulated seconds of every probe."""
+        return math.fsum(p.sim_s for p in self.probes)
+
+    @property
+    def cpu_per_sim_s(self) -> float:
+        """Real-time factor: CPU seconds per simulated second (when computed)."""
+        return self.cpu_s / self.sim_s if self.sim_s > 0 else math.nan
+
     def to_dict(self) -> dict:
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out.update(provenance=self.provenance.to_dict(), rel_error=self.rel_error,
                    rel_resolution=self.rel_resolution, bracketed=self.bracketed,
                    collapsed_below=self.collapsed_below, from_store=self.from_store,
+                   sim_s=self.sim_s, cpu_per_sim_s=self.cpu_per_sim_s,
                    probes=[p.to_dict() for p in self.probes], isolated=list(self.isolated))
         return out
 
