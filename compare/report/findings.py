@@ -17,7 +17,7 @@ import json
 import sys
 from pathlib import Path
 
-from compare.report.trust import fmt_pct, label, trust_table
+from compare.report.trust import AGREEMENT_RULE, fmt_pct, label, trust_table
 
 __all__ = ["render", "update", "BEGIN", "END"]
 
@@ -38,6 +38,7 @@ def render(doc: dict) -> str:
              f"{prov.get('date', 'date unknown')}, commit `{prov.get('commit', 'unknown')[:12]}`): "
              f"{n_pass} of {n} verdicts pass.", ""]
     tol = doc["config"]["tolerances"]["threshold"]
+    lines += [f"Rule: {AGREEMENT_RULE}", ""]
     for engine, row in trust.items():
         lines.append(f"- {row['conclusion']}")
         failing = row["thresholds"]["failing"]
@@ -46,6 +47,7 @@ def render(doc: dict) -> str:
                 f"{'with' if p['case'] == 'pendulum' else 'without'} pendulum, "
                 f"Ω = {p['omega']:g} rad/s, A = {p['a_reference']:.4g} m/s²: "
                 + ("not bracketed" if p["rel_error"] is None else f"{100 * p['rel_error']:+.2g} %")
+                + (f" ({p['cause']})" if p.get("cause") else "")
                 for p in failing)
             lines.append(f"  {label(engine)} thresholds outside {fmt_pct(tol)}: {pts}.")
     shifts = [(case, name, j) for case, spec in doc.get("spectra", {}).items()

@@ -13,7 +13,8 @@ __all__ = ["HEADERS", "table", "error_rows", "history_rows", "jump_rows", "prove
            "restitution_rows", "threshold_rows", "timing_rows", "trust_rows", "verdict_rows"]
 
 _JOBS = {"threshold": "overturning thresholds (bisections)", "history": "time histories A-D",
-         "restitution": "free-rocking restitution", "jump": "mode-jump frequency"}
+         "restitution": "free-rocking restitution", "jump": "mode-jump frequency",
+         "long_run": "long runs (fixed window)"}
 _TIMINGS = {"reference_spectra": "reference spectra (analytic model, both curves)",
             "engine_runs_wall": "all jobs, wall time (parallel)",
             "total": "whole campaign, wall time"}
@@ -130,12 +131,12 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     def cost(row, key):
         c = row["cost"]
         if key == "run":
-            return _cell(fmt_seconds(c["run_s"]))
-        if c["threshold_point_s"] is None:
+            return _cell(fmt_seconds(c["run_cpu_s"]) + " CPU")
+        if c["threshold_point_cpu_s"] is None:
             return _cell("not measured")
-        return _cell(f"{fmt_seconds(c['threshold_point_s'])} per point "
-                     f"({c['runs_per_point']:.2g} runs); ≈ {fmt_seconds(c['spectrum_s'])} for "
-                     f"{c['spectrum_frequencies']} frequencies")
+        return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per point "
+                     f"({c['runs_per_point']:.2g} runs); ≈ {fmt_seconds(c['spectrum_cpu_s'])} "
+                     f"for {c['spectrum_frequencies']} frequencies")
 
     def settings(row):
         return _cell(", ".join(f"{k} = {fmt_sci(v)}" if isinstance(v, float) else f"{k} = {v}"
@@ -182,7 +183,8 @@ def threshold_rows(doc: dict) -> list[list]:
                              _cell("n/a" if err is None else f"{100 * err:+.3g} %", ok),
                              f"{p['mode_reference']} / {p['mode_engine']}", str(p["n_runs"]),
                              p.get("cause") or "not measured",
-                             fmt_seconds(p.get("provenance", {}).get("wall_time"))])
+                             fmt_seconds(p.get("cpu_s")) + (" (store)" if p.get("from_store")
+                                                            else "")])
     return rows
 
 
@@ -226,12 +228,20 @@ def restitution_rows(doc: dict) -> list[list]:
 
 def timing_rows(doc: dict) -> list[list]:
     t = doc["timings"]
-    rows = [[_TIMINGS.get(k, k.replace("_", " ")), fmt_seconds(v)] for k, v in t.items()
-            if not isinstance(v, dict)]
+    counts = ("from_store", "n_jobs", "load_average")
+    rows = [[_TIMINGS.get(k, k.replace("_", " ")) + " (wall)", fmt_seconds(v)]
+            for k, v in t.items() if not isinstance(v, (dict, list)) and k not in counts]
+    if "n_jobs" in t:
+        rows.append(["jobs served by the run store", f"{t.get('from_store', 0)} of {t['n_jobs']}"])
+    if t.get("load_average"):
+        rows.append(["load average (1 min) at start, end",
+                     ", ".join(f"{x:.2g}" for x in t["load_average"])])
+    spent = t.get("spent_by_job", {})
     for key, v in t.get("cpu_by_job", {}).items():
         kind, _, name = key.partition(":")
-        rows.append([f"{_JOBS.get(kind, kind)}, {label(name)} (summed over runs)",
-                     fmt_seconds(v)])
+        now = f"; {fmt_seconds(spent[key])} spent now" if key in spent else ""
+        rows.append([f"{_JOBS.get(kind, kind)}, {label(name)} (CPU when computed)",
+                     fmt_seconds(v) + now])
     return rows
 
 
