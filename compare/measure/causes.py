@@ -134,7 +134,7 @@ def model_jump(scene, omega: float, kind: str, a_engine: float, tol: float) -> s
             else:
                 w1 = mid
         return (f"the model's overturning mode changes from {m0} to {m1} at Omega = "
-                f"{0.5 * (w0 + w1):.3g} rad/s (+/- {0.5 * (w1 - w0):.2g}; located on the model), "
+                f"{0.5 * (w0 + w1):.4g} rad/s (+/- {0.5 * (w1 - w0):.2g}; located on the model), "
                 f"within {100 * JUMP_REL:g} % of {omega:g}; its thresholds there span "
                 f"{min(levels):.4g}-{max(levels):.4g} m/s^2")
     return None
