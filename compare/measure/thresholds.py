@@ -171,10 +171,23 @@ class ThresholdPoint:
 
     @property
     def collapsed_below(self) -> bool:
-        """True when a run below ``a_engine`` ended 'collapsed': the engine's frame
-        broke before it overturned (the threshold is then that of a broken frame)."""
+        """True when a search run below ``a_engine`` ended 'collapsed': the engine's
+        frame broke before it overturned (the threshold is then that of a broken
+        frame).  Perturbed runs count in :attr:`flips` instead."""
         top = self.a_engine if self.bracketed else math.inf
-        return any(p.status == "collapsed" and p.amplitude < top for p in self.probes)
+        return any(p.status == "collapsed" and p.amplitude < top and not p.perturbation
+                   for p in self.probes)
+
+    @property
+    def flips(self) -> tuple:
+        """Perturbed runs of the final ends whose verdict differs from their end's:
+        not 'overturned' above ``a_engine``, not 'survived' below ``a_survives``
+        (e.g. PyBullet's frame collapsing after a 1e-6 rad tilt)."""
+        if not self.bracketed:
+            return ()
+        return tuple(p for p in self.probes if p.perturbation and (
+            (p.amplitude > self.a_engine and p.status != "overturned")
+            or (p.amplitude < self.a_survives and p.status != "survived")))
 
     @property
     def bracketed(self) -> bool:
@@ -210,6 +223,7 @@ class ThresholdPoint:
                    rel_resolution=self.rel_resolution, bracketed=self.bracketed,
                    collapsed_below=self.collapsed_below, from_store=self.from_store,
                    sim_s=self.sim_s, cpu_per_sim_s=self.cpu_per_sim_s,
+                   flips=[p.to_dict() for p in self.flips],
                    probes=[p.to_dict() for p in self.probes], isolated=list(self.isolated))
         return out
 
