@@ -25,7 +25,7 @@ from scenes import POINTS
 
 from compare.run.jsonable import plain as clean_nan
 from compare.measure.trajectories import _plain
-from compare.report.trust import trust_table
+from compare.report.trust import AGREEMENT_RULE, trust_table
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict", "SCHEMA_VERSION"]
 
@@ -61,6 +61,7 @@ def render_markdown(doc: dict) -> str:
     if doc.get("quick"):
         parts.append(f"**{_QUICK}**")
     parts += [f"{_headline(doc)}.", "## Which engine to trust", tables.table(header, rows, md=True),
+              AGREEMENT_RULE,
               *(f"- {r['conclusion']}" for r in doc["trust"].values()),
               "## Verdicts", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc), md=True),
               "## Overturning thresholds (away from mode jumps)",
@@ -116,6 +117,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
              "end.</p>",
              "<h2>Trust table</h2>", tables.table(header, rows),
+             f"<p class='small'>{esc(AGREEMENT_RULE)}</p>",
              *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> {esc(r['conclusion'])}</p>"
                for r in doc["trust"].values()),
              "<h2>Verdicts</h2>", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc)),
