@@ -128,7 +128,7 @@ def test_default_cache_dir(tmp_path):
 
 def test_not_a_store_is_a_clear_error(tmp_path):
     (tmp_path / "runs.sqlite").write_bytes(b"not sqlite" * 100)
-    with pytest.raises(ValueError, match="not a usable run store"):
+    with pytest.raises(ValueError, match="is not usable.*trilith cache clear"):
         RunStore(tmp_path)
     (tmp_path / "file").write_text("")
     with pytest.raises(ValueError, match="cannot create"):

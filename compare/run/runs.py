@@ -24,7 +24,8 @@ import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from compare.run.store import RunStore, digest, project_version, run_key, source_digest
+from compare.run.store import (CODE_SETS, RunStore, code_version, digest, project_version, run_code,
+                               run_key, source_digest)
 
 __all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
            "STATS", "stats_line"]
@@ -94,14 +95,14 @@ def simulate(name: str, scene, excitation, settings=None):
     t0 = time.perf_counter()
     traj = backend.simulate(scene, excitation, settings)
     store.put(key, traj, kind="run", label=_label(name, resolved),
-              cost=time.perf_counter() - t0)
+              cost=time.perf_counter() - t0, code=run_code(name))
     STATS["computed"] += 1
     return traj
 
 
-MODEL_CODE = ("analytic", "engines")
+MODEL_CODE = CODE_SETS[1]
 # Results computed by compare/ itself (campaign jobs, chosen frequencies).
-ALL_CODE = ("analytic", "engines", "compare")
+ALL_CODE = CODE_SETS[2]
 
 
 def memo_key(kind: str, description: dict, code: tuple = MODEL_CODE) -> str:
@@ -134,7 +135,8 @@ def memo(kind: str, description: dict, compute, label: str = "",
         return value
     t0 = time.perf_counter()
     value = compute()
-    store.put(key, value, kind=kind, label=label or kind, cost=time.perf_counter() - t0)
+    store.put(key, value, kind=kind, label=label or kind, cost=time.perf_counter() - t0,
+              code=code_version(code))
     STATS["computed"] += 1
     return value
 
