@@ -211,23 +211,43 @@ def resolve_workers(n: int, option: str = "--workers") -> int:
 
 
 def check_output_path(path: str | os.PathLike, option: str, *, directory: bool = False,
-                      suffixes: tuple[str, ...] | None = None) -> Path:
+                      replace: bool = False, suffixes: tuple[str, ...] | None = None) -> Path:
     """Check an output path before any work; returns it as a Path.
 
     A file (``directory=False``): not an existing directory nor a special file,
     its suffix in ``suffixes`` when given, and its parent directory must exist
     (refused otherwise: a typo should not create directories) and be writable.
     A directory (``directory=True``): not an existing file; created with its
-    parents when missing, then checked writable.  Writability is probed by
-    creating a temporary file, which also holds for root on read-only mounts.
+    parents when missing, then checked writable.  Files are written into it and
+    nothing else there is touched, unless ``replace``: then the directory is
+    replaced whole at the end, and refused now unless it is new, empty or one
+    this tool wrote (:func:`compare.run.atomic.check_replaceable`).
+    Writability is probed by creating a temporary file, which also holds for
+    root on read-only mounts; names too long for the temporary name beside
+    them are refused.
     """
+    from compare.run.atomic import check_name_length, check_replaceable
+
     text = os.fspath(path)
     if not text.strip():
         raise ValueError(f"{option}: empty path")
+    if "\0" in text:
+        raise ValueError(f"{option}: the path contains a NUL character")
     p = Path(text)
+    try:
+        return _check_output_path(p, text, option, directory, replace, suffixes,
+                                  check_name_length, check_replaceable)
+    except OSError as exc:  # a name too long, a loop of links, a permission
+        raise ValueError(f"{option} {text[:60]!r}: {exc.strerror or exc}") from None
+
+
+def _check_output_path(p, text, option, directory, replace, suffixes, check_name_length,
+                       check_replaceable) -> Path:
     if directory:
         if p.exists() and not p.is_dir():
             raise ValueError(f"{option} must be a directory, but {text!r} is a file")
+        if replace:
+            check_replaceable(p, option)
         try:
             p.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -241,6 +261,7 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
         raise ValueError(f"{option}: {text!r} is not a regular file (a FIFO or device)")
     if suffixes is not None and p.suffix.lower() not in suffixes:
         raise ValueError(f"{option} must end in {', '.join(suffixes)}, got {text!r}")
+    check_name_length(p, option, p.suffix)
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         what = "is not a directory" if parent.exists() else "does not exist"
@@ -289,7 +310,7 @@ def check_run_budget(engine: str, settings, excitation, option: str = "--t-max",
         unit = "steps" if getattr(settings, "dt", None) else "samples"
         raise ValueError(f"{option}: a {engine} run of {length:.4g} s at {dt:g} s is "
                          f"{steps:.3g} {unit}, over the budget of {MAX_RUN_STEPS:.0e} "
-                         f"(excitation {excitation.end_time:.4g} s); shorten the run")
+                         f"(excitation {excitation.end_time:.4g} s); shorten the run or use a larger step")
     return steps
 
 

@@ -36,7 +36,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--quick", action="store_true",
                    help="smaller grids (< 2 min on 2 cores) instead of the full campaign")
     p.add_argument("--out", default="report", metavar="DIR",
-                   help="output directory, created if missing")
+                   help="output directory, created if missing and replaced whole at the "
+                        "end; refused when it holds files this tool did not write")
     add_workers_arg(p)
     p.add_argument("--dt", type=float, default=None, metavar="S",
                    help=f"override every engine's time step [s], in [{DT_RANGE[0]:g}, "
@@ -59,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dt is not None and not (math.isfinite(args.dt)
                                     and DT_RANGE[0] <= args.dt <= DT_RANGE[1]):
         raise ValueError(f"--dt must be in [{DT_RANGE[0]:g}, {DT_RANGE[1]:g}] s, got {args.dt!r}")
-    out = check_output_path(args.out, "--out", directory=True)
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
 
     from compare.run import atomic
 
@@ -70,8 +71,6 @@ def run(args: argparse.Namespace) -> int:
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
-    if Path(args.out).is_file():
-        raise ValueError(f"--out must be a directory, got the file {args.out!r}")
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started
