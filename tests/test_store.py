@@ -192,12 +192,12 @@ def test_report_dir_is_swapped_whole(tmp_path):
         with atomic.report_dir(out) as d:
             (d / "index.html").write_text("new")
             raise RuntimeError
-    assert sorted(os.listdir(out)) == ["index.html", "stale.md"]
+    assert sorted(os.listdir(out)) == [atomic.MARKER, "index.html", "stale.md"]
     assert (out / "index.html").read_text() == "old"
     with atomic.report_dir(out) as d:
         (d / "index.html").write_text("new")
         (d / "summary.json").write_text("{}")
-    assert sorted(os.listdir(out)) == ["index.html", "summary.json"]  # nothing old mixed in
+    assert sorted(os.listdir(out)) == [atomic.MARKER, "index.html", "summary.json"]  # nothing old mixed in
     leftovers = [n for n in os.listdir(tmp_path) if n.startswith(".report.")]
     assert leftovers == []
 

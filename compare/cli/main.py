@@ -104,8 +104,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
 
 def _quiet_stdout() -> None:
     """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        fd = sys.stdout.fileno()
+    except (OSError, ValueError):  # an in-memory stream: nothing to flush at exit
+        return
     devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, sys.stdout.fileno())
+    os.dup2(devnull, fd)
     os.close(devnull)
 
 
@@ -115,8 +119,12 @@ def _stdout_open() -> bool:
     if sys.stdout is None:
         return False
     try:
-        os.fstat(sys.stdout.fileno())
-    except (OSError, ValueError):
+        fd = sys.stdout.fileno()
+    except (OSError, ValueError):  # an in-memory stream (tests, notebooks)
+        return True
+    try:
+        os.fstat(fd)
+    except OSError:
         return False
     return True
 
@@ -162,7 +170,9 @@ def main(argv: list[str] | None = None) -> int:
         # A command's run store and scheduler end with it (main() is also called
         # in-process, by tests and scripts).
         if "compare.run.runs" in sys.modules:
-            sys.modules["compare.run.runs"].activate(None)
+            store = sys.modules["compare.run.runs"].activate(None)
+            if store is not None:
+                store.close()
             sys.modules["compare.run.runs"].set_scheduler(None)
 
 

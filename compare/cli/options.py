@@ -221,7 +221,8 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
     parents when missing, then checked writable.  Files are written into it and
     nothing else there is touched, unless ``replace``: then the directory is
     replaced whole at the end, and refused now unless it is new, empty or one
-    this tool wrote (:func:`compare.run.atomic.check_replaceable`).
+    this tool wrote (:func:`compare.run.atomic.check_replaceable`); nothing is
+    created now, its nearest existing ancestor is checked writable.
     Writability is probed by creating a temporary file, which also holds for
     root on read-only mounts; names too long for the temporary name beside
     them are refused.
@@ -246,8 +247,13 @@ def _check_output_path(p, text, option, directory, replace, suffixes, check_name
     if directory:
         if p.exists() and not p.is_dir():
             raise ValueError(f"{option} must be a directory, but {text!r} is a file")
-        if replace:
+        if replace:  # built beside it and swapped in: create nothing now
             check_replaceable(p, option)
+            ancestor = next(a for a in (p.absolute(), *p.absolute().parents) if a.exists())
+            if not ancestor.is_dir():
+                raise ValueError(f"{option}: {str(ancestor)!r} is not a directory")
+            _probe_writable(ancestor, option, text)
+            return p
         try:
             p.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -381,6 +387,8 @@ def use_store(args: argparse.Namespace):
     if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
                                                         "ucx://")) and "://" in address):
         raise ValueError(f"--scheduler must be an address like tcp://host:8786, got {address!r}")
+    if address is not None:
+        runs.check_scheduler(address)  # an address with no scheduler: refused now
     runs.set_scheduler(address)
     runs.STATS.clear()
     store = None if getattr(args, "no_cache", False) else RunStore(

@@ -111,9 +111,12 @@ def atomic_path(path, suffix: str = ""):
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs are ordinary files
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.errno is not None:
+            # A writer's failure (a full disk) names the output, not its temporary name.
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
 
 

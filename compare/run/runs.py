@@ -28,7 +28,7 @@ from compare.run.store import (CODE_SETS, RunStore, code_version, digest, projec
                                run_key, source_digest)
 
 __all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
-           "STATS", "stats_line"]
+           "check_scheduler", "STATS", "stats_line"]
 
 _ACTIVE: RunStore | None = None
 # Default Dask scheduler of run_many (the CLI's --scheduler); None: local processes.
@@ -41,6 +41,13 @@ STATS: Counter = Counter()
 UNSTORED = frozenset({"analytic-fast"})
 # Polling period of the parent's wait: Ctrl-C is acted on within it.
 _POLL_S = 0.2
+# A Dask scheduler answers a handshake in milliseconds; 15 s covers a loaded
+# network.  Past it the address is reported as not being a scheduler.
+CONNECT_TIMEOUT_S = 15.0
+# How long a cluster may have no worker (none yet, or all gone) before the run is
+# stopped with an error: a worker starts in ~2-5 s, a batch system queue may
+# take longer, so a minute.
+NO_WORKERS_TIMEOUT_S = 60.0
 
 
 def activate(store: RunStore | None) -> RunStore | None:
@@ -257,17 +264,64 @@ def _run_local(payloads, workers: int, on_done):
                                                  return_when=FIRST_COMPLETED))
 
 
+def _connect(address: str):
+    """A Dask client of ``address``; ``ValueError`` when no scheduler answers within
+    :data:`CONNECT_TIMEOUT_S` (something else listening there can hold a
+    connection open without ever answering, so the wait is bounded here)."""
+    import threading
+
+    from distributed import Client
+
+    box: dict = {}
+
+    def connect():
+        try:
+            box["client"] = Client(address, timeout=f"{CONNECT_TIMEOUT_S:g}s")
+        except Exception as exc:  # noqa: BLE001 - reported below as one line
+            box["error"] = exc
+
+    thread = threading.Thread(target=connect, daemon=True)
+    thread.start()
+    thread.join(CONNECT_TIMEOUT_S + 5.0)
+    if "client" in box:
+        return box["client"]
+    why = (f"{type(box['error']).__name__}: {box['error']}" if "error" in box
+           else f"no answer within {CONNECT_TIMEOUT_S:g} s")
+    raise ValueError(f"--scheduler: no Dask scheduler at {address!r} ({why})")
+
+
+def check_scheduler(address: str) -> None:
+    """``ValueError`` unless a Dask scheduler answers at ``address`` (see :func:`_connect`)."""
+    _connect(address).close()
+
+
+class NoWorkers(ValueError):
+    """The cluster had no worker for :data:`NO_WORKERS_TIMEOUT_S`."""
+
+
 def _run_dask(payloads, address: str, on_done):
     try:
-        from distributed import Client, wait as dwait
+        from distributed import wait as dwait
     except ImportError:  # pragma: no cover - dask[distributed] is a dependency
         raise ValueError("--scheduler needs dask[distributed] installed") from None
-    try:
-        client = Client(address, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise ValueError(f"--scheduler: cannot reach a Dask scheduler at {address!r} "
-                         f"({exc})") from None
+    client = _connect(address)
     futures = []
+    # Since when the cluster has had no worker (None: it has some).
+    idle = {"since": None, "checked": 0.0}
+
+    def check_workers():
+        now = time.monotonic()
+        if now - idle["checked"] < 1.0:
+            return
+        idle["checked"] = now
+        if client.nthreads():
+            idle["since"] = None
+        elif idle["since"] is None:
+            idle["since"] = now
+        elif now - idle["since"] > NO_WORKERS_TIMEOUT_S:
+            raise NoWorkers(f"--scheduler {address!r}: the cluster has had no worker for "
+                            f"{NO_WORKERS_TIMEOUT_S:g} s; start some (dask worker "
+                            f"{address}) and rerun: finished runs are in the store")
     try:
         # pure=False: every payload is a task of its own (no deduplication by hash).
         futures = [client.submit(_call, p, pure=False, priority=-i)
@@ -282,9 +336,12 @@ def _run_dask(payloads, address: str, on_done):
 
         def poll_safe(pending):
             try:
-                return poll(pending)
+                done, pending = poll(pending)
             except TimeoutError:  # nothing finished within the poll period
-                return set(), pending
+                done = set()
+            if not done:
+                check_workers()
+            return done, pending
         yield from _ordered(futures, lambda f: f.result(), on_done, poll_safe)
     finally:
         if futures:

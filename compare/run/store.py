@@ -203,6 +203,14 @@ def run_key(backend: str, scene, excitation, settings) -> str:
 
 
 # -------------------------------------------------------------------------- store
+class _DiskFull(Exception):
+    """The filesystem under the store is full (reported once, never fatal)."""
+
+
+def _is_full(exc: sqlite3.DatabaseError) -> bool:
+    return getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL
+
+
 class RunStore:
     """A directory holding ``runs.sqlite``; safe to share between processes.
 
@@ -234,7 +242,10 @@ class RunStore:
         self._full_reported = False
         self._check_directory()
         if check_database and self.path.exists():
-            self._connect()  # validate now, before any work
+            try:
+                self._connect()  # validate now, before any work
+            except _DiskFull:
+                self._report_full()
 
     def __getstate__(self):  # a connection does not cross processes: reopen there
         return {"directory": self.directory}
@@ -289,6 +300,7 @@ class RunStore:
         elif not self.path.is_file():
             raise self._damaged("not a regular file")
         # A forked child must not touch its parent's connection: open its own.
+        conn = None
         try:
             conn = sqlite3.connect(self.path, timeout=BUSY_TIMEOUT_MS / 1000,
                                    isolation_level=None, check_same_thread=False)
@@ -305,17 +317,33 @@ class RunStore:
                 raise sqlite3.DatabaseError(f"its 'runs' table has the columns "
                                             f"{sorted(columns)}, not a run store's")
         except sqlite3.DatabaseError as exc:
+            if conn is not None:
+                conn.close()
+            if _is_full(exc):
+                raise _DiskFull from None
             raise self._damaged(exc) from None
         self._conn, self._pid = conn, os.getpid()
         return conn
 
+    def _report_full(self) -> None:
+        if not self._full_reported:
+            self._full_reported = True
+            print(f"warning: run store {self.directory}: the disk is full; results are "
+                  "computed but not stored", file=sys.stderr)
+
     def _query(self, sql: str, args=()) -> list:
-        conn = self._connect()
-        if conn is None:
-            return []
         try:
+            conn = self._connect()
+            if conn is None:
+                return []
             return conn.execute(sql, args).fetchall()
+        except _DiskFull:
+            self._report_full()
+            return []
         except sqlite3.DatabaseError as exc:
+            if _is_full(exc):
+                self._report_full()
+                return []
             raise self._damaged(exc) from None
 
     # ------------------------------------------------------------ values
@@ -338,8 +366,8 @@ class RunStore:
 
     def put_blob(self, key: str, blob: bytes, *, kind: str, label: str, cost: float,
                  code: str = "") -> None:
-        conn = self._connect(create=True)
         try:
+            conn = self._connect(create=True)
             conn.execute(
                 "INSERT INTO runs (key, kind, label, cost, created, value, code) "
                 "VALUES (?, ?, ?, ?, ?, ?, ?) ON CONFLICT(key) DO UPDATE SET "
@@ -347,15 +375,12 @@ class RunStore:
                 "created = excluded.created, value = excluded.value, code = excluded.code "
                 "WHERE substr(runs.value, 1, ?) != ?",
                 (key, kind, label, float(cost), time.time(), blob, code, len(MAGIC), MAGIC))
-        except sqlite3.OperationalError as exc:
-            if getattr(exc, "sqlite_errorcode", None) != sqlite3.SQLITE_FULL:
-                raise self._damaged(exc) from None
-            if not self._full_reported:
-                self._full_reported = True
-                print(f"warning: run store {self.directory}: the disk is full; results "
-                      "are computed but not stored", file=sys.stderr)
+        except _DiskFull:
+            self._report_full()
         except sqlite3.DatabaseError as exc:
-            raise self._damaged(exc) from None
+            if not _is_full(exc):
+                raise self._damaged(exc) from None
+            self._report_full()
 
     # ------------------------------------------------------------- figures
     def count(self, kind: str | None = None, since: float | None = None) -> int:
