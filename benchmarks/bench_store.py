@@ -28,9 +28,14 @@ ROOT = Path(__file__).resolve().parents[1]
 TARGET_SPEEDUP = 10.0  # issue 12: a warm rerun of report --quick at least 10x faster
 
 
+# What differs between two correct reports: what they cost, and when and how
+# they were run (the provenance holds the date and the command line).
+_NOT_RESULTS = ("timings", "wall_time", "provenance")
+
+
 def _strip(obj):
     if isinstance(obj, dict):
-        return {k: _strip(v) for k, v in obj.items() if k not in ("timings", "wall_time")}
+        return {k: _strip(v) for k, v in obj.items() if k not in _NOT_RESULTS}
     if isinstance(obj, list):
         return [_strip(v) for v in obj]
     return obj

@@ -224,3 +224,71 @@ def test_run_many_lookup_sends_only_missing_items(store):
     out = list(runs.run_many(fn, [1, 2, 3], workers=1, on_done=lambda i, r: seen.append(i),
                              lookup=lambda x: runs.lookup("demo", {"x": x})))
     assert out == [10, 20, 30] and calls == [3] and sorted(seen) == [0, 1, 2]
+
+
+# ------------------------------------------------------ the data-only value format
+def test_every_trajectory_field_round_trips_through_the_format(fig5):
+    """A record-driven pymunk run (events, verdict, settings, diagnostics, scene and a
+    SampledRecord excitation) comes back field for field, bit for bit."""
+    from compare.run.codec import decode, encode
+
+    rec = SampledRecord(tuple(np.linspace(0.0, 1.0, 11)), (0.0, 30.0, -30.0, 30.0, -1e-300,
+                                                           -0.0, 5e-324, 2.0, 1.0, 0.5, 0.0))
+    traj = get_backend("pymunk").simulate(fig5, rec, _pymunk_settings(t_max=1.0))
+    assert traj.events and traj.diagnostics and traj.settings
+    back = decode(encode(traj))
+    assert_same_trajectory(traj, back)
+    assert back.theta.flags.writeable and back.excitation == rec
+
+
+def test_format_keeps_types_and_special_floats():
+    from compare.measure.thresholds import ThresholdPoint
+    from compare.measure.trajectories import Provenance
+    from compare.run.codec import decode, encode
+
+    prov_fields = {f.name: 0.5 if f.type in ("float", float) else None
+                   for f in dataclasses.fields(Provenance)}
+    prov = Provenance(**{**prov_fields, **{f.name: "x" for f in dataclasses.fields(Provenance)
+                                           if f.type in ("str", str)}})
+    value = {"nan": float("nan"), "inf": -float("inf"), "zero": -0.0, "tiny": 5e-324,
+             "tuple": (1, "a", None, True), "list": [np.float64(2.5), np.int32(-3)],
+             (1.5, "k"): np.arange(6, dtype=np.int16).reshape(2, 3)[:, ::2],
+             "complex": np.array([1 + 2j]), "big": 10 ** 40,
+             "point": ThresholdPoint(9.0, "sine", 8.0, float("nan"), 7.5, "no-impact", None,
+                                     6, 0, 4e-3, prov, ((7.5, "survived", None),))}
+    back = decode(encode(value))
+    assert same(value, back)
+    assert type(back["list"][1]) is np.int32 and back[(1.5, "k")].dtype == np.int16
+
+
+@pytest.mark.parametrize("value", [object(), {1, 2}, np.array(["a"], dtype=object),
+                                   b"bytes"])
+def test_format_refuses_what_is_not_data(value):
+    from compare.run.codec import encode
+    with pytest.raises(TypeError, match="store"):
+        encode(value)
+
+
+def test_format_reads_nothing_foreign():
+    """Decoding refuses (never runs, never imports outside the project) a pickle,
+    a class of another package, a non-dataclass of the project, a truncated value."""
+    import json
+    import struct
+
+    from compare.run.codec import MAGIC, ForeignValue, decode, encode
+
+    def blob(tree) -> bytes:
+        header = json.dumps(tree).encode()
+        return MAGIC + struct.pack("<Q", len(header)) + header
+
+    good = encode({"a": np.ones(3)})
+    for bad in (b"\x80\x05K\x01.",  # pickle.dumps(1)
+                blob({"~": "class", "cls": "os:system", "v": {}}),
+                blob({"~": "class", "cls": "compare.run.store:RunStore", "v": {}}),
+                blob({"~": "class", "cls": "analytic.nothing_here:X", "v": {}}),
+                blob({"~": "array", "dtype": "|O", "shape": [1], "at": 0, "n": 8}),
+                blob({"~": "array", "dtype": "<f8", "shape": [10], "at": 0, "n": 80}),
+                blob({"~": "eval", "v": "1"}),
+                good[:len(good) - 5], good[:10]):
+        with pytest.raises(ForeignValue):
+            decode(bad)

@@ -57,7 +57,8 @@ def encode(value) -> bytes:
             arr = np.asarray(v)
             if arr.dtype.kind not in _NUMERIC_KINDS:
                 raise TypeError(f"store: arrays of dtype {arr.dtype} are not data")
-            arr = np.ascontiguousarray(arr.astype(arr.dtype.newbyteorder("<"), copy=False))
+            # order="C" (not ascontiguousarray, which makes a 0-d array 1-d)
+            arr = np.asarray(arr, dtype=arr.dtype.newbyteorder("<"), order="C")
             raw = arr.tobytes()
             chunks.append(raw)
             node = {"~": "array", "dtype": arr.dtype.str, "shape": list(arr.shape),
