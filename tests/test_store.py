@@ -15,7 +15,8 @@ import pytest
 from analytic.excitation import Pulse, SampledRecord, Still
 from compare.run import atomic
 from compare.run import runs
-from compare.run.store import RunStore, default_cache_dir, run_key
+from compare.run.keys import run_key
+from compare.run.store import RunStore, default_cache_dir
 from engines import get_backend
 
 # Short pymunk run (0.3 s of simulated time at 5e-4 s steps): milliseconds.

@@ -180,7 +180,7 @@ def run_reference(job: tuple) -> tuple[float, str | None]:
     from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
     from compare.run import runs
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
 
     name, case, pulse, omega = job
     scene, ss = _scene(name, case), SpectrumSettings(pulse=pulse)
@@ -214,7 +214,7 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float):
 
 def threshold_description(job: tuple) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
-    from compare.run.store import _engine_version, scene_dict, settings_dict
+    from compare.run.keys import _engine_version, scene_dict, settings_dict
 
     n, c, p, w, a_ref, mode, e, dt, rb, rt = job
     scene = _scene(n, c)

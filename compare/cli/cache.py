@@ -35,7 +35,8 @@ def _mib(n: int) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.run.store import CODE_SETS, RunStore, code_version, default_cache_dir
+    from compare.run.keys import CODE_SETS, code_version
+    from compare.run.store import RunStore, default_cache_dir
 
     directory = args.cache if args.cache else default_cache_dir()
     store = RunStore(directory, check_database=args.action != "clear")

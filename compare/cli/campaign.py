@@ -136,7 +136,7 @@ def distinct(jobs: list) -> tuple[list, list[int]]:
     """The jobs with distinct store keys, and for each job the index of its
     distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
     the scene name is a label)."""
-    from compare.run.store import digest
+    from compare.run.keys import digest
     from compare.campaign.study import threshold_description
 
     seen: dict[str, int] = {}
@@ -166,7 +166,7 @@ def _bar(total: float):
 
 
 def _versions(study) -> dict:
-    from compare.run.store import _engine_version, project_version
+    from compare.run.keys import _engine_version, project_version
     return {"project": project_version(), "analytic-fast": _engine_version("analytic-fast"),
             **{e: _engine_version(e) for e in study.engines}}
 

@@ -51,6 +51,25 @@ def parse_engines(text: str) -> tuple[str, ...]:
     return parse_engine_list(text, ENGINES)
 
 
+def _check_budget(config) -> None:
+    """Refuse before any work an engine run over the run budget: the longest pulse
+    of the campaign (its lowest threshold frequency, or a labelled point's)."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+    from scenes import POINTS
+
+    from compare.cli.options import check_run_budget
+
+    omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
+    for name in config.engines:
+        settings = get_backend(name).Settings()
+        if config.engine_dt is not None:
+            settings = dataclasses.replace(settings, dt=config.engine_dt)
+        check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
+
+
 def run(args: argparse.Namespace) -> int:
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
@@ -71,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
+    _check_budget(config)
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started

@@ -76,7 +76,7 @@ def _map_fn(scene, settings, workers: int):
     """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
     through the store, on local processes or the ``--scheduler`` cluster."""
     from compare.run import runs
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
 
     description = {"scene": scene_dict(scene), "settings": settings.describe()}
 

@@ -24,8 +24,9 @@ import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from compare.run.store import (CODE_SETS, RunStore, code_version, digest, project_version, run_code,
-                               run_key, source_digest)
+from compare.run.keys import (CODE_SETS, code_version, digest, project_version, run_code, run_key,
+                              source_digest)
+from compare.run.store import RunStore
 
 __all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
            "check_scheduler", "STATS", "stats_line"]

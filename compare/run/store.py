@@ -1,11 +1,8 @@
 """The run store: every finished run kept in an embedded SQLite database.
 
 A result is stored under the SHA-256 of a canonical JSON of everything that
-determines it (:func:`run_key`): backend name and engine version, the scene's
-fields, the excitation (type and fields, sampled records sample by sample), the
-backend settings, the project's version and a digest of the model/engine source
-files (so an edited checkout never reuses results of older code).  The scene's
-``name`` is a label and is left out: the same trilith under two names is one run.
+determines it (:mod:`compare.run.keys`: backend and engine version, scene,
+excitation, settings, project version and a digest of the source files).
 
 The value is data, never code (:mod:`compare.run.codec`: a JSON header and raw
 little-endian arrays): a store shared on a cluster filesystem cannot make a reader
@@ -25,18 +22,13 @@ full disk under the store is reported once on stderr and the results are still
 returned, just not kept.
 
 Concurrency: WAL journal (readers never block the writer), every write one
-autocommitted ``INSERT OR IGNORE`` (a SIGKILL loses at most the transaction in
+autocommitted insert that keeps a readable existing value (a SIGKILL loses at most the transaction in
 flight; SQLite rolls it back on the next open), and ``busy_timeout`` so
 processes sharing a store wait for each other's lock instead of failing.
 """
 from __future__ import annotations
 
 import contextlib
-import dataclasses
-import functools
-import hashlib
-import json
-import math
 import os
 import stat
 import sqlite3
@@ -47,8 +39,7 @@ from pathlib import Path
 
 from compare.run.codec import MAGIC, ForeignValue, decode, encode
 
-__all__ = ["RunStore", "default_cache_dir", "run_key", "canonical_json", "digest",
-           "project_version", "code_version", "CODE_SETS", "DB_NAME"]
+__all__ = ["RunStore", "default_cache_dir", "DB_NAME"]
 
 DB_NAME = "runs.sqlite"
 # Waiting for another process's write lock: writes take ~1 ms, so 60 s means a
@@ -58,11 +49,6 @@ _SCHEMA = ("CREATE TABLE IF NOT EXISTS runs (key TEXT PRIMARY KEY, kind TEXT NOT
            "label TEXT NOT NULL, cost REAL NOT NULL, created REAL NOT NULL, "
            "value BLOB NOT NULL, code TEXT NOT NULL DEFAULT '')")
 _COLUMNS = {"key", "kind", "label", "cost", "created", "value", "code"}
-# The sets of source packages a key can depend on: the analytic backends
-# (analytic/), engine runs and model-side results (+ engines/), results computed
-# by compare/ itself (+ compare/).
-CODE_SETS = (("analytic",), ("analytic", "engines"), ("analytic", "engines", "compare"))
-_ROOT = Path(__file__).resolve().parents[2]
 
 
 def default_cache_dir(environ=None) -> Path:
@@ -99,107 +85,6 @@ def _not_creatable(path: Path) -> str | None:
                 return f"{str(p)!r} is not writable"
             return None
     return "no existing parent directory"
-
-
-# --------------------------------------------------------------------------- keys
-def _plain(value):
-    """JSON-ready form of dataclasses, numpy values, tuples (recursively)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {"__type__": type(value).__name__,
-                **{f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}}
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if hasattr(value, "tolist"):  # numpy arrays and scalars
-        return _plain(value.tolist())
-    if isinstance(value, float) and not math.isfinite(value):
-        return repr(value)  # 'nan', 'inf': JSON has no such numbers
-    return value
-
-
-def canonical_json(obj) -> str:
-    """Sorted keys, no spaces, floats by ``repr`` (shortest exact form)."""
-    return json.dumps(_plain(obj), sort_keys=True, separators=(",", ":"), allow_nan=False)
-
-
-def digest(obj) -> str:
-    """SHA-256 (hex) of :func:`canonical_json`."""
-    return hashlib.sha256(canonical_json(obj).encode()).hexdigest()
-
-
-@functools.lru_cache(maxsize=None)
-def project_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-    try:
-        return version("trilith-xval")
-    except PackageNotFoundError:  # a bare source checkout
-        return "unknown"
-
-
-@functools.lru_cache(maxsize=None)
-def source_digest(packages: tuple[str, ...]) -> str:
-    """SHA-256 over the ``*.py`` files of ``packages`` and their subpackages (paths
-    and bytes): ~1 ms once per process.  The project version alone would hand stale
-    results to an edited checkout."""
-    h = hashlib.sha256()
-    for pkg in packages:
-        for path in sorted((_ROOT / pkg).rglob("*.py")):
-            h.update(f"{path.relative_to(_ROOT).as_posix()}\0".encode())
-            h.update(path.read_bytes())
-    return h.hexdigest()
-
-
-def _code_packages(backend: str) -> tuple[str, ...]:
-    # The analytic backends depend on analytic/ only; engines also read analytic/.
-    return ("analytic",) if backend.startswith("analytic") else ("analytic", "engines")
-
-
-@functools.lru_cache(maxsize=None)
-def _engine_version(backend: str) -> str:
-    from engines import get_backend
-    module = get_backend(backend)
-    return module.version() if hasattr(module, "version") else "unknown"
-
-
-def settings_dict(settings) -> dict:
-    """A backend Settings as a plain dict (its ``describe()`` when it has one)."""
-    if hasattr(settings, "describe"):
-        return _plain(settings.describe())
-    return _plain(settings)
-
-
-def excitation_dict(excitation) -> dict:
-    """Type and every field (a SampledRecord's samples included, not its summary)."""
-    return {"type": type(excitation).__name__, **_plain(dataclasses.asdict(excitation))}
-
-
-def scene_dict(scene) -> dict:
-    """Every Scene field but ``name`` (a label: it does not change a run)."""
-    out = dataclasses.asdict(scene)
-    out.pop("name", None)
-    return out
-
-
-@functools.lru_cache(maxsize=None)
-def code_version(packages: tuple[str, ...]) -> str:
-    """``'<project version>+<source digest, 12 hex>'``: the code a stored row came from."""
-    return f"{project_version()}+{source_digest(tuple(packages))[:12]}"
-
-
-def run_code(backend: str) -> str:
-    """:func:`code_version` of a backend run's key."""
-    return code_version(_code_packages(backend))
-
-
-def run_key(backend: str, scene, excitation, settings) -> str:
-    """The store key of one backend run (``settings`` already resolved)."""
-    return digest({"kind": "run", "backend": backend, "engine": _engine_version(backend),
-                   "scene": scene_dict(scene), "excitation": excitation_dict(excitation),
-                   "settings": settings_dict(settings), "project": project_version(),
-                   "code": source_digest(_code_packages(backend))})
-
-
 
 
 # -------------------------------------------------------------------------- store
