@@ -77,6 +77,7 @@ def per_run_overhead() -> dict:
     key (canonical JSON + SHA-256), a missed lookup, the insert (encode + commit)
     on a miss; the lookup (select + decode) on a hit; against the run itself."""
     from analytic.excitation import Pulse
+    from compare.run.codec import decode, encode
     from compare.run.keys import run_key
     from compare.run.store import RunStore
     from engines import get_backend
@@ -109,10 +110,18 @@ def per_run_overhead() -> dict:
             t_hit = (time.perf_counter() - t0) / n + t_key
             size = len(store._connect().execute("SELECT value FROM runs LIMIT 1").fetchone()[0])
             store.close()
+        c0 = time.process_time()  # the value format alone, in CPU time
+        for _ in range(n):
+            blob = encode(traj)
+        c1 = time.process_time()
+        for _ in range(n):
+            decode(blob)
+        c2 = time.process_time()
         overhead = t_key + t_miss + t_put
         out[name] = {"run_ms": 1e3 * run, "miss_overhead_ms": 1e3 * overhead,
                      "miss_overhead_rel": overhead / run, "hit_ms": 1e3 * t_hit,
-                     "blob_kB": size / 1e3}
+                     "blob_kB": size / 1e3, "encode_cpu_ms": 1e3 * (c1 - c0) / n,
+                     "decode_cpu_ms": 1e3 * (c2 - c1) / n}
     return out
 
 
@@ -134,7 +143,8 @@ def main() -> int:
     for name, r in runs_.items():
         print(f"  {name}: run {r['run_ms']:.2f} ms; store work on a miss "
               f"{r['miss_overhead_ms']:.3f} ms ({100 * r['miss_overhead_rel']:.1f} % of the run),"
-              f" a hit {r['hit_ms']:.3f} ms; {r['blob_kB']:.0f} kB stored")
+              f" a hit {r['hit_ms']:.3f} ms; {r['blob_kB']:.0f} kB stored; encode "
+              f"{r['encode_cpu_ms']:.3f} ms, decode {r['decode_cpu_ms']:.3f} ms CPU")
     write("store", {"machine": machine(), "report_quick_s": {
         "no_cache": t_plain, "cold": t_cold, "warm": t_warm}, "report_quick_cpu_s": {
         "no_cache": c_plain, "cold": c_cold, "warm": c_warm}, "warm_cpu_speedup": speedup,

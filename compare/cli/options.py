@@ -250,9 +250,15 @@ def _check_output_path(p, text, option, directory, replace, suffixes, check_name
         if replace:  # built beside it and swapped in: create nothing now
             check_replaceable(p, option)
             ancestor = next(a for a in (p.absolute(), *p.absolute().parents) if a.exists())
-            if not ancestor.is_dir():
-                raise ValueError(f"{option}: {str(ancestor)!r} is not a directory")
-            _probe_writable(ancestor, option, text)
+            try:
+                if not ancestor.is_dir():
+                    raise NotADirectoryError(20, f"{str(ancestor)!r} is not a directory")
+                fd, probe = tempfile.mkstemp(prefix=".trilith-probe-", dir=ancestor)
+                os.close(fd)
+                os.unlink(probe)
+            except OSError as exc:
+                raise ValueError(f"{option}: cannot create directory {text!r} "
+                                 f"({exc.strerror or exc})") from None
             return p
         try:
             p.mkdir(parents=True, exist_ok=True)

@@ -41,6 +41,12 @@ MARKER = ".trilith-output"
 _TMP_EXTRA = len(".") + len(".tmp-") + 8
 
 
+# The exact file sets of report and campaign directories written before the
+# marker existed: replaced like marked ones (a folder of a user's holds other files).
+_UNMARKED_OUTPUTS = ({"index.html", "summary.json", "summary.md"},
+                     {"index.html", "campaign.json"})
+
+
 def check_name_length(path, option: str, suffix: str = "") -> None:
     """``ValueError`` when the temporary name next to ``path``
     (``.<name>.tmp-XXXXXXXX<suffix>``) is longer than the filesystem allows."""
@@ -60,8 +66,9 @@ def check_name_length(path, option: str, suffix: str = "") -> None:
 
 def check_replaceable(out, option: str = "--out") -> None:
     """``ValueError`` unless ``out`` may be replaced whole: missing, an empty
-    directory, or a directory holding :data:`MARKER`; never the working
-    directory or one of its ancestors, never a file."""
+    directory, a directory holding :data:`MARKER`, or one holding exactly the
+    files an earlier report or campaign wrote before the marker existed; never
+    the working directory or one of its ancestors, never a file."""
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"{option} must be a directory, got the file {str(out)!r}")
@@ -72,10 +79,11 @@ def check_replaceable(out, option: str = "--out") -> None:
     check_name_length(target, option)
     if out.is_dir() and not (out / MARKER).is_file():
         try:
-            empty = next(out.iterdir(), None) is None
+            names = {p.name for p in out.iterdir() if p.is_file() and not p.is_symlink()}
+            entries = sum(1 for _ in out.iterdir())
         except OSError as exc:
             raise ValueError(f"{option} {str(out)!r}: {exc.strerror or exc}") from None
-        if not empty:
+        if entries and not any(names == set(files) for files in _UNMARKED_OUTPUTS):
             raise ValueError(f"{option} {str(out)!r} holds files this tool did not write "
                              f"(no {MARKER} inside) and is not replaced; choose a new or "
                              "empty directory")

@@ -415,3 +415,14 @@ def test_a_cluster_without_workers_is_reported(monkeypatch):
                                   silence_logs=40) as cluster:
         with pytest.raises(runs.NoWorkers, match="no worker for 3 s"):
             list(runs.run_many(abs, [-1, -2], scheduler=cluster.scheduler_address))
+
+
+def test_a_report_from_before_the_marker_is_replaced_but_not_a_look_alike(tmp_path):
+    old = tmp_path / "old"
+    old.mkdir()
+    for name in ("index.html", "summary.json", "summary.md"):
+        (old / name).write_text("earlier report")
+    atomic.check_replaceable(old)  # exactly what an earlier report wrote
+    (old / "notes.txt").write_text("mine")
+    with pytest.raises(ValueError, match="did not write"):
+        atomic.check_replaceable(old)
