@@ -411,7 +411,7 @@ def test_scheduler_address_that_is_not_a_scheduler(monkeypatch, capsys, here):
 def test_a_cluster_without_workers_is_reported(monkeypatch):
     distributed = pytest.importorskip("distributed")
     monkeypatch.setattr(runs, "NO_WORKERS_TIMEOUT_S", 3.0)
-    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None,
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=":0",
                                   silence_logs=40) as cluster:
         with pytest.raises(runs.NoWorkers, match="no worker for 3 s"):
             list(runs.run_many(abs, [-1, -2], scheduler=cluster.scheduler_address))
