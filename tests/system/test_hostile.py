@@ -134,6 +134,9 @@ def test_record_with_bom_keeps_its_first_sample(here, capsys):
     (["spectrum", "--omega", "10", "--engine", "pymunk", "--dt", "1e-9"], "--dt: a pymunk run"),
     (["spectrum", "--omega", "0.1", "--engine", "pymunk", "--dt", "5e-5", "--convergence"],
      "--dt (with --convergence: dt/4)"),
+    (["report", "--quick", "--dt", "1e-5", "--out", "r"], "--dt: a pybullet run"),
+    (["calibrate", "--engine", "pymunk", "--dt", "1e-9"], "--dt: a pymunk run"),
+    (["calibrate", "--engine", "pymunk", "--dt", "-1"], "each step must be > 0 s"),
 ])
 def test_option_refused_in_one_line(argv, needle, here, capsys):
     before = snapshot(here)
