@@ -293,3 +293,10 @@ def test_format_reads_nothing_foreign():
                 good[:len(good) - 5], good[:10]):
         with pytest.raises(ForeignValue):
             decode(bad)
+
+
+def test_a_value_the_format_cannot_hold_is_not_stored_but_not_lost(tmp_path, capsys):
+    s = RunStore(tmp_path / "c")
+    s.put("k", {1, 2}, kind="demo", label="demo", cost=0.0)
+    assert s.get("k") is None and "'demo' result is not stored" in capsys.readouterr().err
+    s.close()

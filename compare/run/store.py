@@ -246,8 +246,16 @@ class RunStore:
     def put(self, key: str, value, *, kind: str, label: str, cost: float,
             code: str = "") -> None:
         """Store ``value`` unless ``key`` holds a readable value already (same key:
-        same result).  ``code``: the :func:`code_version` of the key."""
-        self.put_blob(key, encode(value), kind=kind, label=label, cost=cost, code=code)
+        same result).  ``code``: the :func:`~compare.run.keys.code_version` of the key.
+        A value the format cannot hold is not stored (one warning): the caller
+        still has its result."""
+        try:
+            blob = encode(value)
+        except TypeError as exc:
+            print(f"warning: run store: a {kind!r} result is not stored ({exc})",
+                  file=sys.stderr)
+            return
+        self.put_blob(key, blob, kind=kind, label=label, cost=cost, code=code)
 
     def put_blob(self, key: str, blob: bytes, *, kind: str, label: str, cost: float,
                  code: str = "") -> None:

@@ -331,6 +331,8 @@ def test_a_damaged_store_is_refused_in_one_line(tmp_path, capsys):
     db.write_bytes(bytes(data))
     refused(["spectrum", "--omega", "10", "--cache", str(tmp_path / "c")], capsys,
             "trilith cache clear")
+    assert main(["cache", "clear", "--cache", str(tmp_path / "c")]) == 0  # the cure works
+    assert not db.exists()
 
 
 def test_a_foreign_runs_table_is_refused(tmp_path, capsys):
