@@ -9,12 +9,17 @@ full or closed stdout).  A pipe whose reader went away
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import re
 import sys
 
 from compare.cli import COMMANDS
+
+
+# Errors of a write that found no room or no device.
+_WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 
 
 class UsageError(ValueError):
@@ -155,9 +160,12 @@ def main(argv: list[str] | None = None) -> int:
         _quiet_stdout()
         return 1  # what Python itself does on EPIPE
     except OSError as exc:  # an output that cannot be written: full disk, read-only
-        where = f"{exc.filename}: " if exc.filename else "standard output: "
-        if exc.filename is None:
-            _quiet_stdout()  # the failed write was stdout's (e.g. > /dev/full)
+        where = f"{exc.filename}: " if exc.filename else ""
+        if exc.filename is None and exc.errno in _WRITE_ERRORS:
+            # Every file output names itself (compare.run.atomic): a nameless write
+            # failure is stdout's (e.g. > /dev/full).
+            where = "standard output: "
+            _quiet_stdout()
         print(f"error: {where}{exc.strerror or exc}; nothing was left half-written",
               file=sys.stderr)
         return 2

@@ -20,6 +20,7 @@ from analytic.parameters import Scene
 from scenes import load_scene
 
 from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
+from compare.run.atomic import check_name_length, check_replaceable
 from compare.run.jsonable import plain
 
 SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel_height",
@@ -227,8 +228,6 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
     root on read-only mounts; names too long for the temporary name beside
     them are refused.
     """
-    from compare.run.atomic import check_name_length, check_replaceable
-
     text = os.fspath(path)
     if not text.strip():
         raise ValueError(f"{option}: empty path")
@@ -236,14 +235,13 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
         raise ValueError(f"{option}: the path contains a NUL character")
     p = Path(text)
     try:
-        return _check_output_path(p, text, option, directory, replace, suffixes,
-                                  check_name_length, check_replaceable)
+        return _check_output_path(p, text, option, directory, replace, suffixes)
     except OSError as exc:  # a name too long, a loop of links, a permission
         raise ValueError(f"{option} {text[:60]!r}: {exc.strerror or exc}") from None
 
 
-def _check_output_path(p, text, option, directory, replace, suffixes, check_name_length,
-                       check_replaceable) -> Path:
+def _check_output_path(p: Path, text: str, option: str, directory: bool, replace: bool,
+                       suffixes: tuple[str, ...] | None) -> Path:
     if directory:
         if p.exists() and not p.is_dir():
             raise ValueError(f"{option} must be a directory, but {text!r} is a file")
@@ -322,7 +320,8 @@ def check_run_budget(engine: str, settings, excitation, option: str = "--t-max",
         unit = "steps" if getattr(settings, "dt", None) else "samples"
         raise ValueError(f"{option}: a {engine} run of {length:.4g} s at {dt:g} s is "
                          f"{steps:.3g} {unit}, over the budget of {MAX_RUN_STEPS:.0e} "
-                         f"(excitation {excitation.end_time:.4g} s); shorten the run or use a larger step")
+                         f"(excitation {excitation.end_time:.4g} s); shorten the run or use a "
+                         "larger step")
     return steps
 
 

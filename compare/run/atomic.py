@@ -36,10 +36,9 @@ __all__ = ["write_text", "write_bytes", "savefig", "savetxt", "atomic_path",
 
 # The file that marks a directory as written (and replaceable) by this tool.
 MARKER = ".trilith-output"
-# Characters the temporary names add to an output's name: '.' + '.tmp-' + 8 random
-# (tempfile) + '.lock' is shorter; the suffix of a file comes on top.
+# Bytes a temporary name adds to an output's name: '.' + '.tmp-' + 8 random ones
+# (tempfile), and a file's suffix on top; the lock file's '.lock' adds fewer.
 _TMP_EXTRA = len(".") + len(".tmp-") + 8
-
 
 # The exact file sets of report and campaign directories written before the
 # marker existed: replaced like marked ones (a folder of a user's holds other files).
