@@ -154,8 +154,10 @@ def load_study(path) -> Study:
         raise ValueError(f"{where}: need 0 < rel_tol < rel_bracket < 0.5, got "
                          f"{rel_tol!r}, {rel_bracket!r}")
     workers = table.get("workers", Study.workers)
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"{where}: workers must be an integer >= 1, got {workers!r}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 256:
+        shown = repr(workers) if len(repr(workers)) <= 40 else f"a {type(workers).__name__}"
+        raise ValueError(f"{where}: campaign.workers must be an integer in [1, 256] (as "
+                         f"--workers), got {shown}")
     return Study(name=name, scenes=tuple(names),
                  engines=tuple(engines), pulses=tuple(pulses),
                  omegas=tuple(float(w) for w in np.asarray(omegas)), steps=tuple(steps),

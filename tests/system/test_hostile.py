@@ -97,6 +97,8 @@ CAMPAIGN_FILES = {
     "hidden": (CAMPAIGN + 'name = ".."\n', "campaign.name must be"),
     "tiny_step": (CAMPAIGN + "steps = [1e-9]\n", "campaign.steps: a pymunk run"),
     "no_table": ("x = 1\n", "a [campaign] table is needed"),
+    "huge_workers": (CAMPAIGN + "workers = " + "9" * 400 + "\n", "campaign.workers must be"),
+    "bool_workers": (CAMPAIGN + "workers = true\n", "campaign.workers must be"),
 }
 
 
