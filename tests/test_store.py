@@ -300,3 +300,23 @@ def test_a_value_the_format_cannot_hold_is_not_stored_but_not_lost(tmp_path, cap
     s.put("k", {1, 2}, kind="demo", label="demo", cost=0.0)
     assert s.get("k") is None and "'demo' result is not stored" in capsys.readouterr().err
     s.close()
+
+
+def test_a_store_of_pickles_is_read_as_empty_and_pruned(tmp_path):
+    """A store written before the data-only format (no code column, pickled values)
+    opens, is never unpickled, and ``prune`` removes its rows."""
+    import pickle
+    import sqlite3
+
+    d = tmp_path / "old"
+    d.mkdir(mode=0o700)
+    con = sqlite3.connect(d / "runs.sqlite")
+    con.execute("CREATE TABLE runs (key TEXT PRIMARY KEY, kind TEXT NOT NULL, label TEXT NOT "
+                "NULL, cost REAL NOT NULL, created REAL NOT NULL, value BLOB NOT NULL)")
+    con.execute("INSERT INTO runs VALUES ('k', 'demo', 'demo', 0, 0, ?)", (pickle.dumps(1.5),))
+    con.commit()
+    con.close()
+    s = RunStore(d)
+    assert s.get("k") is None and s.by_code() == [("foreign", 1, len(pickle.dumps(1.5)))]
+    assert s.prune(set()) == 1 and s.count() == 0
+    s.close()
