@@ -225,6 +225,8 @@ def run_many(fn, items, *, workers: int = 1, scheduler: str | None = None,
         return
     scheduler = _SCHEDULER if scheduler is None else scheduler
     store_dir = str(_ACTIVE.directory) if _ACTIVE is not None else None
+    if _ACTIVE is not None and (scheduler is not None or (workers > 1 and len(items) > 1)):
+        _ACTIVE.create()  # workers will store results: none of them creates the store
     payloads = [(fn, item, store_dir) for item in items]
     if scheduler is not None:
         yield from _run_dask(payloads, scheduler, on_done)

@@ -231,6 +231,14 @@ class RunStore:
                 return []
             raise self._damaged(exc) from None
 
+    def create(self) -> None:
+        """Create the directory and the database now: before several processes
+        write to it, so that they never race to create it."""
+        try:
+            self._connect(create=True)
+        except _DiskFull:
+            self._report_full()
+
     # ------------------------------------------------------------ values
     def get(self, key: str):
         """The stored value under ``key``, or None (also for a value this format
