@@ -108,7 +108,7 @@ def test_cause_contact_when_the_error_does_not_shrink(monkeypatch, fig5_ref):
         return ThresholdPoint(12.0, "sine", 20.0, a, a - 0.1, None, None, 5, 0, 5e-3, prov)
 
     monkeypatch.setattr(es, "_threshold", lambda *a, **k: point(19.0))
-    monkeypatch.setattr("analytic.reactions.check_model",
+    monkeypatch.setattr("analytic.bounds.check_model",
                         lambda *a, **k: {"valid": True, "reason": ""})
     monkeypatch.setattr(es, "_contact_detail", lambda *a, **k: "pivot_sliding_max = 1e-3")
     cause, detail, rows = es.classify("pymunk", scene, 12.0, point(19.0),
