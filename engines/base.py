@@ -280,7 +280,8 @@ class Engine:
         s = self.settings
         wall0 = time.perf_counter()
         monitor = RunMonitor(self.scene, self.excitation, s)
-        diagnostics = Diagnostics(self.scene, self.excitation, s.monitor)
+        # Kept on the run: an engine's own extra readings may consult the window.
+        self.diagnostics = diagnostics = Diagnostics(self.scene, self.excitation, s.monitor)
         try:
             self.build()
             while True:

@@ -22,7 +22,7 @@ from ._common import (add_engine_list_arg, add_workers_arg, check_output_path, d
                       format_quantity, parse_engine_list, resolve_workers)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
-# contacts creep, engines/pybullet_engine.py); above 1e-2 s the campaign refuses it.
+# contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
 DT_RANGE = (1e-5, 1e-2)
 
 from ._common import add_store_args, use_store

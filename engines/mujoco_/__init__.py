@@ -1,8 +1,9 @@
 """MuJoCo backend: the trilith as planar bodies with 3D box contacts, the
 pendulum as a hinged child body of the lintel (model built from the Scene in
-:mod:`engines.mujoco_scene`).
+:mod:`engines.mujoco_.world`).
 
-The hooks of :class:`engines.base.Engine`.  There is no ``render_frames``: MuJoCo's renderer needs an OpenGL context (EGL/OSMesa/GLFW),
+The hooks of :class:`engines.base.Engine`.  There is no ``render_frames``:
+MuJoCo's renderer needs an OpenGL context (EGL/OSMesa/GLFW),
 which a headless machine lacks; recordings draw MuJoCo runs in 2D from the
 Trajectory (``trilith record``), as for Pymunk.
 

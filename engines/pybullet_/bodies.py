@@ -81,7 +81,7 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
     calibration was measured with: sinking it too gave the same statistics
     (107 impacts, lam 3/5/7 x mu 0.5/1/2 x release 0.3/0.5/0.8 alpha: 5.6 % beyond
     0.5 % either way, median 0.039 % vs 0.034 %) but moved the column-step
-    outliers (see ``pybullet_engine.Settings``) onto other releases.  A tilted
+    outliers (see ``engines.pybullet_.Settings``) onto other releases.  A tilted
     start *under a pulse* still settles for ~4.5 ms at the pulse's start.
     """
     b, h, depth = scene.b, scene.h, scene.depth
