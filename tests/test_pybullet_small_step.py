@@ -17,7 +17,7 @@ import pytest
 
 import engines
 from analytic.excitation import Pulse
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 from engines.pybullet_ import world as ps
 from scenes import load_scene
 
