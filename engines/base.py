@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
+import dataclasses
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -111,6 +112,12 @@ class EngineSettings(RunOptions):
         if not isinstance(self.monitor, MonitorSettings):
             raise TypeError(f"{owner}: monitor must be a MonitorSettings, "
                             f"got {type(self.monitor).__name__}")
+
+    def with_solver_iterations(self, n: int) -> EngineSettings:
+        """These settings with ``n`` solver iterations per step (engines declaring
+        ``solver_iterations``; each names its own field, this is the one way to
+        set it)."""
+        return dataclasses.replace(self, solver_iterations=n)
 
 
 def run_steps(settings: EngineSettings, excitation) -> int:

@@ -13,6 +13,7 @@ import re
 import sys
 
 from compare.cli import COMMANDS
+from engines import engine_names
 
 
 class UsageError(ValueError):
@@ -72,8 +73,9 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     parser = argparse.ArgumentParser(
         prog="trilith", formatter_class=HelpFormatter,
-        description="Cross-validate PyBullet and Pymunk against the analytic rocking "
-                    "model of a trilith with a pendulum mass absorber.")
+        description=f"Cross-validate physics engines ({', '.join(engine_names())}) "
+                    "against the analytic rocking model of a trilith with a pendulum mass "
+                    "absorber.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     modules = {}

@@ -151,7 +151,7 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
         rows.append({"dt": finer.dt, "iterations": _iterations(finer), "a_engine": p.a_engine,
                      "rel_error": p.rel_error})
     if supports(engine, "solver_iterations"):
-        more = _with_iterations(engine, settings, 2 * _iterations(settings))
+        more = settings.with_solver_iterations(2 * _iterations(settings))
         p = _threshold(engine, scene, omega, point.a_reference, point.mode_reference, more,
                        kind, rel_tol)
         rows.append({"dt": more.dt, "iterations": _iterations(more), "a_engine": p.a_engine,
@@ -202,15 +202,6 @@ def _model_island(scene, omega, point, kind, n: int = 40) -> str | None:
 
 def _iterations(settings) -> int | None:
     return getattr(settings, "solver_iterations", None)
-
-
-def _with_iterations(engine, settings, n):
-    # Each engine names its own solver-iteration field; the contract exposes the value
-    # as the attribute solver_iterations (a field, or a property over 'iterations').
-    import dataclasses
-    names = {f.name for f in dataclasses.fields(settings)}
-    return configure(engine, settings,
-                     **{"solver_iterations" if "solver_iterations" in names else "iterations": n})
 
 
 # Noise levels of the engines' contact diagnostics while the model is valid

@@ -32,6 +32,7 @@ without gap makes contacts act at a distance).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import mujoco
@@ -145,6 +146,9 @@ class Settings(EngineSettings):
     def solver_iterations(self) -> int:
         """The contract's name for ``iterations`` (convergence studies double it)."""
         return self.iterations
+
+    def with_solver_iterations(self, n: int) -> Settings:
+        return dataclasses.replace(self, iterations=n)
 
     def __post_init__(self) -> None:
         super().__post_init__()
