@@ -21,7 +21,7 @@ from typing import ClassVar
 
 from analytic.bounds import required_friction
 from analytic.excitation import Pulse, SampledRecord, Still
-from analytic.options import RunOptions, check_real
+from analytic.options import MAX_RUN_STEPS, RunOptions, check_real
 from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
 
@@ -42,10 +42,6 @@ CAPABILITIES = {
     "trajectory": "simulate() samples theta(t) (every backend does)",
 }
 BASE_MOTIONS = ("gravity", "ground")
-# Largest run accepted: engine steps (length / dt).  5e6 steps is about 3 min of
-# PyBullet and 1 min of Pymunk on the reference machine (30 and 90 thousand
-# steps/s, README); the default runs need at most 1.3e6 (62.8 s pulse + 60 s).
-MAX_RUN_STEPS = 5_000_000
 # Default friction is at least this multiple of the no-sliding bound
 # (analytic.bounds.required_friction): 20 % headroom over a bound that is itself
 # conservative (it exceeded the exact demand along the analytic runs at A-D).
