@@ -78,12 +78,12 @@ class EngineSettings(RunOptions):
     monitor : MonitorSettings
         The shared stop and verdict thresholds.
     friction : float or None
-        Coulomb coefficient at every contact, in (0, 1000]; None: the engine's
-        calibrated default (each engine documents its own and how it combines
-        two bodies' values).  Never below
-        :func:`~analytic.bounds.required_friction` (rocking without sliding);
-        None follows the excitation: ``max(Engine.default_friction,
-        FRICTION_MARGIN * required_friction)``.
+        Coulomb coefficient at every contact, in (0, 1000] (each engine
+        documents how it combines two bodies' values).  None (default) follows
+        the excitation: ``max(Engine.default_friction, FRICTION_MARGIN *
+        required_friction)``, the calibrated value unless the pulse needs more.
+        A value given is refused below :func:`~analytic.bounds.required_friction`
+        (rocking without sliding).
     """
 
     dt: float = 1e-4
