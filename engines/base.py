@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 import dataclasses
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -136,8 +136,9 @@ class Engine:
     * Declare ``name`` (the registry name), ``label``, ``color``, ``marker``
       (display), ``capabilities`` (keys of :data:`CAPABILITIES`, never probed at
       run time), ``known_failures`` (check name -> measured reason, see
-      :mod:`engines.testing`), ``default_friction`` (the calibrated Coulomb
-      coefficient) and ``Settings``: a frozen dataclass derived from
+      :mod:`engines.testing`), ``calibration_space`` (Settings field -> values
+      ``trilith calibrate`` searches besides ``dt``; optional), ``default_friction``
+      (the calibrated Coulomb coefficient) and ``Settings``: a frozen dataclass derived from
       :class:`EngineSettings` whose defaults are the calibrated values, each
       documented with its measurement.  Implement :meth:`version`.
     * :meth:`build` creates a fresh world (nothing shared between runs) from
@@ -182,6 +183,7 @@ class Engine:
     marker: ClassVar[str]
     capabilities: ClassVar[frozenset[str]]
     known_failures: ClassVar[Mapping[str, str]] = {}
+    calibration_space: ClassVar[Mapping[str, Sequence]] = {}
     default_friction: ClassVar[float]
     Settings: ClassVar[type[EngineSettings]]
 
