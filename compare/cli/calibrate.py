@@ -13,7 +13,7 @@ from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg,
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     from compare.campaign.calibrate import DT_FACTORS, METRICS
-    from engines import ENGINES
+    from engines import engine_names
     parser = subparsers.add_parser(
         "calibrate",
         help="the cheapest engine settings meeting a tolerance on a validation set: "
@@ -24,7 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "measure each one's CPU time with the run store bypassed, and recommend "
                     "the cheapest within the tolerance.")
     parser.add_argument("--engine", required=True, metavar="NAME",
-                        help=f"the engine to calibrate: {', '.join(ENGINES)}")
+                        help=f"the engine to calibrate: {', '.join(engine_names())}")
     add_scene_args(parser)
     parser.add_argument("--metric", choices=METRICS, default="thresholds",
                         help="what must agree (default: thresholds)")

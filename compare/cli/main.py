@@ -16,6 +16,7 @@ import re
 import sys
 
 from compare.cli import COMMANDS
+from engines import engine_names
 
 
 # Errors of a write that found no room or no device.
@@ -90,8 +91,9 @@ class _TopParser(_OneLineErrors, argparse.ArgumentParser):
 def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     parser = _TopParser(
         prog="trilith", formatter_class=HelpFormatter,
-        description="Cross-validate PyBullet and Pymunk against the analytic rocking "
-                    "model of a trilith with a pendulum mass absorber.")
+        description=f"Cross-validate physics engines ({', '.join(engine_names())}) "
+                    "against the analytic rocking model of a trilith with a pendulum mass "
+                    "absorber.")
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     modules = {}

@@ -16,6 +16,7 @@ import tempfile
 from pathlib import Path
 
 from analytic.excitation import PULSE_KINDS, Pulse
+from analytic.options import MAX_RUN_STEPS
 from analytic.parameters import Scene
 from scenes import load_scene
 
@@ -28,11 +29,6 @@ SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel
 # Version of the --json documents (simulate, restitution, spectrum); bumped when a
 # key changes meaning or disappears.  1: inputs echoed, 'engine', 'timings' block.
 SCHEMA_VERSION = 1
-# Largest run a command accepts: engine steps (length / dt) or analytic output
-# samples (length / sample_dt).  5e6 steps is about 3 min of PyBullet and 1 min
-# of Pymunk on this machine (30 and 90 thousand steps/s, README), 200 MB of
-# analytic samples; the default runs need at most 1.3e6 (62.8 s pulse + 60 s).
-MAX_RUN_STEPS = 5_000_000
 # Formats matplotlib writes without extra packages (--plot).
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps",
                  ".webp")

@@ -15,14 +15,14 @@ import sys
 import time
 from pathlib import Path
 
-from engines import ENGINES
+from engines import engine_names
 from scenes import load_scene
 
 from compare.cli.options import (add_engine_list_arg, add_workers_arg, check_output_path, detail,
                       format_quantity, parse_engine_list, resolve_workers)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
-# contacts creep, engines/pybullet_engine.py); above 1e-2 s the campaign refuses it.
+# contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
 DT_RANGE = (1e-5, 1e-2)
 
 from compare.cli.options import add_store_args, use_store
@@ -32,7 +32,7 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser("report", help="run the validation campaign, write an HTML/JSON report",
                               description=__doc__)
     p.add_argument("--scene", default="fig5", help="scene name or TOML path")
-    add_engine_list_arg(p, ENGINES, ENGINES)
+    add_engine_list_arg(p, engine_names(), engine_names())
     p.add_argument("--quick", action="store_true",
                    help="smaller grids (< 2 min on 2 cores) instead of the full campaign")
     p.add_argument("--out", default="report", metavar="DIR",
@@ -48,7 +48,7 @@ def add_parser(subparsers) -> None:
 
 
 def parse_engines(text: str) -> tuple[str, ...]:
-    return parse_engine_list(text, ENGINES)
+    return parse_engine_list(text, engine_names())
 
 
 def _check_budget(config) -> None:

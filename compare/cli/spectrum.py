@@ -5,6 +5,8 @@ import argparse
 import math
 import sys
 
+from engines import engine_names
+
 from compare.cli import options as _common
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
                       add_workers_arg, check_output_path, clean_nan, envelope, info,
@@ -42,7 +44,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="fixed run length [s] (default: exact survival rules)")
     parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
                         help="analytic (the model's spectrum), or engines to bisect on the same "
-                             "grid around it: pybullet, pymunk, mujoco, or all")
+                             f"grid around it: {', '.join(engine_names())}, or all")
     parser.add_argument("--dt", type=float, default=None, metavar="S",
                         help="engine time step [s], in (0, 0.01] (default: each engine's "
                              "calibrated step)")

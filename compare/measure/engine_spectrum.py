@@ -95,15 +95,17 @@ def _threshold(engine, scene, omega, a_ref, mode_ref, settings, kind, rel_tol) -
 def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "sine",
                    **options):
     """The engine's settings (``options`` applied, :func:`engines.configure`) with a
-    fixed friction raised to 1.2x the no-sliding bound of the largest pulse a bracket
-    may try (20 % above it, as the calibrated defaults keep; a friction of None is the
-    engine's own default for each run).  The campaign and the spectra both use it."""
+    fixed friction raised to :data:`engines.base.FRICTION_MARGIN` times the no-sliding
+    bound of the largest pulse a bracket may try (a friction of None is the engine's
+    own default for each run, which follows the same rule).  The campaign and the
+    spectra both use it."""
+    from analytic.bounds import required_friction
     from analytic.excitation import Pulse
-    from engines._common import required_friction
+    from engines.base import FRICTION_MARGIN
     settings = configure(engine, **options)
-    need = required_friction(scene, Pulse(a_max, omega, kind))
-    if settings.friction is not None and settings.friction < 1.2 * need:
-        settings = configure(engine, settings, friction=1.2 * need)
+    need = FRICTION_MARGIN * required_friction(scene, Pulse(a_max, omega, kind))
+    if settings.friction is not None and settings.friction < need:
+        settings = configure(engine, settings, friction=need)
     return settings
 
 
@@ -113,7 +115,7 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
     """``(cause, detail, convergence rows)`` of a point that disagrees by more than
     ``tol`` (see the module docstring).  ``convergence`` False skips the reruns."""
     from analytic.excitation import Pulse
-    from analytic.reactions import check_model
+    from analytic.bounds import check_model
 
     # The model's own assumptions first: where they fail, no engine is to blame.  The
     # model predicts an overturn at its threshold and survival below it, so it is
@@ -149,7 +151,7 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
         rows.append({"dt": finer.dt, "iterations": _iterations(finer), "a_engine": p.a_engine,
                      "rel_error": p.rel_error})
     if supports(engine, "solver_iterations"):
-        more = _with_iterations(engine, settings, 2 * _iterations(settings))
+        more = settings.with_solver_iterations(2 * _iterations(settings))
         p = _threshold(engine, scene, omega, point.a_reference, point.mode_reference, more,
                        kind, rel_tol)
         rows.append({"dt": more.dt, "iterations": _iterations(more), "a_engine": p.a_engine,
@@ -200,15 +202,6 @@ def _model_island(scene, omega, point, kind, n: int = 40) -> str | None:
 
 def _iterations(settings) -> int | None:
     return getattr(settings, "solver_iterations", None)
-
-
-def _with_iterations(engine, settings, n):
-    # Each engine names its own solver-iteration field; the contract exposes the value
-    # as the attribute solver_iterations (a field, or a property over 'iterations').
-    import dataclasses
-    names = {f.name for f in dataclasses.fields(settings)}
-    return configure(engine, settings,
-                     **{"solver_iterations" if "solver_iterations" in names else "iterations": n})
 
 
 # Noise levels of the engines' contact diagnostics while the model is valid
