@@ -31,23 +31,21 @@ column tops under the lintel) is statically indeterminate in a rigid model.
 
 The other contact the model takes for granted, the lintel on the column tops,
 is computed alike in :mod:`analytic.contact_forces`; :func:`validity_diagnostics`
-reports both and :func:`check_model` is the single entry point that runs a
-pulse and names the first assumption that fails.
+reports both and :func:`analytic.bounds.check_model` is the single entry point that
+runs a pulse and names the first assumption that fails.
 """
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
 from . import equations as eq
 from .contact_forces import (lintel_extrema, lintel_force_from_accelerations, lintel_load,
-                             top_corner_acceleration, violations)
+                             top_corner_acceleration)
 
 __all__ = ["system_mass", "reaction_from_accelerations", "ground_reaction", "lintel_force",
-           "sample_sides", "reaction_history", "lintel_history", "validity_diagnostics",
-           "check_model"]
+           "sample_sides", "reaction_history", "lintel_history", "validity_diagnostics"]
 
 
 def system_mass(mu: float, gamma: float) -> float:
@@ -275,7 +273,7 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
         tops).  ``model_valid``: no pull at either contact
         (``min_vertical_reaction > 0`` and ``min_lintel_normal > 0``); the
         friction demands are left to the caller, who knows the coefficient
-        (:func:`~analytic.contact_forces.violations`, :func:`check_model`).
+        (:func:`~analytic.contact_forces.violations`, :func:`analytic.bounds.check_model`).
         ``ground_pull_time`` and ``lintel_pull_time`` [s]: first sample of the
         window with a normal force ``<= 0`` (None if none).  ``reaction_window_end`` [s],
         ``min_vertical_reaction_to_verdict``, ``max_friction_demand_to_verdict``,
@@ -318,58 +316,3 @@ def validity_diagnostics(t: np.ndarray, theta: np.ndarray, theta_dot: np.ndarray
     out["model_valid"] = bool(min_ry > 0.0 and (lintel["min_lintel_normal"] is None
                                                  or lintel["min_lintel_normal"] > 0.0))
     return out
-
-
-def check_model(scene, pulse, friction: float | None = None) -> dict:
-    """Does the analytic model hold for ``pulse``?  One accurate run
-    (:func:`analytic.simulate.simulate`, default Settings) and its contact checks.
-
-    Parameters
-    ----------
-    scene : Scene
-    pulse : Pulse or SampledRecord
-    friction : float, optional
-        An engine's Coulomb coefficient (> 0), compared against both friction
-        demands; None checks the normal forces only.
-
-    Returns
-    -------
-    dict
-        ``ground_min_normal`` (fraction of the total weight),
-        ``ground_max_friction``, ``lintel_min_normal`` (fraction of the lintel
-        and bob's weight), ``lintel_max_friction`` (None without lintel and
-        pendulum), ``valid`` (no pull at either contact and, if ``friction`` is
-        given, no demand above it), ``reason`` (the first of
-        :func:`~analytic.contact_forces.violations`, "" when valid),
-        ``violations`` (all of them), ``verdict`` (the run's status) and
-        ``friction``.  The window is the verdict's (:func:`validity_diagnostics`):
-        up to the last ``|theta| <= alpha`` of an overturning run, past which the
-        fall is beyond the model.
-
-    Examples
-    --------
-    >>> from analytic.excitation import Pulse
-    >>> from scenes import load_scene
-    >>> check_model(load_scene("fig5"), Pulse(64.0, 24.0))["reason"]  # doctest: +ELLIPSIS
-    'lintel normal force -0.26 of its weight (lintel + bob) at t = ...'
-    """
-    if friction is not None:
-        if isinstance(friction, bool) or not isinstance(friction, numbers.Real):
-            raise TypeError(f"friction must be a real number or None, "
-                            f"got {type(friction).__name__}")
-        if not (math.isfinite(friction) and friction > 0.0):
-            raise ValueError(f"friction must be finite and > 0, got {friction!r}")
-        friction = float(friction)
-    from .simulate import simulate  # simulate imports this module
-    tr = simulate(scene, pulse)
-    d = tr.diagnostics
-    if "model_valid" not in d:  # non-finite samples: nothing to judge
-        raise ValueError(f"the analytic run ended {tr.verdict.status!r} with non-finite "
-                         f"samples; its contact forces cannot be computed")
-    found = violations(d, friction)
-    return {"ground_min_normal": d["min_vertical_reaction"],
-            "ground_max_friction": d["max_friction_demand"],
-            "lintel_min_normal": d["min_lintel_normal"],
-            "lintel_max_friction": d["max_lintel_friction_demand"],
-            "valid": not found, "reason": found[0] if found else "",
-            "violations": found, "verdict": tr.verdict.status, "friction": friction}

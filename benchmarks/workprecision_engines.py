@@ -171,7 +171,7 @@ def _configs(name: str, quick: bool):
             yield f"{name} {key}", {key: v}
 
 
-def run_engines(quick: bool, engines=("pybullet", "pymunk"), log=print) -> list[Point]:
+def run_engines(quick: bool, engines=("pybullet", "pymunk", "mujoco"), log=print) -> list[Point]:
     ref = _Reference(quick)
     log(f"  analytic references: first impact at {ref.t_impact:.4f} s; threshold "
         f"A = {ref.a_thr:.6g} m/s^2 at Omega = {THR_CASE['omega']} rad/s ({THR_CASE['t_max']} s window)")

@@ -1,16 +1,14 @@
 """Backends behind one contract, selected by name (like scipy's ``solve_ivp`` methods).
 
-The contract is code, in :mod:`engines.base`: every backend module has ``NAME``,
-``CAPABILITIES``, a frozen ``Settings`` derived from
-:class:`analytic.options.RunOptions` (criterion, t_max, theta0, psi0,
-early_stop; engines add dt, base_motion, sample_every, monitor through
-:class:`engines.base.EngineSettings`), ``simulate(scene, excitation, settings)
--> Trajectory`` and ``version()``.  :func:`configure` is the one way to build a
-backend's settings; :func:`supports` reads its declared capabilities.
-
-Adding an engine is one module ``engines/<name>_engine.py`` and one line in
-:data:`BACKENDS` (and :data:`ENGINES`); see ``docs/adding-an-engine.md``.
-Modules are imported lazily, so the analytic model never imports an engine.
+A physics engine is a subclass of :class:`engines.base.Engine` (its rules are in
+that class's docstring), registered by one line in :data:`ENGINE_CLASSES` or, from
+a separately installed package, by an entry point of the group
+``trilith_xval.engines`` (``name = "package.module:Class"``).  The analytic model
+(``analytic``, ``analytic-fast``) is selectable the same way through small
+adapters (:mod:`engines.analytic_`); it never imports this package.  Everywhere
+else (help texts, reports, recordings, tests, benchmarks) the engine list comes
+from :func:`engine_names`, display metadata from the class (``label``, ``color``,
+``marker``).  Classes are imported only when a backend is asked for.
 
 Examples
 --------
@@ -29,78 +27,110 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-from types import ModuleType
+from functools import lru_cache
 
-__all__ = ["BACKENDS", "ENGINES", "get_backend", "simulate", "backend_names", "configure",
-           "supports", "engine_list"]
+__all__ = ["BACKENDS", "ENGINES", "ENGINE_CLASSES", "ENTRY_POINT_GROUP", "get_backend",
+           "simulate", "backend_names", "engine_names", "configure", "supports", "engine_list"]
 
-BACKENDS: dict[str, str] = {
-    "analytic": "analytic.simulate",
-    "analytic-fast": "analytic.fast",
-    "pybullet": "engines.pybullet_engine",
-    "pymunk": "engines.pymunk_engine",
-    "mujoco": "engines.mujoco_engine",
+# The physics engines under validation: name -> "module:Class".
+ENGINE_CLASSES: dict[str, str] = {
+    "pybullet": "engines.pybullet_:PyBulletEngine",
+    "pymunk": "engines.pymunk_:PymunkEngine",
+    "mujoco": "engines.mujoco_:MujocoEngine",
 }
+BACKENDS: dict[str, str] = {
+    "analytic": "engines.analytic_:Analytic",
+    "analytic-fast": "engines.analytic_:AnalyticFast",
+    **ENGINE_CLASSES,
+}
+ENGINES: tuple[str, ...] = tuple(ENGINE_CLASSES)
+ENTRY_POINT_GROUP = "trilith_xval.engines"
 
-# The physics engines proper (what the comparison layer validates).
-ENGINES: tuple[str, ...] = ("pybullet", "pymunk", "mujoco")
+
+@lru_cache(maxsize=None)
+def _installed() -> dict[str, str]:
+    """Engines registered by other installed packages (entry points)."""
+    from importlib.metadata import entry_points
+    return {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)
+            if ep.name not in BACKENDS}
+
+
+def engine_names() -> tuple[str, ...]:
+    """Every physics engine: the built-in ones, then those installed as entry points."""
+    return ENGINES + tuple(_installed())
 
 
 def backend_names() -> tuple[str, ...]:
     """Every registered backend name, analytic ones first."""
-    return tuple(BACKENDS)
+    return tuple(BACKENDS) + tuple(_installed())
 
 
-def get_backend(name: str) -> ModuleType:
-    """The backend module registered under ``name``; ``ValueError`` if unknown."""
-    if not isinstance(name, str) or name not in BACKENDS:
-        raise ValueError(f"unknown engine {name!r}; allowed: {', '.join(BACKENDS)}")
+def get_backend(name_or_class):
+    """The backend class registered under a name (or the class itself, checked);
+    ``ValueError`` if unknown or not importable in this checkout."""
+    from .base import Engine
+    if isinstance(name_or_class, type):
+        from .analytic_ import AnalyticBackend
+        if not issubclass(name_or_class, (Engine, AnalyticBackend)):
+            raise TypeError(f"engine: a class must subclass engines.base.Engine, "
+                            f"got {name_or_class.__name__}")
+        return name_or_class
+    target = BACKENDS.get(name_or_class) if isinstance(name_or_class, str) else None
+    if target is None and isinstance(name_or_class, str):
+        target = _installed().get(name_or_class)
+    if target is None:
+        raise ValueError(f"unknown engine {name_or_class!r}; allowed: "
+                         f"{', '.join(backend_names())}")
+    module_name, _, attr = target.partition(":")
     try:
-        return importlib.import_module(BACKENDS[name])
+        module = importlib.import_module(module_name)
     except ModuleNotFoundError as exc:
-        if exc.name and BACKENDS[name].startswith(exc.name):
-            raise ValueError(f"backend {name!r} is not available in this checkout "
-                             f"(module {BACKENDS[name]} is missing)") from None
+        if exc.name and module_name.startswith(exc.name):
+            raise ValueError(f"backend {name_or_class!r} is not available in this checkout "
+                             f"(module {module_name} is missing)") from None
         raise
+    return getattr(module, attr)
 
 
-def supports(name: str, capability: str) -> bool:
-    """Whether backend ``name`` declares ``capability`` (see ``engines.base.CAPABILITIES``)."""
+def supports(name, capability: str) -> bool:
+    """Whether backend ``name`` (or class) declares ``capability`` (see
+    ``engines.base.CAPABILITIES``)."""
     from .base import CAPABILITIES
     if capability not in CAPABILITIES:
         raise ValueError(f"unknown capability {capability!r}; allowed: {', '.join(CAPABILITIES)}")
-    return capability in get_backend(name).CAPABILITIES
+    return capability in get_backend(name).capabilities
 
 
 def engine_list(spec: str | list | tuple) -> tuple[str, ...]:
     """``'pybullet,pymunk'`` / ``'all'`` / a sequence -> engine names, checked
-    against :data:`ENGINES` (``ValueError`` naming the unknown one)."""
+    against :func:`engine_names` (``ValueError`` naming the unknown one)."""
+    known = engine_names()
     items = spec.split(",") if isinstance(spec, str) else list(spec)
     names = [str(x).strip() for x in items if str(x).strip()]
     if names == ["all"]:
-        return ENGINES
+        return known
     if not names:
-        raise ValueError(f"engine: name at least one of {', '.join(ENGINES)} (or 'all')")
+        raise ValueError(f"engine: name at least one of {', '.join(known)} (or 'all')")
     for n in names:
-        if n not in ENGINES:
-            raise ValueError(f"engine: unknown engine {n!r}; allowed: {', '.join(ENGINES)}, all")
+        if n not in known:
+            raise ValueError(f"engine: unknown engine {n!r}; allowed: {', '.join(known)}, all")
     return tuple(dict.fromkeys(names))
 
 
-def configure(name: str, settings=None, **options):
-    """Backend ``name``'s settings: its calibrated defaults (or ``settings``) with
+def configure(name_or_class, settings=None, **options):
+    """A backend's settings: its calibrated defaults (or ``settings``) with
     ``options`` replaced.
 
     Parameters
     ----------
-    name : str
+    name_or_class : str or Engine subclass
         A registered backend.
     settings : the backend's Settings, optional
         Start from these instead of the defaults.
     **options
         Field values.  ``criterion`` may be given as ``'topple'``/``'alpha'`` (the
         backend's topple angle is kept); ``monitor`` (engines) as a dict of
-        :class:`engines._common.MonitorSettings` fields to change.
+        :class:`engines.monitor.MonitorSettings` fields to change.
 
     Returns
     -------
@@ -112,11 +142,11 @@ def configure(name: str, settings=None, **options):
         Unknown backend, an option the backend does not have (naming its options),
         or a value out of range.
     """
-    backend = get_backend(name)
+    backend = get_backend(name_or_class)
+    name = backend.name
     base = settings if settings is not None else backend.Settings()
     if not isinstance(base, backend.Settings):
-        raise TypeError(f"settings must be a {backend.__name__}.Settings, "
-                        f"got {type(base).__name__}")
+        raise TypeError(f"settings must be a {name} Settings, got {type(base).__name__}")
     known = {f.name for f in dataclasses.fields(base)}
     for key in options:
         if key not in known:
@@ -131,11 +161,11 @@ def configure(name: str, settings=None, **options):
     return dataclasses.replace(base, **options) if options else base
 
 
-def simulate(name: str, scene, excitation, settings=None, **options):
-    """Run ``scene`` under ``excitation`` in backend ``name``; returns a Trajectory.
+def simulate(name_or_class, scene, excitation, settings=None, **options):
+    """Run ``scene`` under ``excitation`` in a backend; returns a Trajectory.
 
     ``options`` are applied to ``settings`` (or the defaults) by :func:`configure`.
     """
     if options:
-        settings = configure(name, settings, **options)
-    return get_backend(name).simulate(scene, excitation, settings)
+        settings = configure(name_or_class, settings, **options)
+    return get_backend(name_or_class).simulate(scene, excitation, settings)

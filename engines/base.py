@@ -1,34 +1,37 @@
-"""The backend contract, written once (in the spirit of scipy's ``OdeSolver`` base).
+"""The engine contract, written once (in the spirit of scipy's ``OdeSolver``).
 
-A *backend* is a module registered in :data:`engines.BACKENDS` that satisfies
-:class:`Backend`: a ``NAME``, a frozen ``Settings`` dataclass derived from
-:class:`analytic.options.RunOptions` (engines: from :class:`EngineSettings`),
-``simulate(scene, excitation, settings) -> Trajectory``, ``version()`` and the set
-``CAPABILITIES`` of optional features it declares (never probed at run time).
-
-An *engine* adapter is the same short loop for every engine,
-:func:`simulate_world`: build a :class:`World` (the engine's bodies from the
-:class:`~analytic.parameters.Scene`), then alternately ``advance`` it by
-``sample_every`` steps and ``sample`` its state into the shared
-:class:`~engines._common.RunMonitor`, which decides when the verdict is certain.
-A new engine is one module (its ``Settings``, ``World`` and ``version``) and one
-line in :data:`engines.BACKENDS`; see ``docs/adding-an-engine.md``.
+An engine is a subclass of :class:`Engine`: one run is one instance.  The base
+class validates everything before any work (types, the scene, friction, the run
+budget), owns the run loop (:meth:`Engine.run`: build, then read / judge /
+advance until the verdict is decided, close, finish) and the shared rules (the
+monitor of :mod:`engines.monitor`, the diagnostics of :mod:`engines.diagnostics`,
+the geometry of :mod:`engines.geometry`).  An engine fills four hooks
+(:meth:`~Engine.build`, :meth:`~Engine.advance`, :meth:`~Engine.read`,
+:meth:`~Engine.close`) and declares its settings, capabilities and display
+metadata.  The implementer's rules are in :class:`Engine`'s docstring.
 """
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Mapping, Sequence
+import dataclasses
 from dataclasses import dataclass, field
-from typing import Callable, Protocol, runtime_checkable
+from typing import ClassVar
 
-from analytic.options import RunOptions, check_real
+from analytic.bounds import required_friction
+from analytic.excitation import Pulse, SampledRecord, Still
+from analytic.options import MAX_RUN_STEPS, RunOptions, check_real
+from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
 
-from ._common import MonitorSettings, RunMonitor, required_friction
+from .diagnostics import Diagnostics, PlaneState
+from .monitor import MonitorSettings, RunMonitor
 
-__all__ = ["Backend", "World", "EngineSettings", "simulate_world", "check_run", "CAPABILITIES",
-           "BASE_MOTIONS"]
+__all__ = ["Engine", "EngineSettings", "CAPABILITIES", "BASE_MOTIONS", "MAX_RUN_STEPS",
+           "FRICTION_MARGIN", "run_steps"]
 
-# Optional features a backend may declare in its CAPABILITIES.
+# Optional features an engine declares in ``capabilities``.
 CAPABILITIES = {
     "time_step": "Settings has a fixed step 'dt' [s] (engines; convergence studies halve it)",
     "solver_iterations": "Settings has 'solver_iterations' (convergence studies double it)",
@@ -39,39 +42,11 @@ CAPABILITIES = {
     "trajectory": "simulate() samples theta(t) (every backend does)",
 }
 BASE_MOTIONS = ("gravity", "ground")
-
-
-@runtime_checkable
-class Backend(Protocol):
-    """What :func:`engines.get_backend` returns (a module, checked structurally)."""
-
-    NAME: str
-    Settings: type
-    CAPABILITIES: frozenset
-
-    def simulate(self, scene, excitation, settings=None) -> Trajectory: ...
-
-    def version(self) -> str: ...
-
-
-class World(Protocol):
-    """One engine's bodies, built fresh for one run (nothing shared between runs).
-
-    ``sample()`` returns ``(theta_left, theta_right, theta_dot, psi, psi_dot,
-    problem)`` in the analytic model's signs (``theta > 0``: rocking on the left
-    corners; ``psi`` from the downward vertical, counter-clockwise) and updates the
-    contact diagnostics in ``diag``; ``problem`` names a blow-up (non-finite state,
-    a body flown away) or is None.
-    """
-
-    step_index: int
-    diag: dict
-
-    def advance(self, count: int) -> None: ...
-
-    def sample(self) -> tuple[float, float, float, float, float, str | None]: ...
-
-    def close(self) -> None: ...
+# Default friction is at least this multiple of the no-sliding bound
+# (analytic.bounds.required_friction): 20 % headroom over a bound that is itself
+# conservative (it exceeded the exact demand along the analytic runs at A-D).
+FRICTION_MARGIN = 1.2
+EXCITATIONS = (Pulse, SampledRecord, Still)
 
 
 @dataclass(frozen=True)
@@ -103,10 +78,12 @@ class EngineSettings(RunOptions):
     monitor : MonitorSettings
         The shared stop and verdict thresholds.
     friction : float or None
-        Coulomb coefficient at every contact, in (0, 1000]; None: the engine's
-        calibrated default (each engine documents its own and how it combines
-        two bodies' values).  Never below
-        :func:`~engines._common.required_friction` (rocking without sliding).
+        Coulomb coefficient at every contact, in (0, 1000] (each engine
+        documents how it combines two bodies' values).  None (default) follows
+        the excitation: ``max(Engine.default_friction, FRICTION_MARGIN *
+        required_friction)``, the calibrated value unless the pulse needs more.
+        A value given is refused below :func:`~analytic.bounds.required_friction`
+        (rocking without sliding).
     """
 
     dt: float = 1e-4
@@ -132,81 +109,205 @@ class EngineSettings(RunOptions):
             raise TypeError(f"{owner}: monitor must be a MonitorSettings, "
                             f"got {type(self.monitor).__name__}")
 
-    def check_friction(self, friction: float, scene, excitation) -> float:
-        """``friction`` if it is at least :func:`~engines._common.required_friction`
-        for rocking without sliding under ``excitation``, else ``ValueError``."""
-        need = required_friction(scene, excitation)
-        value = check_real(type(self).__name__, "friction", friction, 0.0, 1e3)
-        if value < need:
-            raise ValueError(f"{type(self).__name__}: friction must be >= {need:.4g} for rocking "
-                             f"without sliding in this scene and excitation (see "
-                             f"required_friction), got {friction!r}")
-        return value
+    def with_solver_iterations(self, n: int) -> EngineSettings:
+        """These settings with ``n`` solver iterations per step (engines declaring
+        ``solver_iterations``; each names its own field, this is the one way to
+        set it)."""
+        return dataclasses.replace(self, solver_iterations=n)
 
 
-def check_run(name: str, settings_cls: type, s, scene, excitation,
-              friction: float | None = None) -> float:
-    """The checks every engine makes before building anything, with the scene and
-    excitation at hand; returns the friction coefficient to use (``friction``, by
-    default ``s.friction``).
-
-    Raises ``TypeError`` for settings of another backend, ``ValueError`` for a
-    massless lintel carrying a pendulum (the analytic model allows it, a body
-    cannot), a tilt beyond ``alpha`` or friction below the no-sliding bound.
-    """
-    if not isinstance(s, settings_cls):
-        raise TypeError(f"{name} settings must be {settings_cls.__module__}.Settings, "
-                        f"got {type(s).__name__}")
-    if scene.mu == 0.0 and scene.has_pendulum:
-        raise ValueError(f"{name}: mu must be > 0 when gamma > 0 (a massless lintel, which the "
-                         "analytic model allows, cannot carry the pendulum hinge in an engine)")
-    s.check_scene(scene)
-    return s.check_friction(s.friction if friction is None else friction, scene, excitation)
+def run_steps(settings: EngineSettings, excitation) -> int:
+    """Most steps a run can take: its length (``t_max``, else the excitation's end
+    plus the monitor's ``t_cap``) over ``dt``, rounded up."""
+    length = (settings.t_max if settings.t_max is not None
+              else excitation.end_time + settings.monitor.t_cap)
+    return int(math.ceil(length / settings.dt))
 
 
-def simulate_world(name: str, make_world: Callable[[], World], scene, excitation,
-                   settings: EngineSettings, info: dict) -> Trajectory:
-    """The adapter loop every engine shares: build, then advance/sample until decided.
+class Engine:
+    """One run of one physics engine; subclass it to add an engine.
+
+    The base class checks the inputs, owns the run loop (:meth:`run`) and the
+    rules every engine is judged by; a subclass declares what it is and fills
+    four hooks.
+
+    Rules for implementers
+    ----------------------
+    * Declare ``name`` (the registry name), ``label``, ``color``, ``marker``
+      (display), ``capabilities`` (keys of :data:`CAPABILITIES`, never probed at
+      run time), ``known_failures`` (check name -> measured reason, see
+      :mod:`engines.testing`), ``calibration_space`` (Settings field -> values
+      ``trilith calibrate`` searches besides ``dt``; optional), ``default_friction``
+      (the calibrated Coulomb coefficient) and ``Settings``: a frozen dataclass derived from
+      :class:`EngineSettings` whose defaults are the calibrated values, each
+      documented with its measurement.  Implement :meth:`version`.
+    * :meth:`build` creates a fresh world (nothing shared between runs) from
+      :mod:`engines.geometry`: the rest poses at ``settings.theta0`` /
+      ``settings.psi0``, box inertias, the ground box; the column inertia is the
+      scene's ``J_G``; the pendulum bob collides with nothing; ``mu = 0`` builds
+      no lintel.  Every contact uses ``self.friction`` (combined so that the
+      pair sees exactly it) and is plastic.
+    * :meth:`advance` steps ``steps`` times.  Base motion ``'gravity'``: add
+      :meth:`base_load` of each step to gravity's x component (d'Alembert,
+      mid-step, zero after the pulse); ``'ground'`` (capability
+      ``moving_ground``): move a ground body by :meth:`ground_motion`.
+    * :meth:`read` returns the bodies in the analytic plane
+      (:class:`~engines.diagnostics.PlaneState`); it judges nothing.  Every
+      verdict, diagnostic and blow-up rule lives in :mod:`engines.monitor` and
+      :mod:`engines.diagnostics`, the same for every engine.
+    * :meth:`close` releases what :meth:`build` took; it is called once, also
+      after an error.
+    * The class is registered by one line in :data:`engines.ENGINES` (or an
+      entry point of the group ``trilith_xval.engines``) and must pass
+      :func:`engines.testing.check_backend`.
 
     Parameters
     ----------
-    name : str
-        The backend's registry name (``Trajectory.backend``).
-    make_world : callable
-        Builds the engine's :class:`World` (called once, timed with the run).
-    scene, excitation
-        What is simulated (the monitor judges the run with the analytic rules).
-    settings : EngineSettings
-        Validated settings (``dt``, ``sample_every``, the run options).
-    info : dict
-        The settings as the result should carry them (``describe()`` plus what
-        the engine resolved, e.g. the friction used and its version).
+    scene : Scene
+    excitation : Pulse, SampledRecord or Still
+    settings : Settings, optional
+        The engine's own ``Settings``; None: the calibrated defaults.
 
-    Returns
-    -------
-    Trajectory
-        Samples every ``sample_every`` steps, events, the verdict and the world's
-        diagnostics (plus ``steps``, ``wall_time`` and ``cpu_time``: this
-        process's CPU seconds for the run, which a load on the machine does not
-        inflate as it does the wall time).
+    Raises
+    ------
+    TypeError
+        A scene, excitation or settings of the wrong type.
+    ValueError
+        A tilt beyond ``alpha``, a massless lintel carrying a pendulum, a
+        friction below the no-sliding bound, or a run over :data:`MAX_RUN_STEPS`.
     """
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    monitor = RunMonitor(scene, excitation, settings)
-    world = make_world()
-    try:
-        while True:
-            t = world.step_index * settings.dt
-            *state, problem = world.sample()
-            if problem is not None:
-                monitor.mark_unstable(t, problem)
-                break
-            if monitor.record(t, *state) or monitor.check_frame(t, world.diag):
-                break
-            world.advance(settings.sample_every)
-        diagnostics = dict(world.diag, steps=world.step_index)
-    finally:
-        world.close()
-    wall = time.perf_counter() - wall0
-    diagnostics["wall_time"] = wall
-    diagnostics["cpu_time"] = time.process_time() - cpu0
-    return monitor.finish(name, info, diagnostics, wall)
+
+    name: ClassVar[str]
+    label: ClassVar[str]
+    color: ClassVar[str]
+    marker: ClassVar[str]
+    capabilities: ClassVar[frozenset[str]]
+    known_failures: ClassVar[Mapping[str, str]] = {}
+    calibration_space: ClassVar[Mapping[str, Sequence]] = {}
+    default_friction: ClassVar[float]
+    Settings: ClassVar[type[EngineSettings]]
+
+    @classmethod
+    def version(cls) -> str:
+        """The engine library's version string."""
+        raise NotImplementedError
+
+    @classmethod
+    def simulate(cls, scene, excitation, settings=None) -> Trajectory:
+        """Run ``scene`` under ``excitation``; returns a :class:`Trajectory`."""
+        return cls(scene, excitation, settings).run()
+
+    def __init__(self, scene, excitation, settings=None) -> None:
+        name = self.name
+        if not isinstance(scene, Scene):
+            raise TypeError(f"{name}: scene must be a Scene, got {type(scene).__name__}")
+        if not isinstance(excitation, EXCITATIONS):
+            raise TypeError(f"{name}: excitation must be a Pulse, SampledRecord or Still, "
+                            f"got {type(excitation).__name__}")
+        s = settings if settings is not None else self.Settings()
+        if not isinstance(s, self.Settings):
+            raise TypeError(f"{name} settings must be {type(self).__module__}.Settings, "
+                            f"got {type(s).__name__}")
+        if scene.mu == 0.0 and scene.has_pendulum:
+            raise ValueError(f"{name}: mu must be > 0 when gamma > 0 (a massless lintel, which "
+                             "the analytic model allows, cannot carry the pendulum hinge in an "
+                             "engine)")
+        s.check_scene(scene)
+        need = required_friction(scene, excitation)
+        if s.friction is None:
+            friction = max(self.default_friction, FRICTION_MARGIN * need)
+        else:
+            friction = check_real(type(s).__name__, "friction", s.friction, 0.0, 1e3)
+            if friction < need:
+                raise ValueError(f"{type(s).__name__}: friction must be >= {need:.4g} for "
+                                 f"rocking without sliding in this scene and excitation (see "
+                                 f"analytic.bounds.required_friction), got {s.friction!r}")
+        steps = run_steps(s, excitation)
+        if steps > MAX_RUN_STEPS:
+            raise ValueError(f"{name}: a run of {steps * s.dt:.4g} s (t_max, or the excitation's "
+                             f"end plus t_cap) at dt = {s.dt:g} s is {steps:.3g} steps, over the "
+                             f"budget of {MAX_RUN_STEPS:.0e}; raise dt or shorten t_max")
+        self.scene, self.excitation, self.settings = scene, excitation, s
+        self.friction = friction
+        self.required_friction = need
+        self.step_index = 0
+        dt = s.dt
+        # The d'Alembert load is evaluated mid-step; from this step on it is 0.
+        self._load_end = max(0, math.ceil(excitation.end_time / dt) + 1)
+
+    # ------------------------------------------------------------------ the hooks
+    def build(self) -> None:
+        """Create the world's bodies (see the implementer's rules)."""
+        raise NotImplementedError
+
+    def advance(self, steps: int) -> None:
+        """Step the world ``steps`` times (and add them to ``step_index``)."""
+        raise NotImplementedError
+
+    def read(self) -> PlaneState:
+        """The bodies' state now, in the analytic plane."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release what :meth:`build` took (called once, also after an error)."""
+
+    # ---------------------------------------------------------------- for hooks
+    def base_load(self, step: int) -> float:
+        """Horizontal d'Alembert acceleration [m/s^2] to add to gravity during step
+        ``step`` (from ``step dt`` to ``(step + 1) dt``): ``-xg_ddot`` at mid-step,
+        which makes the step's velocity change second-order accurate, and exactly
+        0 after the pulse."""
+        if step >= self._load_end:
+            return 0.0
+        return -self.excitation.acceleration((step + 0.5) * self.settings.dt)
+
+    def ground_motion(self, step: int) -> tuple[float, float]:
+        """``(x, v)`` of a moving ground at the start of step ``step``: its
+        displacement [m] and the mean velocity [m/s] over the step (so the
+        position follows the excitation exactly)."""
+        dt, displacement = self.settings.dt, self.excitation.displacement
+        x0, x1 = displacement(step * dt), displacement((step + 1) * dt)
+        return x0, (x1 - x0) / dt
+
+    def describe(self) -> dict:
+        """The settings as the result carries them, with the friction used and
+        the engine's version."""
+        info = self.settings.describe()
+        info["friction_used"] = self.friction
+        info["engine_version"] = self.version()
+        return info
+
+    # ------------------------------------------------------------------ the loop
+    def run(self) -> Trajectory:
+        """Build, then read / judge / advance every ``sample_every`` steps until the
+        monitor decides; close and return the :class:`Trajectory` (samples,
+        events, verdict, diagnostics, ``steps``, ``wall_time`` and ``cpu_time``:
+        this process's CPU seconds for the run, which a load on the machine does
+        not inflate as it does the wall time)."""
+        s = self.settings
+        wall0, cpu0 = time.perf_counter(), time.process_time()
+        monitor = RunMonitor(self.scene, self.excitation, s)
+        # Kept on the run: an engine's own extra readings may consult the window.
+        self.diagnostics = diagnostics = Diagnostics(self.scene, self.excitation, s.monitor)
+        try:
+            self.build()
+            while True:
+                t = self.step_index * s.dt
+                state = self.read()
+                problem = diagnostics.update(state)
+                left, right = state.columns
+                if problem is not None:
+                    monitor.mark_unstable(t, problem)
+                    break
+                if (monitor.record(t, left.angle, right.angle, 0.5 * (left.omega + right.omega),
+                                   state.psi, state.psi_dot)
+                        or monitor.check_frame(t, diagnostics.values)):
+                    break
+                self.advance(s.sample_every)
+        finally:
+            self.close()
+        wall = time.perf_counter() - wall0
+        diag = dict(diagnostics.values, steps=self.step_index, wall_time=wall,
+                    cpu_time=time.process_time() - cpu0,
+                    required_friction=self.required_friction)
+        return monitor.finish(self.name, self.describe(), diag, wall)

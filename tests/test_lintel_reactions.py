@@ -11,7 +11,8 @@ import pytest
 
 from analytic import equations as eq
 from analytic.excitation import Pulse
-from analytic.reactions import check_model, lintel_force, lintel_history
+from analytic.bounds import check_model
+from analytic.reactions import lintel_force, lintel_history
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
 from finite_differences import central_difference_force

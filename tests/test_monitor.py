@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from analytic import OverturnCriterion, Pulse, Scene
-from engines._common import RunMonitor
+from engines.monitor import RunMonitor
 from engines.base import EngineSettings
 
 

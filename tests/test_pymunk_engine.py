@@ -16,7 +16,9 @@ import pytest
 from analytic import equations as eq
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
-from engines import pymunk_engine as pe
+from analytic.bounds import required_friction
+from engines.pymunk_ import PymunkEngine, Settings
+from engines.pymunk_ import world as pw
 from compare.measure.restitution import measure_restitution
 
 # ---------------------------------------------------------------- restitution
@@ -43,7 +45,7 @@ def test_single_column_frame_mu0_matches_housner():
 def test_positive_pulse_rocks_on_left_corners_like_analytic(fig5, run_analytic):
     # Sign convention: xg_ddot > 0 pushes the trilith onto its left corners
     # (theta > 0, Eq. 9 with side = +1), in both backends.
-    tr = pe.simulate(fig5, Pulse(10.0, 9.0), pe.Settings(t_max=0.3))
+    tr = PymunkEngine.simulate(fig5, Pulse(10.0, 9.0), Settings(t_max=0.3))
     ref = run_analytic(fig5, 10.0, 9.0)
     assert ref.theta[np.argmax(np.abs(ref.theta) > 1e-3)] > 0
     assert tr.theta[np.argmax(np.abs(tr.theta) > 1e-3)] > 0
@@ -71,9 +73,9 @@ def test_bad_settings_raise_before_stepping(fig5, monkeypatch, changes, field):
     def boom(*args, **kwargs):
         raise AssertionError("a world was built before validation")
 
-    monkeypatch.setattr(pe, "World", boom)
+    monkeypatch.setattr(PymunkEngine, "build", boom)
     with pytest.raises((ValueError, TypeError), match=field):  # at construction or at the run
-        pe.simulate(fig5, Pulse(25.0, 11.0), dataclasses.replace(pe.Settings(), **changes))
+        PymunkEngine.simulate(fig5, Pulse(25.0, 11.0), dataclasses.replace(Settings(), **changes))
 
 
 def test_required_friction_bound(fig5):
@@ -81,36 +83,35 @@ def test_required_friction_bound(fig5):
     e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
     # Free rocking: the impact impulse ratio lam (1-e)/(1+e) or a_up/g, whichever is larger.
     a_up = eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g)
-    assert pe.required_friction(fig5, Still()) == pytest.approx(
+    assert required_friction(fig5, Still()) == pytest.approx(
         max(a_up / g, fig5.lam * (1 - e) / (1 + e)))
-    assert pe.required_friction(fig5, Pulse(-25.0, 11.0)) == pytest.approx(25.0 / g)
-    assert pe.Settings().friction >= pe.required_friction(fig5, Pulse(25.0, 11.0))
+    assert required_friction(fig5, Pulse(-25.0, 11.0)) == pytest.approx(25.0 / g)
+    assert PymunkEngine.default_friction >= required_friction(fig5, Pulse(25.0, 11.0))
 
 
 def test_mu0_with_pendulum_is_refused():
     with pytest.raises(ValueError, match="mu"):
-        pe.simulate(Scene(mu=0.0, gamma=0.3), Still(), pe.Settings(theta0=0.05))
+        PymunkEngine.simulate(Scene(mu=0.0, gamma=0.3), Still(), Settings(theta0=0.05))
 
 
 # --------------------------------------------------------------- instability
-class _Kicked(pe.World):
+class _Kicked(PymunkEngine):
     """Test hook: a world whose lintel is launched at 1e5 m/s (a blown-up solver)."""
 
-    def __init__(self, scene, s, excitation=None):
-        super().__init__(scene, s, excitation)
-        self.lintel.velocity = (1e5, 0.0)
+    def build(self):
+        super().build()
+        self.world.lintel.velocity = (1e5, 0.0)
 
 
-class _NaNWorld(pe.World):
-    def __init__(self, scene, s, excitation=None):
-        super().__init__(scene, s, excitation)
-        self.columns[0].angular_velocity = math.nan
+class _NaNWorld(PymunkEngine):
+    def build(self):
+        super().build()
+        self.world.columns[0].angular_velocity = math.nan
 
 
-@pytest.mark.parametrize("world, reason", [(_Kicked, "m/s"), (_NaNWorld, "non-finite")])
-def test_blow_up_gives_unstable_verdict(fig5, monkeypatch, world, reason):
-    monkeypatch.setattr(pe, "World", world)
-    tr = pe.simulate(fig5, Pulse(4.0, 9.0))
+@pytest.mark.parametrize("engine, reason", [(_Kicked, "m/s"), (_NaNWorld, "non-finite")])
+def test_blow_up_gives_unstable_verdict(fig5, engine, reason):
+    tr = engine.simulate(fig5, Pulse(4.0, 9.0))
     assert tr.verdict.status == "unstable"
     assert reason in tr.verdict.reason
     assert tr.events[-1].kind == "unstable"
@@ -121,8 +122,8 @@ def test_blow_up_gives_unstable_verdict(fig5, monkeypatch, world, reason):
 @pytest.mark.parametrize("theta0", [0.08, -0.08])
 def test_initial_geometry_and_conventions(fig5, theta0):
     psi0 = 0.3
-    s = pe.Settings(theta0=theta0, psi0=psi0)
-    w = pe._World(fig5, s)
+    s = Settings(theta0=theta0, psi0=psi0)
+    w = pw.build_space(fig5, s, 10.0)
     b, h, t_l = fig5.b, fig5.h, fig5.lintel_thickness
     for col, x_left in zip(w.columns, (0.0, b + fig5.d)):
         assert col.angle == theta0
@@ -148,10 +149,10 @@ def test_initial_geometry_and_conventions(fig5, theta0):
 
 
 def test_no_pendulum_body_when_gamma_zero_and_no_lintel_when_mu_zero(fig5):
-    w = pe._World(fig5.without_pendulum(), pe.Settings())
+    w = pw.build_space(fig5.without_pendulum(), Settings(), 10.0)
     dynamic = [bd for bd in w.space.bodies if bd.body_type == pymunk.Body.DYNAMIC]
     assert w.bob is None and len(dynamic) == 3
-    w0 = pe._World(fig5.replace(gamma=0.0, mu=0.0), pe.Settings())
+    w0 = pw.build_space(fig5.replace(gamma=0.0, mu=0.0), Settings(), 10.0)
     dynamic = [bd for bd in w0.space.bodies if bd.body_type == pymunk.Body.DYNAMIC]
     assert w0.lintel is None and len(dynamic) == 2
 
@@ -162,7 +163,7 @@ def test_friction_at_the_bound_prevents_sliding_while_rocking(fig5):
     # drift measured with friction 10 is 0.03 mm (contact compliance, not slip),
     # a Coulomb slip would run to millimetres within one pulse.
     pulse = Pulse(25.0, 11.0)
-    need = pe.required_friction(fig5, pulse)
-    tr = pe.simulate(fig5, pulse, pe.Settings(friction=need * 1.0001))
+    need = required_friction(fig5, pulse)
+    tr = PymunkEngine.simulate(fig5, pulse, Settings(friction=need * 1.0001))
     assert tr.verdict.status == "overturned"
     assert tr.diagnostics["pivot_sliding_max"] < 1e-4

@@ -50,7 +50,7 @@ def load_settings_file(path) -> dict[str, dict]:
         doc = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise ValueError(f"{where}: not TOML ({str(exc).splitlines()[0]})") from None
-    known = engines.ENGINES
+    known = engines.engine_names()
     out = {}
     for name, table in doc.items():
         if name not in known:

@@ -18,20 +18,21 @@ from compare.cli.options import (add_engine_list_arg, add_store_args, check_outp
                       parse_engine_list, use_store)
 
 ROOT = Path(__file__).resolve().parents[2]
-from engines import ENGINES  # every registered engine
+from engines import engine_names
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "bench", help="work-precision benchmarks: error vs wall time of every backend",
         description="Measure error against the analytic reference versus wall time: the "
-                    "analytic paths across tolerances, PyBullet and Pymunk across time "
-                    "steps and solver settings. Writes JSON, PNG plots and markdown tables.")
+                    "analytic paths across tolerances, every engine "
+                    f"({', '.join(engine_names())}) across time steps and solver settings. "
+                    "Writes JSON, PNG plots and markdown tables.")
     parser.add_argument("--quick", action="store_true",
                         help="the < 2 min variant (fewer points, coarser bisection)")
     parser.add_argument("--out", default=None, metavar="DIR",
                         help="output directory, created if missing (default: benchmarks/out)")
-    add_engine_list_arg(parser, ENGINES, ENGINES, none_ok=True)
+    add_engine_list_arg(parser, engine_names(), engine_names(), none_ok=True)
     parser.add_argument("--no-analytic", action="store_true",
                         help="skip the analytic paths")
     parser.add_argument("--strict", action="store_true",
@@ -59,7 +60,7 @@ def failed_defaults(bench, points) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    engines = parse_engine_list(args.engine, ENGINES, none_ok=True)  # before any heavy work
+    engines = parse_engine_list(args.engine, engine_names(), none_ok=True)  # before any heavy work
     if not engines and args.no_analytic:
         raise ValueError("--engine none with --no-analytic leaves nothing to measure")
     out = check_output_path(args.out, "--out", directory=True) if args.out is not None else None

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from engines import engine_names
+
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_workers_arg,
                       check_output_path, clean_nan, parse_omega_range, parse_range,
                       print_json, resolve_workers, scene_from_args)
@@ -27,8 +29,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--amplitude", default=DEFAULT_AMPLITUDE, metavar="A0:A1:dA",
                         help="amplitudes [m/s^2], A1 included")
     parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]",
-                        help="also map these engines (pybullet, pymunk, mujoco, or all), each "
-                             "on a coarser grid beside the analytic map")
+                        help=f"also map these engines ({', '.join(engine_names())}, or all), "
+                             "each on a coarser grid beside the analytic map")
     parser.add_argument("--engine-omega", default=None, metavar="START:STOP:STEP",
                         help=f"engine frequencies (default: {ENGINE_POINTS} of --omega)")
     parser.add_argument("--engine-amplitude", default=None, metavar="A0:A1:dA",

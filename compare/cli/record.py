@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import argparse
 
+from engines import backend_names
+
 from compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, FORMATS,
                            RecordSettings, check_output, default_duration, record,
                            resolve_engines)
@@ -15,8 +17,8 @@ def add_watch_args(parser: argparse.ArgumentParser) -> None:
     """Options shared by ``view`` and ``record``."""
     add_scene_args(parser)
     parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
-                        help="backends side by side on one time base (analytic, "
-                             "analytic-fast, pybullet, pymunk, mujoco), or all "
+                        help="backends side by side on one time base "
+                             f"({', '.join(backend_names())}), or all "
                              f"({', '.join(ALL_ENGINES)})")
     add_pulse_args(parser, required=False)
     parser.set_defaults(amplitude=None, omega=None)

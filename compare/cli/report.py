@@ -15,14 +15,14 @@ import sys
 import time
 from pathlib import Path
 
-from engines import ENGINES
+from engines import engine_names
 from scenes import load_scene
 
 from compare.cli.options import (add_engine_list_arg, add_workers_arg, check_output_path, detail,
                       format_quantity, parse_engine_list, resolve_workers)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
-# contacts creep, engines/pybullet_engine.py); above 1e-2 s the campaign refuses it.
+# contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
 DT_RANGE = (1e-5, 1e-2)
 
 from compare.cli.options import add_store_args, use_store
@@ -32,11 +32,12 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser("report", help="run the validation campaign, write an HTML/JSON report",
                               description=__doc__)
     p.add_argument("--scene", default="fig5", help="scene name or TOML path")
-    add_engine_list_arg(p, ENGINES, ENGINES)
+    add_engine_list_arg(p, engine_names(), engine_names())
     p.add_argument("--quick", action="store_true",
                    help="smaller grids (< 2 min on 2 cores) instead of the full campaign")
     p.add_argument("--out", default="report", metavar="DIR",
-                   help="output directory, created if missing")
+                   help="output directory, created if missing and replaced whole at the "
+                        "end; refused when it holds files this tool did not write")
     add_workers_arg(p)
     p.add_argument("--dt", type=float, default=None, metavar="S",
                    help=f"override every engine's time step [s], in [{DT_RANGE[0]:g}, "
@@ -47,7 +48,26 @@ def add_parser(subparsers) -> None:
 
 
 def parse_engines(text: str) -> tuple[str, ...]:
-    return parse_engine_list(text, ENGINES)
+    return parse_engine_list(text, engine_names())
+
+
+def _check_budget(config) -> None:
+    """Refuse before any work an engine run over the run budget: the longest pulse
+    of the campaign (its lowest threshold frequency, or a labelled point's)."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+    from scenes import POINTS
+
+    from compare.cli.options import check_run_budget
+
+    omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
+    for name in config.engines:
+        settings = get_backend(name).Settings()
+        if config.engine_dt is not None:
+            settings = dataclasses.replace(settings, dt=config.engine_dt)
+        check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -59,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dt is not None and not (math.isfinite(args.dt)
                                     and DT_RANGE[0] <= args.dt <= DT_RANGE[1]):
         raise ValueError(f"--dt must be in [{DT_RANGE[0]:g}, {DT_RANGE[1]:g}] s, got {args.dt!r}")
-    out = check_output_path(args.out, "--out", directory=True)
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
 
     from compare.run import atomic
 
@@ -70,8 +90,7 @@ def run(args: argparse.Namespace) -> int:
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
-    if Path(args.out).is_file():
-        raise ValueError(f"--out must be a directory, got the file {args.out!r}")
+    _check_budget(config)
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started

@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
+from engines import engine_names
+
 from compare.cli.options import (add_scene_args, add_store_args, clean_nan, detail, envelope, info,
                       print_json, scene_from_args, sig, use_store)
 
@@ -20,8 +22,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "at the measured pendulum angle.")
     add_scene_args(parser)
     parser.add_argument("--engine", default="pymunk", metavar="NAME",
-                        help="backend with free-rocking settings (theta0): pymunk, pybullet, "
-                             "analytic")
+                        help="backend with free-rocking settings (theta0): "
+                             + ", ".join(("analytic",) + engine_names()))
     parser.add_argument("--theta0", type=float, default=None, metavar="RAD",
                         help="initial tilt [rad], 0 < |theta0| < alpha; sign = side "
                              f"(default: {DEFAULT_THETA0_FRACTION:g} alpha)")

@@ -8,7 +8,7 @@ Candidates (all evaluated; ``causes`` lists every one that applies):
     the model's threshold and the amplitude where the engine departs from it
     (its robust first overturn, or its first collapse below that): a negative
     normal force at the ground or the lintel-column contacts, a friction demand
-    above the engine's coefficient (:func:`analytic.reactions.check_model`), or
+    above the engine's coefficient (:func:`analytic.bounds.check_model`), or
     the bob meeting a column (:func:`analytic.clearance.check_clearance`).
     Validity is also checked at both ends of the engine's bracket; a failure
     only above the decisive amplitude is reported in ``validity``, not blamed.
@@ -84,10 +84,10 @@ class Classification:
 
 def model_validity(scene, omega: float, kind: str, amplitudes: dict, friction) -> list[dict]:
     """The model's validity at each ``{where: amplitude}``: contact forces and
-    friction (:func:`analytic.reactions.check_model`) and the bob's clearance."""
+    friction (:func:`analytic.bounds.check_model`) and the bob's clearance."""
     from analytic.clearance import check_clearance
     from analytic.excitation import Pulse
-    from analytic.reactions import check_model
+    from analytic.bounds import check_model
     from analytic.simulate import simulate
     out, seen = [], {}
     for where, a in amplitudes.items():
@@ -163,14 +163,6 @@ def _iterations(settings) -> int | None:
     return getattr(settings, "solver_iterations", None)
 
 
-def _with_iterations(engine, settings, n):
-    # The contract exposes each engine's solver-iteration count as the attribute
-    # solver_iterations (a field, or a property over 'iterations').
-    names = {f.name for f in dataclasses.fields(settings)}
-    return configure(engine, settings,
-                     **{"solver_iterations" if "solver_iterations" in names else "iterations": n})
-
-
 def _row(kind, settings, p: ThresholdPoint) -> dict:
     return {"kind": kind, "dt": settings.dt, "iterations": _iterations(settings),
             "a_engine": p.a_engine, "a_survives": p.a_survives, "rel_error": p.rel_error,
@@ -187,7 +179,7 @@ def convergence_rows(engine, scene, omega, point: ThresholdPoint, settings, kind
         rows.append(_row("dt", finer, engine_threshold(
             engine, scene, omega, point.a_reference, finer, kind=kind, search=search)))
     if supports(engine, "solver_iterations"):
-        more = _with_iterations(engine, settings, 2 * _iterations(settings))
+        more = settings.with_solver_iterations(2 * _iterations(settings))
         rows.append(_row("iterations", more, engine_threshold(
             engine, scene, omega, point.a_reference, more, kind=kind, search=search)))
     return rows

@@ -78,15 +78,16 @@ class EnginePoint:
 def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "sine",
                    **options):
     """The engine's settings (``options`` applied, :func:`engines.configure`) with a
-    fixed friction raised to 1.2x the no-sliding bound of the largest pulse a bracket
-    may try (20 % above it, as the calibrated defaults keep; a friction of None is the
-    engine's own default for each run)."""
+    fixed friction raised to :data:`engines.base.FRICTION_MARGIN` times the no-sliding
+    bound of the largest pulse a bracket may try (a friction of None is the engine's
+    own default for each run, which follows the same rule)."""
+    from analytic.bounds import required_friction
     from analytic.excitation import Pulse
-    from engines._common import required_friction
+    from engines.base import FRICTION_MARGIN
     settings = configure(engine, **options)
-    need = required_friction(scene, Pulse(a_max, omega, kind))
-    if settings.friction is not None and settings.friction < 1.2 * need:
-        settings = configure(engine, settings, friction=1.2 * need)
+    need = FRICTION_MARGIN * required_friction(scene, Pulse(a_max, omega, kind))
+    if settings.friction is not None and settings.friction < need:
+        settings = configure(engine, settings, friction=need)
     return settings
 
 

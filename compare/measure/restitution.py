@@ -3,7 +3,7 @@
 The trilith is released at rest from a tilt ``theta0`` with no base motion
 (:class:`~analytic.excitation.Still`) and rocks freely; at every impact the
 backend's measured velocity ratio ``theta_dot+ / theta_dot-`` (read away from the
-impact: :mod:`engines._common`) is compared with the model: Eq. 20 without the
+impact: :mod:`engines.monitor`) is compared with the model: Eq. 20 without the
 pendulum, Eq. 19 at the impact's measured ``psi`` with it (both as corrected in
 :func:`analytic.equations.restitution_ratio`, ``docs/paper-errata.md``).
 

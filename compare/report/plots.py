@@ -28,11 +28,27 @@ import numpy as np  # noqa: E402
 from compare.report.trust import label  # noqa: E402
 
 __all__ = ["spectra_figure", "convergence_figure", "history_figure", "restitution_figure",
-           "COLORS", "DPI"]
+           "color", "marker", "DPI"]
 
-COLORS = {"analytic": "k", "analytic-fast": "tab:green", "pybullet": "tab:blue",
-          "pymunk": "tab:orange", "mujoco": "tab:purple"}
-MARKERS = {"pybullet": "o", "pymunk": "s", "mujoco": "^", "analytic-fast": "x"}
+
+
+def color(name: str) -> str | None:
+    """A backend's plot colour (its class's ``color``; None: matplotlib's cycle)."""
+    return _style(name, "color", None)
+
+
+def marker(name: str) -> str:
+    """A backend's plot marker (its class's ``marker``; 'o' if not registered)."""
+    return _style(name, "marker", "o")
+
+
+def _style(name: str, attr: str, default):
+    from engines import get_backend
+    try:
+        return getattr(get_backend(name), attr)
+    except ValueError:
+        return default
+
 # 100 dpi on figures 7 in wide: 700 px, sharp on a laptop, scaled down on a phone.
 DPI = 100
 _CASES = {"pendulum": "with pendulum", "no_pendulum": "without pendulum"}
@@ -76,7 +92,7 @@ def spectra_figure(doc: dict) -> str | None:
                     label=f"±{tol:g} % tolerance")
         bot.axhline(0.0, color="0.5", lw=0.6)
         for name, pts in spec.get("engines", {}).items():
-            style = dict(color=COLORS.get(name), marker=MARKERS.get(name, "o"), ls="none",
+            style = dict(color=color(name), marker=marker(name), ls="none",
                          mfc="none", ms=5)
             top.plot([p["omega"] for p in pts], _arr([p["a_engine"] for p in pts]),
                      label=label(name), **style)
@@ -136,8 +152,8 @@ def convergence_figure(doc: dict) -> str | None:
     ax.axhline(0.0, color="0.5", lw=0.6)
     for name, case, p, (dt, err) in series:
         order = np.argsort(dt)
-        ax.semilogx(dt[order], 100.0 * err[order], marker=MARKERS.get(name, "o"),
-                    color=COLORS.get(name), lw=0.9, ms=4,
+        ax.semilogx(dt[order], 100.0 * err[order], marker=marker(name),
+                    color=color(name), lw=0.9, ms=4,
                     label=f"{label(name)}, Ω = {p['omega']:g} ({_CASES.get(case, case)})")
     ax.set_xlabel("engine time step dt [s]", fontsize=8)
     ax.set_ylabel("engine / model − 1 [%]", fontsize=8)
@@ -182,12 +198,12 @@ def history_figure(histories: dict, point: str, alphas: dict, reference: str,
             if pt != point or p != pend:
                 continue
             is_ref = name == reference
-            top.plot(traj.t, traj.theta / alpha, color=COLORS.get(name), lw=1.4 if is_ref else 0.9,
+            top.plot(traj.t, traj.theta / alpha, color=color(name), lw=1.4 if is_ref else 0.9,
                      ls="-" if is_ref else "--", label=label(name), zorder=1 if is_ref else 2)
             if ref is not None and not is_ref:
                 grid, err = _error_vs_time(ref, traj, alpha)
                 if grid.size:
-                    bot.semilogy(grid, np.maximum(err, 1e-7), color=COLORS.get(name), lw=0.8,
+                    bot.semilogy(grid, np.maximum(err, 1e-7), color=color(name), lw=0.8,
                                  label=label(name))
         if ref is not None and ref.impacts:
             for ax in (top, bot):
@@ -228,8 +244,8 @@ def restitution_figure(doc: dict) -> str | None:
         for r in (r for r in rows if r["pendulum"] == pend):
             name = r["backend"]
             errs = [100.0 * i["rel_error"] for i in r["impacts"] if i.get("rel_error") is not None]
-            ax.plot(np.arange(1, len(errs) + 1), errs, marker=MARKERS.get(name, "o"), ms=4,
-                    lw=0.7, color=COLORS.get(name),
+            ax.plot(np.arange(1, len(errs) + 1), errs, marker=marker(name), ms=4,
+                    lw=0.7, color=color(name),
                     label=label(name) if name not in seen else None)
             seen.add(name)
         ax.set_title(title, fontsize=8)

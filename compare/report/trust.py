@@ -13,11 +13,8 @@ import math
 import statistics
 
 __all__ = ["trust_table", "threshold_agreement", "engine_cost", "key_settings", "conclusion",
-           "LABELS", "label", "fmt_sci", "fmt_seconds", "fmt_pct", "AGREEMENT_RULE", "EXCUSED"]
+           "label", "fmt_sci", "fmt_seconds", "fmt_pct", "AGREEMENT_RULE", "EXCUSED"]
 
-# Human names of backends (run-time tables, conclusions).
-LABELS = {"pybullet": "PyBullet", "pymunk": "Pymunk", "mujoco": "MuJoCo",
-          "analytic": "analytic model (scipy)", "analytic-fast": "analytic model (compiled)"}
 
 # Settings that are bookkeeping, not the engine's numerical choices.
 _NOT_SETTINGS = {"criterion", "t_max", "theta0", "psi0", "monitor", "engine_version", "t_cap",
@@ -25,8 +22,13 @@ _NOT_SETTINGS = {"criterion", "t_max", "theta0", "psi0", "monitor", "engine_vers
 
 
 def label(name: str) -> str:
-    """Human name of a backend."""
-    return LABELS.get(name, name)
+    """Human name of a backend: its class's ``label`` (the name itself if it is
+    not registered, e.g. an engine from a package no longer installed)."""
+    from engines import get_backend
+    try:
+        return get_backend(name).label
+    except ValueError:
+        return name
 
 
 def _num(value) -> float | None:

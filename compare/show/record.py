@@ -27,6 +27,7 @@ import numpy as np
 
 from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
+from engines import engine_names
 
 __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
            "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
@@ -36,7 +37,7 @@ __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", 
 
 # ``--engine all``: the accurate analytic reference and every physics engine
 # (``analytic-fast`` is the same model as ``analytic``; a panel for it adds nothing).
-ALL_ENGINES = ("analytic", "pybullet", "pymunk", "mujoco")  # the model and every engine
+ALL_ENGINES = ("analytic",) + engine_names()  # the model and every registered engine
 FORMATS = (".gif", ".mp4")
 # The paper integrates to at least ten pulse periods (Sec. 5.1): the default length.
 DEFAULT_PERIODS = 10.0

@@ -1,15 +1,14 @@
-"""Building the trilith's bodies in a PyBullet client, for :mod:`engines.pybullet_scene`.
+"""Building the trilith's bodies in a PyBullet client, for :mod:`engines.pybullet_`.
 
-Geometry, signs and the bodies built are described in :mod:`engines.pybullet_scene`
-(the analytic plane is PyBullet's x-z plane, ``theta = -pitch``).  Split from it
-only to keep modules short: :func:`build_scene` and :func:`initial_poses` are
-re-exported there.
+Geometry and signs are described in :mod:`engines.pybullet_.world` (the analytic
+plane is PyBullet's x-z plane, ``theta = -pitch``); the numbers come from
+:mod:`engines.geometry`.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
+from engines import geometry
 from engines._quiet_pybullet import pybullet as pb
 
 __all__ = ["Bodies", "build_scene", "initial_poses", "NEGLIGIBLE_MASS_FRACTION",
@@ -43,12 +42,6 @@ class Bodies:
         return self.columns + ((self.lintel,) if self.lintel is not None else ())
 
 
-def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
-    """Principal inertia of a uniform box with full side lengths sx, sy, sz."""
-    return (mass * (sy * sy + sz * sz) / 12.0, mass * (sx * sx + sz * sz) / 12.0,
-            mass * (sx * sx + sy * sy) / 12.0)
-
-
 def _quat_theta(theta: float) -> tuple[float, float, float, float]:
     """Quaternion of an analytic CCW rotation ``theta``: a rotation about -y."""
     return pb.getQuaternionFromEuler((0.0, -theta, 0.0))
@@ -64,25 +57,9 @@ def initial_poses(scene, theta0: float, psi0: float, sink: float = 0.0) -> dict:
     lintel by ``2 sink``: every contact then starts at that penetration (the
     contact slop, where Bullet's resting contacts settle, see :func:`build_scene`).
     """
-    b, h, d = scene.b, scene.h, scene.d
-    c, s = math.cos(theta0), math.sin(theta0)
-
-    def rotate_about(px: float, pz: float, x: float, z: float) -> tuple[float, float]:
-        rx, rz = x - px, z - pz  # analytic CCW rotation in the x-z plane
-        return px + c * rx - s * rz, pz + s * rx + c * rz
-
-    centres = []
-    for x_left in (0.0, b + d):
-        pivot_x = x_left if theta0 >= 0.0 else x_left + b
-        cx, cz = rotate_about(pivot_x, 0.0, x_left + 0.5 * b, 0.5 * h)
-        centres.append((cx, cz - sink))
-    # The lintel rests on the top corner diagonally opposite the pivot (it rises
-    # the most) and translates with it (the parallelogram of Eq. 5-6).
-    pivot, top = (0.0, b) if theta0 >= 0.0 else (b, 0.0)
-    top_x, top_z = rotate_about(pivot, 0.0, top, h)
-    shift = (top_x - top, top_z - h)
-    lintel = (0.5 * scene.lintel_length + shift[0],
-              h + 0.5 * scene.lintel_thickness + shift[1] - 2.0 * sink)
+    poses = geometry.rest_poses(scene, theta0, psi0)
+    centres = [(cx, cz - sink) for cx, cz in poses.columns]
+    lintel = (poses.lintel[0], poses.lintel[1] - 2.0 * sink)
     return {"columns": centres, "lintel": lintel, "quat": _quat_theta(theta0)}
 
 
@@ -104,7 +81,7 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
     calibration was measured with: sinking it too gave the same statistics
     (107 impacts, lam 3/5/7 x mu 0.5/1/2 x release 0.3/0.5/0.8 alpha: 5.6 % beyond
     0.5 % either way, median 0.039 % vs 0.034 %) but moved the column-step
-    outliers (see ``pybullet_engine.Settings``) onto other releases.  A tilted
+    outliers (see ``engines.pybullet_.Settings``) onto other releases.  A tilted
     start *under a pulse* still settles for ~4.5 ms at the pulse's start.
     """
     b, h, depth = scene.b, scene.h, scene.depth
@@ -114,7 +91,7 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
     # Ground: wide enough for columns lying on their sides, thick enough that a
     # corner cannot tunnel through it; a box, not a GEOM_PLANE (DESIGN.md: the
     # plane makes top and bottom impacts resolve one step apart).
-    g_half = (span + 2.5 * h, depth + h, max(0.5 * b, 0.1))
+    g_half = geometry.ground_box(scene)
     g_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=g_half, physicsClientId=client)
     g_pos = (0.5 * span, 0.0, -g_half[2])
     if moving_ground:
@@ -143,7 +120,7 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
         body = pb.createMultiBody(baseMass=scene.m1, baseCollisionShapeIndex=col_shape,
                                   baseVisualShapeIndex=col_vis, basePosition=(x, 0.0, z),
                                   baseOrientation=poses["quat"], physicsClientId=client)
-        ix, _, iz = _box_inertia(scene.m1, b, depth, h)
+        ix, _, iz = geometry.box_inertia(scene.m1, b, depth, h)
         # J_G comes from the scene (it may differ from the uniform box's value).
         pb.changeDynamics(body, -1, mass=scene.m1, localInertiaDiagonal=(ix, scene.inertia_J_G, iz),
                           physicsClientId=client)
@@ -192,7 +169,7 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
                                     baseVisualShapeIndex=l_vis, basePosition=(lx, 0.0, lz),
                                     physicsClientId=client, **link_kw)
         pb.changeDynamics(lintel, lintel_link, mass=scene.m3,
-                          localInertiaDiagonal=_box_inertia(scene.m3, span, depth, t_lin),
+                          localInertiaDiagonal=geometry.box_inertia(scene.m3, span, depth, t_lin),
                           physicsClientId=client)
         for k in range(len(links)):
             # Joints are free: no default velocity motor (it would lock them).

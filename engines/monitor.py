@@ -1,6 +1,6 @@
-"""What every engine adapter shares: run monitoring, verdicts and impact measurement.
+"""The run monitor every engine shares: when to stop, the verdict, impact measurement.
 
-An engine adapter steps its world and hands sampled column angles to a
+An engine (:class:`engines.base.Engine`) steps its world and hands sampled column angles to a
 :class:`RunMonitor`, which decides when the run can stop (same overturning
 criterion and survival rules as the analytic model) and turns the samples into a
 :class:`~analytic.trajectory.Trajectory`.
@@ -24,12 +24,10 @@ from scipy.integrate import solve_ivp
 
 from analytic import equations as eq
 from analytic.events import free_pendulum_period
-from analytic.excitation import Pulse, SampledRecord
 from analytic.options import check_real
 from analytic.trajectory import Event, Trajectory, Verdict
 
-__all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero", "free_pendulum_period",
-           "required_friction", "peak_acceleration"]
+__all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero"]
 
 
 @dataclass(frozen=True)
@@ -66,6 +64,17 @@ class MonitorSettings:
         within ~1e-5 rad at A-D (PyBullet's out-of-plane roll 2e-6 rad).  Beyond
         it: 'collapsed' (PyBullet's 18 m columns at lam 30 roll out of their
         plane by 0.35 rad, docs/engine-trust.md).
+    max_out_of_plane : largest out-of-plane drift of any body (3D engines) [in
+        trilith sizes, :func:`engines.geometry.size`] while both columns stand.
+        0.1: far beyond PyBullet's ~1e-5 m of noise.  Beyond it: 'unstable' (the
+        solver, not the mechanism, moved the body off its plane).
+    blowup_distance : a body (column or lintel) farther than this many trilith
+        sizes from its start, relative to the ground, marks the run 'unstable'.
+        10: no motion of the mechanism, even a column lying down, reaches it.
+    blowup_speed : a body faster than ``blowup_speed * (sqrt(g size) + peak
+        ground speed)`` [m/s] (the pendulum: ``l |psi_dot|``) marks the run
+        'unstable'.  20: a toppling column's tip never exceeds ``~2 sqrt(g
+        size)`` relative to the ground, so 20 is a tenfold margin.
 
     Whether the run stops as soon as the verdict is certain is the run option
     ``early_stop`` (:class:`analytic.options.RunOptions`), not a monitor setting.
@@ -80,51 +89,19 @@ class MonitorSettings:
     max_mismatch: float = 0.25
     max_sliding: float = 0.01
     max_lintel_rotation: float = 0.1
+    max_out_of_plane: float = 0.1
+    blowup_distance: float = 10.0
+    blowup_speed: float = 20.0
 
     def __post_init__(self) -> None:
         for name, lo, hi in (("uplift_angle", 0.0, 0.1), ("impact_window", 0.0, 0.5),
                              ("rest_angle", 0.0, 0.1), ("rest_rate", 0.0, 1.0),
                              ("rest_hold", 0.0, 1e4), ("t_cap", 0.0, 1e5),
                              ("max_mismatch", 0.0, 10.0), ("max_sliding", 0.0, 10.0),
-                             ("max_lintel_rotation", 0.0, 10.0)):
+                             ("max_lintel_rotation", 0.0, 10.0),
+                             ("max_out_of_plane", 0.0, 10.0), ("blowup_distance", 1.0, 1e6),
+                             ("blowup_speed", 1.0, 1e6)):
             check_real("MonitorSettings", name, getattr(self, name), lo, hi)
-
-
-def required_friction(scene, excitation) -> float:
-    """Conservative Coulomb coefficient needed for rocking without sliding
-    (one rule for every engine; ``analytic.reactions`` gives the exact demand
-    along an analytic run, and this bound exceeded it at A-D).
-
-    The largest of three ratios of horizontal to vertical ground reaction:
-
-    * at rest up to uplift the trilith moves with the ground: ``|a_up| / g``
-      (Eq. 9, pendulum hanging still) and, for a sampled or pulse excitation,
-      ``peak |xg_ddot| / g`` (the rigid-body bound if the trilith were carried
-      along for the whole pulse; it over-estimates the rocking phase, where the
-      columns' rotation absorbs most of the horizontal acceleration);
-    * at an impact, the plastic impulse at the new corners of every body in the
-      rocking mechanism has the ratio ``lam (1 - e) / (1 + e)`` with ``e`` the
-      velocity ratio of Eq. 20 (Eq. 19 at ``psi = 0`` with the pendulum): the
-      columns' centres and the lintel move on circles of the same shape.
-    """
-    b, h, mu, gamma, j, l, g = scene.model_args()
-    a_up = abs(eq.uplift_acceleration(0.0, 0.0, 1.0, b, h, mu, gamma, l, g))
-    e = eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j)
-    impact = (h / b) * (1.0 - e) / (1.0 + e)
-    return max(a_up / g, peak_acceleration(excitation) / g, impact)
-
-
-def peak_acceleration(excitation) -> float:
-    """``max |xg_ddot|`` [m/s^2] of an excitation (0 for :class:`Still`)."""
-    if isinstance(excitation, Pulse):
-        return abs(excitation.amplitude)
-    if isinstance(excitation, SampledRecord):  # linear interpolation peaks at a sample
-        return max(abs(a) for a in excitation.accelerations)
-    if excitation.end_time > 0.0:
-        t = np.linspace(0.0, excitation.end_time, 20001)
-        return float(np.max(np.abs(excitation.acceleration_array(t))))
-    return 0.0
-
 
 
 def propagate_to_zero(scene, excitation, t0: float, state0, side: int,

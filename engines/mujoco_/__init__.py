@@ -1,12 +1,11 @@
 """MuJoCo backend: the trilith as planar bodies with 3D box contacts, the
 pendulum as a hinged child body of the lintel (model built from the Scene in
-:mod:`engines.mujoco_scene`).
+:mod:`engines.mujoco_.world`).
 
-Contract (``engines/__init__.py``): ``NAME``, ``version()``, ``Settings``,
-``simulate(scene, excitation, settings) -> Trajectory``.  There is no
-``render_frames``: MuJoCo's renderer needs an OpenGL context (EGL/OSMesa/GLFW),
+The hooks of :class:`engines.base.Engine`.  There is no ``render_frames``:
+MuJoCo's renderer needs an OpenGL context (EGL/OSMesa/GLFW),
 which a headless machine lacks; recordings draw MuJoCo runs in 2D from the
-Trajectory (``compare/show/record.py``), as for Pymunk.
+Trajectory (``trilith record``), as for Pymunk.
 
 Base motion: ``"gravity"`` adds the d'Alembert load ``-xg_ddot(t + dt/2)`` to
 gravity in the base frame each step (exact for a rigid translating base);
@@ -33,22 +32,21 @@ without gap makes contacts act at a distance).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import mujoco
 
 from analytic.options import check_real
-from analytic.trajectory import Trajectory
-from engines import mujoco_scene as ms
-from engines._common import MonitorSettings, required_friction
-from engines.base import BASE_MOTIONS, EngineSettings, check_run, simulate_world
+from engines import geometry
+from engines.base import Engine, EngineSettings
+from engines.diagnostics import PlaneState, Pose
+from engines.monitor import MonitorSettings
 
-__all__ = ["NAME", "Settings", "simulate", "version", "BASE_MOTIONS", "INTEGRATORS", "CONES",
-           "SOLVERS"]
+from .world import BAD_WARNINGS, mjcf
 
-NAME = "mujoco"
-CAPABILITIES = frozenset({"time_step", "solver_iterations", "moving_ground", "initial_tilt",
-                          "trajectory"})
+__all__ = ["MujocoEngine", "Settings", "INTEGRATORS", "CONES", "SOLVERS"]
+
 INTEGRATORS = ("Euler", "implicitfast", "implicit", "RK4")
 CONES = ("elliptic", "pyramidal")
 SOLVERS = ("Newton", "CG", "PGS")
@@ -87,11 +85,11 @@ class Settings(EngineSettings):
         velocities are read from samples farther away.  At the shared 1e-3 rad
         the restitution errors were up to 0.33 % (Eq. 20 grid), at 5e-3 rad
         0.05 %.
-    friction : float
+    friction : float or None
         Coulomb coefficient of every contact (MuJoCo takes the larger of the
-        two geoms' values; all geoms get this one).  Must be >=
-        :func:`engines._common.required_friction`.  10, as Pymunk: above the
-        bound for pulses up to 10 g; pivot sliding at point D (2.5 g) 7e-5 m.
+        two geoms' values; all geoms get this one).  None: ``max(10, 1.2
+        required_friction)`` (:class:`engines.base.EngineSettings`); 10, as
+        Pymunk; pivot sliding at point D (2.5 g) 7e-5 m.
     timeconst_steps : float
         Contact ``solref`` time constant in time steps (used when ``timeconst``
         is None).  3 (3e-4 s): with ``dampratio = 3`` this is about the
@@ -134,7 +132,6 @@ class Settings(EngineSettings):
     """
 
     monitor: MonitorSettings = field(default_factory=lambda: MonitorSettings(impact_window=5e-3))
-    friction: float = 10.0
     timeconst_steps: float = 3.0
     timeconst: float | None = None
     dampratio: float = 3.0
@@ -149,6 +146,9 @@ class Settings(EngineSettings):
     def solver_iterations(self) -> int:
         """The contract's name for ``iterations`` (convergence studies double it)."""
         return self.iterations
+
+    def with_solver_iterations(self, n: int) -> Settings:
+        return dataclasses.replace(self, iterations=n)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -195,48 +195,113 @@ def _check_own(s: Settings) -> None:
     choice("integrator", s.integrator, INTEGRATORS)
 
 
-def _validate(scene, excitation, s: Settings) -> None:
-    """Checks that need the scene, before anything is built."""
-    check_run(NAME, Settings, s, scene, excitation)
-
-
-def simulate(scene, excitation, settings: Settings | None = None) -> Trajectory:
-    """Run ``scene`` under ``excitation`` in MuJoCo; returns a :class:`Trajectory`.
-
-    Parameters
-    ----------
-    scene : analytic.parameters.Scene
-    excitation : Pulse, SampledRecord or Still
-    settings : Settings or None
-        None: the calibrated defaults.
-
-    Returns
-    -------
-    Trajectory
-        Sampled every ``sample_every`` steps; diagnostics ``lintel_rotation_max``
-        [rad], ``pivot_sliding_max`` [m], ``penetration_max`` [m] (over the rocking
-        regime), ``steps``, ``wall_time`` [s], ``required_friction``.
-
-    Raises ``ValueError`` for bad settings before any model is built.  A blow-up
-    (non-finite state, a MuJoCo reset warning, a body flown away or too fast)
-    gives the verdict ``'unstable'``.
+class MujocoEngine(Engine):
+    """MuJoCo (planar joints, 3D box contacts); the hooks of :class:`engines.base.Engine`.
 
     Examples
     --------
     >>> from analytic.excitation import Pulse
     >>> from scenes import load_scene
-    >>> tr = simulate(load_scene("fig5"), Pulse(4.0, 9.0), Settings(t_max=0.1))
-    >>> tr.backend, tr.verdict.status
-    ('mujoco', 'survived')
+    >>> tr = MujocoEngine.simulate(load_scene("fig5"), Pulse(4.0, 9.0), Settings(t_max=0.1))
+    >>> tr.backend, tr.verdict.status, tr.settings["friction_used"]
+    ('mujoco', 'survived', 10.0)
     """
-    s = settings if settings is not None else Settings()
-    _validate(scene, excitation, s)
-    info = s.describe()
-    info["engine_version"] = version()
 
-    def make_world():
-        world = ms.World(scene, excitation, s, s.friction)
-        world.diag["required_friction"] = required_friction(scene, excitation)
-        return world
+    name = "mujoco"
+    label = "MuJoCo"
+    color = "tab:purple"
+    marker = "^"
+    capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
+                              "initial_tilt", "trajectory"})
+    default_friction = 10.0
+    Settings = Settings
 
-    return simulate_world(NAME, make_world, scene, excitation, s, info)
+    @classmethod
+    def version(cls) -> str:
+        """MuJoCo's version string, e.g. ``'mujoco 4.0.0'``."""
+        return f"mujoco {mujoco.__version__}"
+
+    def build(self) -> None:
+        scene, s = self.scene, self.settings
+        self.xml = mjcf(scene, s, self.friction)
+        try:
+            self.model = m = mujoco.MjModel.from_xml_string(self.xml)
+        except ValueError as exc:  # e.g. a body below MuJoCo's mass/inertia floor (1e-15)
+            raise ValueError(f"mujoco cannot model this scene: {str(exc).splitlines()[0]} "
+                             f"(scene {scene.name!r}: column_mass, gamma and l set the "
+                             f"smallest body)") from None
+        self.data = d = mujoco.MjData(m)
+        self.moving = s.base_motion == "ground"
+
+        def adr(joint: str) -> int:
+            return int(m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)])
+
+        # Slide/hinge joints only: qpos and qvel share their addresses.
+        self.columns = (adr("column_left_x"), adr("column_right_x"))
+        self.lintel = adr("lintel_x") if scene.mu > 0.0 else None
+        self.pendulum = adr("pendulum_psi") if scene.has_pendulum else None
+        self.ground = adr("ground_x") if self.moving else None
+        # Joint coordinates are offsets from the upright MJCF pose.
+        b, h, t_l = scene.b, scene.h, scene.lintel_thickness
+        self.centres0 = [(x + 0.5 * b, 0.5 * h) for x in geometry.column_lefts(scene)]
+        self.centres0.append((0.5 * scene.lintel_length, h + 0.5 * t_l))
+        poses = geometry.rest_poses(scene, s.theta0, s.psi0)
+        for a, (x, y), (x0, y0), angle in zip(
+                self.columns + ((self.lintel,) if self.lintel is not None else ()),
+                poses.columns + (poses.lintel,), self.centres0, (s.theta0, s.theta0, 0.0)):
+            d.qpos[a:a + 3] = (x - x0, y - y0, angle)
+        if self.pendulum is not None:
+            d.qpos[self.pendulum] = s.psi0  # relative to the lintel, which starts unrotated
+        if self.moving:
+            self._set_ground(0)
+        mujoco.mj_forward(m, d)
+        self._warnings = [int(getattr(mujoco.mjtWarning, w)) for w in BAD_WARNINGS]
+
+    def close(self) -> None:
+        """Nothing to release (MuJoCo frees the model with its Python objects)."""
+        self.model = self.data = None
+
+    def _set_ground(self, step: int) -> None:
+        self.data.qpos[self.ground], self.data.qvel[self.ground] = self.ground_motion(step)
+
+    def advance(self, steps: int) -> None:
+        """One loop with local names: stepping is the hot path."""
+        n, m, d = self.step_index, self.model, self.data
+        step = mujoco.mj_step
+        if self.moving:
+            for k in range(n, n + steps):
+                self._set_ground(k)
+                step(m, d)
+        else:
+            gravity, load = m.opt.gravity, self.base_load
+            # After the pulse the load stays 0: stop setting it.
+            k_end = min(n + steps, max(n, self._load_end))
+            for k in range(n, k_end):
+                gravity[0] = load(k)
+                step(m, d)
+            if k_end < n + steps:
+                gravity[0] = 0.0
+                for _ in range(n + steps - k_end):
+                    step(m, d)
+        self.step_index = n + steps
+
+    def read(self) -> PlaneState:
+        d = self.data
+        qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
+        problem = None
+        for w in self._warnings:
+            if d.warning[w].number:
+                problem = f"MuJoCo warning {mujoco.mjtWarning(w).name} (state reset or invalid)"
+                break
+
+        def pose(a: int, k: int) -> Pose:
+            return Pose(self.centres0[k][0] + qpos[a], self.centres0[k][1] + qpos[a + 1],
+                        qpos[a + 2], qvel[a], qvel[a + 1], qvel[a + 2])
+
+        (al, ar), li, pe = self.columns, self.lintel, self.pendulum
+        lintel = pose(li, 2) if li is not None else None
+        psi = psi_dot = 0.0
+        if pe is not None:  # absolute angle: relative hinge angle plus the lintel's rotation
+            psi, psi_dot = qpos[pe] + qpos[li + 2], qvel[pe] + qvel[li + 2]
+        gx = float(qpos[self.ground]) if self.moving else 0.0
+        return PlaneState((pose(al, 0), pose(ar, 1)), lintel, psi, psi_dot, gx, problem=problem)
