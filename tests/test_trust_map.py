@@ -74,12 +74,16 @@ def test_documented_agreement_point_runs_with_the_default_friction(engine):
 # change of any of them invalidates the map until it is regenerated.
 PINNED = {"pybullet": {"dt": 1e-4, "solver_iterations": 50, "contact_erp": 0.2,
                        "friction": None},
-          "pymunk": {"dt": 1e-4, "iterations": 30, "friction": 10.0, "slop_fraction": 1e-4},
-          "mujoco": {"dt": 1e-4, "iterations": 100, "friction": 10.0, "impratio": 10.0,
+          "pymunk": {"dt": 1e-4, "iterations": 30, "friction": None, "slop_fraction": 1e-4},
+          "mujoco": {"dt": 1e-4, "iterations": 100, "friction": None, "impratio": 10.0,
                      "cone": "elliptic", "solver": "Newton"}}
+# A friction of None is the engine's class default, raised to the pulse's need.
+DEFAULT_FRICTION = {"pymunk": 10.0, "mujoco": 10.0}
 
 
 @pytest.mark.parametrize("engine", sorted(PINNED))
 def test_defaults_the_map_depends_on_are_pinned(engine):
     described = engines.configure(engine).describe()
     assert {k: described.get(k) for k in PINNED[engine]} == PINNED[engine]
+    if engine in DEFAULT_FRICTION:
+        assert engines.get_backend(engine).default_friction == DEFAULT_FRICTION[engine]
