@@ -49,6 +49,14 @@ def _real(name: str, value) -> float:
     return float(value)
 
 
+def _positive_factor(factor) -> float:
+    """A scale factor: real, finite, > 0 (a mirror is ``mirrored()``)."""
+    f = _real("factor", factor)
+    if not (math.isfinite(f) and f > 0.0):
+        raise ValueError(f"scale factor must be finite and > 0, got {factor!r}")
+    return f
+
+
 @dataclass(frozen=True)
 class Pulse:
     """One full cycle of ``A sin(Omega t)`` (``kind='sine'``, Eq. 22) or
@@ -143,6 +151,27 @@ class Pulse:
             x = a / w * (tc - math.sin(w * tc) / w)
         return x + self.velocity(self.period) * max(t - self.period, 0.0)
 
+    @property
+    def peak_times(self) -> tuple[float, ...]:
+        """Instants of the extrema of ``|xg_ddot|`` [s] (where an uplift margin is
+        smallest): the quarter periods of the sine, the half period of the cosine."""
+        quarter = 0.25 * self.period
+        return (quarter, 3.0 * quarter) if self.kind == "sine" else (2.0 * quarter,)
+
+    @property
+    def pga(self) -> float:
+        """Peak ground acceleration ``|A|`` [m/s^2]."""
+        return abs(self.amplitude)
+
+    @property
+    def pgv(self) -> float:
+        """Peak ground velocity [m/s]: ``2|A|/Omega`` (sine), ``|A|/Omega`` (cosine)."""
+        return (1.0 if self.is_cosine else 2.0) * abs(self.amplitude) / self.omega
+
+    def scaled(self, factor: float) -> "Pulse":
+        """The pulse with its amplitude times ``factor`` (> 0)."""
+        return Pulse(_positive_factor(factor) * self.amplitude, self.omega, self.kind)
+
     def mirrored(self) -> "Pulse":
         return Pulse(-self.amplitude, self.omega, self.kind)
 
@@ -219,9 +248,7 @@ class SampledRecord:
         """The record with every acceleration times ``factor`` (> 0, finite; a
         mirror is :meth:`mirrored`).  The result obeys the same bounds
         (``|a| <= 1e4 m/s^2``), ``ValueError`` naming the factor otherwise."""
-        f = _real("factor", factor)
-        if not (math.isfinite(f) and f > 0.0):
-            raise ValueError(f"scale factor must be finite and > 0, got {factor!r}")
+        f = _positive_factor(factor)
         if f * self.pga > MAX_ACCELERATION:
             raise ValueError(f"scale factor {f:g} takes the record's PGA {self.pga:.4g} m/s^2 "
                              f"beyond {MAX_ACCELERATION:g} m/s^2; at most "

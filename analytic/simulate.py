@@ -103,10 +103,7 @@ class _Run:
         # A pulse's |xg_ddot| extrema, where the margin has its minima: REST
         # segments stop there too, so a short dip below zero cannot hide inside
         # one step (exact without a pendulum, whose margin depends on t only).
-        kind = getattr(excitation, "kind", None)
-        quarter = 0.25 * excitation.end_time
-        self.peaks = ([quarter, 3.0 * quarter] if kind == "sine" else
-                      [2.0 * quarter] if kind == "cosine" else [])
+        self.peaks = list(getattr(excitation, "peak_times", ()))
         self.t = 0.0
         self.theta, self.theta_dot = st.theta0, st.theta_dot0
         self.psi, self.psi_dot = st.psi0, st.psi_dot0
