@@ -25,7 +25,7 @@ import sys
 import time
 from pathlib import Path
 
-from compare import atomic
+from compare.run import atomic
 
 from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
     plot_work_precision, write_json

@@ -40,8 +40,8 @@ from engines._quiet_pybullet import pybullet as pb
 
 import engines
 from analytic.excitation import Pulse
-from compare.jsonable import plain
-from compare.restitution import measure_restitution
+from compare.run.jsonable import plain
+from compare.measure.restitution import measure_restitution
 from engines import pybullet_engine as pbe
 from engines import pybullet_scene as ps
 from engines.base import simulate_world

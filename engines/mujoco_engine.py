@@ -6,7 +6,7 @@ Contract (``engines/__init__.py``): ``NAME``, ``version()``, ``Settings``,
 ``simulate(scene, excitation, settings) -> Trajectory``.  There is no
 ``render_frames``: MuJoCo's renderer needs an OpenGL context (EGL/OSMesa/GLFW),
 which a headless machine lacks; recordings draw MuJoCo runs in 2D from the
-Trajectory (``scenes/record.py``), as for Pymunk.
+Trajectory (``compare/show/record.py``), as for Pymunk.
 
 Base motion: ``"gravity"`` adds the d'Alembert load ``-xg_ddot(t + dt/2)`` to
 gravity in the base frame each step (exact for a rigid translating base);

@@ -17,7 +17,7 @@ import pytest
 import engines
 from analytic.excitation import Pulse
 from analytic.options import RunOptions
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 from engines.base import CAPABILITIES, Backend, EngineSettings
 from scenes import PAPER_OUTCOMES, load_scene, point_pulse
 from test_closed_forms import makris_vassiliou

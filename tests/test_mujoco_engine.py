@@ -19,11 +19,11 @@ import pytest
 
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
-from compare.spectra import first_overturning_amplitude
-from compare.thresholds import engine_threshold
+from compare.measure.reference_spectra import first_overturning_amplitude
+from compare.measure.thresholds import engine_threshold
 from engines import mujoco_engine as me
 from engines import mujoco_scene as ms
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 from scenes import load_scene
 
 # Issue acceptance: 0.5 %.  Measured at the defaults (docs/mujoco.md): max

@@ -19,7 +19,7 @@ from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
 from engines import pybullet_engine as pe
 from engines import pybullet_scene as ps
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 from scenes import load_scene
 
 # Restitution tolerance (issue acceptance): 0.5 %.  The measured errors are
@@ -175,7 +175,7 @@ def test_uplift_time_at_point_a_matches_eq9():
     landing's friction impulse set them rocking 3.9 ms early (theta RMS before
     the first impact 8.5e-3 alpha).  Measured after the fix: -0.17 ms, 2.6e-4 alpha.
     """
-    from compare.metrics import compare_trajectories
+    from compare.measure.trajectories import compare_trajectories
     from analytic.simulate import Settings as AnalyticSettings, simulate as analytic_simulate
 
     scene, pulse = load_scene("fig5"), Pulse(19.0, 15.0)
@@ -185,7 +185,7 @@ def test_uplift_time_at_point_a_matches_eq9():
     cmp = compare_trajectories(ref, tr)
     # 1 ms: one sample interval of the engine (uplift interpolated between samples).
     assert abs(cmp.uplift_time_error) < 1e-3, cmp.uplift_time_error
-    # 1e-3 alpha: the campaign's theta tolerance (compare.campaign.Tolerances).
+    # 1e-3 alpha: the campaign's theta tolerance (compare.campaign.validation.Tolerances).
     assert cmp.theta_rms_first < 1e-3, cmp.theta_rms_first
     assert cmp.t_first_impact > cmp.t_start + 0.05  # a real window, not a few samples
     assert tr.diagnostics["pivot_sliding_max"] < 1e-5  # no sliding at the default friction

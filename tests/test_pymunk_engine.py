@@ -17,7 +17,7 @@ from analytic import equations as eq
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
 from engines import pymunk_engine as pe
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 
 # ---------------------------------------------------------------- restitution
 # The acceptance bound of the engine contract.  Measured at the defaults, first

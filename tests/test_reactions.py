@@ -16,7 +16,7 @@ from analytic.reactions import ground_reaction, reaction_history, system_mass
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
 from finite_differences import central_difference_force
-from compare.commands._common import clean_nan
+from compare.cli.options import clean_nan
 
 G = 9.81
 
@@ -186,7 +186,7 @@ def test_extreme_pulse_is_flagged_invalid(fig5, monkeypatch):
 
 
 def test_cli_warns_when_the_model_is_invalid(capsys):
-    from compare.cli import main
+    from compare.cli.main import main
     code = main(["simulate", "--set", "lam=1.5", "--set", "b=0.6", "--set", "mu=1",
                  "--no-pendulum", "-A", "490.5", "-w", "100"])
     out = capsys.readouterr().out

@@ -19,9 +19,9 @@ from scipy.integrate import quad
 from analytic import equations as eq
 from analytic.parameters import Scene
 from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
-from compare.cli import main
+from compare.cli.main import main
 from engines import BACKENDS
-from compare.restitution import analytic_impact_times, measure_restitution
+from compare.measure.restitution import analytic_impact_times, measure_restitution
 
 
 # ------------------------------------------------------ analytic run length
