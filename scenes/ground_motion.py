@@ -30,7 +30,7 @@ import numpy as np
 
 from analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
 
-__all__ = ["load_record", "G_PEER"]
+__all__ = ["load_record", "load_suite", "G_PEER"]
 
 G_PEER = 9.80665  # m/s^2: the standard gravity of the g units in PEER files
 MAX_FILE_BYTES = 64 * 2 ** 20  # a 1e6-sample record is about 25 MB of text
@@ -190,3 +190,30 @@ def load_record(path, option: str | None = None) -> SampledRecord:
         return SampledRecord(tuple(times), tuple(accels), label=path.name)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
+
+
+RECORD_SUFFIXES = (".at2", ".csv")
+MAX_SUITE = 500  # records per suite: IDA runs ~30 simulations per record and backend
+
+
+def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
+    """A suite of records: every ``*.AT2`` / ``*.csv`` file of a directory (sorted
+    by name), or ``'sample'`` (the shipped synthetic record, a suite of one).
+
+    ``ValueError`` naming ``option`` for a missing or empty directory, or for
+    any unreadable record (its file and line, as :func:`load_record`).
+    """
+    text = str(spec)
+    if text == "sample":
+        return [load_record(Path(__file__).resolve().parent / "records" / "sample.csv", option)]
+    path = Path(text).expanduser()
+    if not path.is_dir():
+        raise ValueError(f"{option}: {text!r} is neither a directory of .AT2/.csv records "
+                         f"nor a suite name ('sample')")
+    files = sorted(p for p in path.iterdir()
+                   if p.is_file() and p.suffix.lower() in RECORD_SUFFIXES)
+    if not files:
+        raise ValueError(f"{option}: no .AT2 or .csv record in {text!r}")
+    if len(files) > MAX_SUITE:
+        raise ValueError(f"{option}: {len(files)} records in {text!r}; at most {MAX_SUITE}")
+    return [load_record(p, option) for p in files]
