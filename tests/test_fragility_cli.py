@@ -71,3 +71,26 @@ def test_empty_folder_is_refused(tmp_path, capsys):
     assert main(["fragility", "--records", str(tmp_path / "empty"), "--no-cache",
                  "--out", str(tmp_path / "o")]) == 2
     assert "no .AT2 or .csv record" in capsys.readouterr().err
+
+
+def test_spectrum_record_equals_the_fragility_ida(tmp_path, capsys):
+    """``spectrum --record`` is the IDA of one record: the same first overturning
+    intensity as ``fragility`` gives that record (same search, same window)."""
+    suite = write_suite(tmp_path / "suite", n=1)
+    cache = tmp_path / "cache"
+    assert main(["fragility", "--records", str(suite), "--out", str(tmp_path / "o"),
+                 "--cache", str(cache), *ARGS]) == 0
+    capsys.readouterr()
+    frag = json.loads((tmp_path / "o" / "fragility.json").read_text())
+    assert main(["spectrum", "--record", str(suite / "r0.csv"), "--json", "--cache", str(cache),
+                 *ARGS]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    one = doc["backends"]["analytic"]
+    assert one["im_overturn"] == frag["backends"]["analytic"]["records"][0]["im_overturn"]
+    assert one["runs"] == frag["backends"]["analytic"]["records"][0]["runs"]
+
+
+def test_spectrum_record_refuses_pulse_options(tmp_path, capsys):
+    suite = write_suite(tmp_path / "suite", n=1)
+    assert main(["spectrum", "--record", str(suite / "r0.csv"), "--tol", "0.1"]) == 2
+    assert capsys.readouterr().err.startswith("error: --record searches the record's intensity")

@@ -31,19 +31,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_scene_args(parser)
     parser.add_argument("--records", required=True, metavar="DIR|SUITE",
                         help="a directory of PEER .AT2 / CSV records, or 'sample'")
-    parser.add_argument("--im", choices=("pga", "pgv", "scale"), default="pga",
-                        help="intensity measure: PGA [m/s^2], PGV [m/s] or the scale factor")
-    parser.add_argument("--im-range", default=None, metavar="LO:HI",
-                        help="search range of the intensity (PGA accepts a g suffix: "
-                             "0.05g:2g; default 0.5:20 m/s^2, 0.05:2 m/s, 0.1:10)")
-    parser.add_argument("--rel-step", type=float, default=0.15, metavar="R",
-                        help="grid step ratio minus one, in (0, 10]: overturning windows "
-                             "narrower than one step may be missed")
-    parser.add_argument("--rtol", type=float, default=0.01, metavar="R",
-                        help="relative width of the final bracket, below --rel-step")
-    parser.add_argument("--tail", type=float, default=5.0, metavar="S",
-                        help="seconds run after each record ends (the same fixed window "
-                             "for every backend)")
+    add_ida_args(parser)
     parser.add_argument("--engine", default="none", metavar="NAME[,NAME...]",
                         help=f"engines beside the model: {', '.join(ENGINES)}, or none")
     parser.add_argument("--out", default="fragility", metavar="DIR",
@@ -104,9 +92,7 @@ def run(args: argparse.Namespace) -> int:
 
     scene = scene_from_args(args)
     engines_ = parse_engine_list(args.engine, ENGINES, none_ok=True)
-    lo, hi = _im_range(args)
-    st = IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step, rtol=args.rtol,
-                     tail=args.tail)
+    st = ida_settings(args)
     workers = resolve_workers(args.workers)
     out = check_output_path(args.out, "--out", directory=True)
     suite = load_suite(args.records)
@@ -209,7 +195,8 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
         sec.set_xlabel("PGA [g]")
     ax.set_ylabel("P(overturn | IM)")
     ax.set_ylim(0.0, 1.0)
-    ax.legend(fontsize=8, loc="upper left")
+    if ax.get_legend_handles_labels()[1]:  # no fit (fewer than 2 overturns): no line
+        ax.legend(fontsize=8, loc="upper left")
     pendulum = "" if doc["scene"].get("gamma", 0.0) > 0.0 else " without pendulum"
     ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records "
                  "(steps: empirical; lines: lognormal fit, 90 % band)",
@@ -238,3 +225,53 @@ def _print(doc: dict, st: IDASettings) -> None:
             print(f"  vs model: median ratio {ratio}, largest distance fitted "
                   f"{ag['max_distance_fit'] if ag['max_distance_fit'] is not None else 'n/a'}"
                   f", empirical {ag['max_distance_empirical']:.3f}")
+
+
+def add_ida_args(parser: argparse.ArgumentParser) -> None:
+    """The IDA search options shared by ``fragility`` and ``spectrum --record``."""
+    parser.add_argument("--im", choices=("pga", "pgv", "scale"), default="pga",
+                        help="intensity measure: PGA [m/s^2], PGV [m/s] or the scale factor")
+    parser.add_argument("--im-range", default=None, metavar="LO:HI",
+                        help="search range of the intensity (PGA accepts a g suffix: "
+                             "0.05g:2g; default 0.5:20 m/s^2, 0.05:2 m/s, 0.1:10)")
+    parser.add_argument("--rel-step", type=float, default=0.15, metavar="R",
+                        help="grid step ratio minus one, in (0, 10]: overturning windows "
+                             "narrower than one step may be missed")
+    parser.add_argument("--rtol", type=float, default=0.01, metavar="R",
+                        help="relative width of the final bracket, below --rel-step")
+    parser.add_argument("--tail", type=float, default=5.0, metavar="S",
+                        help="seconds run after each record ends (the same fixed window "
+                             "for every backend)")
+
+
+def ida_settings(args) -> IDASettings:
+    lo, hi = _im_range(args)
+    return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step, rtol=args.rtol,
+                       tail=args.tail)
+
+
+def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:
+    """``trilith spectrum --record FILE``: the record's first overturning intensity
+    (and islands) for each backend; ``--json`` prints them as one object."""
+    from compare.cli.options import print_json, scaled_record
+    from scenes.ground_motion import load_record
+    st = ida_settings(args)
+    record = scaled_record(load_record(args.record, option="--record"), args)
+    use_store(args)
+    results = _run_all([(b, scene, record, st) for b in backends], workers, args.scheduler)
+    if args.json:
+        print_json({"command": "spectrum", "record": record.describe(), "ida": st.describe(),
+                    "backends": dict(zip(backends, results))})
+        return 0
+    unit = IM_UNITS[st.im]
+    print(f"record {record.label}: PGA {record.pga:.4g} m/s^2 ({record.pga / G_STANDARD:.3g} g), "
+          f"PGV {record.pgv:.4g} m/s; first overturning {IM_TEXT[st.im]} "
+          f"(grid step {100 * st.rel_step:g} %, bracket {100 * st.rtol:g} %):")
+    for b, r in zip(backends, results):
+        if r["censored"]:
+            print(f"  {b}: none up to {st.im_hi:g} {unit}")
+            continue
+        g = f" ({r['im_overturn'] / G_STANDARD:.3g} g)" if st.im == "pga" else ""
+        isl = "".join(f", survives again {a:.4g}-{c:.4g}" for a, c in r["islands"])
+        print(f"  {b}: {r['im_overturn']:.4g} {unit}{g}{isl}")
+    return 0
