@@ -16,8 +16,10 @@ Phases (the compiled fast path ``analytic/fast.py`` implements the same):
 
 Integration segments never straddle a discontinuity of ``xg_ddot`` (the ends of
 the excitation window); REST segments also stop at the pulse's ``|xg_ddot|`` peaks
-(a record's samples), where the margin is smallest, so a short dip below zero is
-not stepped over.  An uplift whose rocking stays below the integrator's
+(``peak_times``), and check the margin at a record's samples (integrated in
+blocks of up to 4096 samples; a sample past the margin sends the interval
+before it to a one-sample segment), where the margin is smallest, so a short
+dip below zero is not stepped over.  An uplift whose rocking stays below the integrator's
 resolution (``s*theta`` never positive: a margin dip of nanoseconds) keeps the
 trilith down until the margin is positive again, then Event('rest').
 Without a pendulum (``gamma = 0``) ``psi`` and
@@ -69,10 +71,10 @@ REASON_BARRIER = "energy below the overturning barrier after the pulse"
 REASON_REST = "at rest after the pulse without pendulum"
 REASON_PERIOD = "at rest after the pulse: no uplift during one free-pendulum period"
 REASON_WINDOW = "t_max reached without overturning (fixed window)"
+REASON_CAP = "t_cap reached after the pulse before the outcome was certain"
 # Record samples per REST integration: doubled after each block without uplift,
 # back to one at an uplift (so at most one block is integrated in vain).
 REST_BLOCK_MAX = 4096
-REASON_CAP = "t_cap reached after the pulse before the outcome was certain"
 
 
 def version() -> str:
@@ -97,7 +99,7 @@ class _Run:
         self.breaks = sorted({x for x in (self.t_on, self.t_off) if 0.0 < x < self.t_stop})
         times = getattr(excitation, "times", None)
         # A record's xg_ddot has kinks at its samples, where the (then piecewise
-        # linear) margin has its minima: REST segments stop at every sample.
+        # linear) margin has its minima: REST checks the margin at every sample.
         self.kinks = np.asarray(times, dtype=float) if times is not None else None
         self.rest_block = 1  # kinks per REST integration, grows while at rest
         # A pulse's |xg_ddot| extrema, where the margin has its minima: REST
