@@ -191,7 +191,7 @@ def test_sample_record_both_formats_agree_and_regenerate():
 def test_simulate_with_a_record(capsys):
     assert main(["simulate", "--record", str(SAMPLE_CSV)]) == 0
     out = capsys.readouterr().out
-    assert "record sample.csv (1001 samples, 10 s, peak 4 m/s^2)" in out
+    assert "record sample.csv (1001 samples, 10 s, PGA 4 m/s^2 (0.408 g)" in out
     assert "verdict: " in out
 
 
