@@ -67,7 +67,7 @@ def ida_job(item):
 
     from analytic.ida import first_overturn_intensity
     from compare.run import runs
-    from compare.run.store import digest, excitation_dict, scene_dict, settings_dict
+    from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
     backend, scene, record, st = item
     extra = {"sample_dt": 0.01} if backend == "analytic" else {}
 
