@@ -1,5 +1,5 @@
 """Local worker processes for parallel maps (spectra, overturn maps, the run store's
-``compare.runs.run_many``): forked, so they inherit the loaded kernels and engines;
+``compare.run.runs.run_many``): forked, so they inherit the loaded kernels and engines;
 deaf to Ctrl-C, which the parent handles; dead with their parent, even after a
 ``kill -9`` of it; and killed at once when the caller stops early."""
 from __future__ import annotations

@@ -12,7 +12,13 @@ from dataclasses import dataclass, field
 
 from .trajectory import OverturnCriterion
 
-__all__ = ["RunOptions", "check_real"]
+__all__ = ["RunOptions", "check_real", "MAX_RUN_STEPS"]
+
+# Largest run any backend accepts: engine steps (length / dt) or analytic output
+# samples (length / sample_dt).  5e6 steps is about 3 min of PyBullet and 1 min
+# of Pymunk on the reference machine (30 and 90 thousand steps/s, README), 200 MB
+# of analytic samples; the default runs need at most 1.3e6 (62.8 s pulse + 60 s).
+MAX_RUN_STEPS = 5_000_000
 
 
 def check_real(owner: str, name: str, value, lo: float, hi: float, lo_open: bool = True,

@@ -151,7 +151,7 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
         Show a tqdm bar (on stderr, only once the run has lasted 1 s).
     map_fn : callable, optional
         ``map_fn(fn, omegas)`` -> ``fn(omega)`` for each, in order: the caller's
-        parallel map (e.g. :func:`compare.runs.run_many` with a run store or a
+        parallel map (e.g. :func:`compare.run.runs.run_many` with a run store or a
         Dask cluster); replaces ``workers``.
     """
     ss = SpectrumSettings() if settings is None else settings

@@ -23,8 +23,8 @@ import time
 import numpy as np
 
 from analytic.spectrum import overturning_spectrum
-from compare import engine_spectrum as es
-from compare import thresholds
+from compare.measure import engine_spectrum as es
+from compare.measure import thresholds
 from scenes import load_scene
 
 from . import machine, write

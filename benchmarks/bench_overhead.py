@@ -7,10 +7,9 @@ run stays inside the pulse (it ends at 0.70 s, where the energy rule would stop
 the run early), uplifts at ~0.1 s and impacts once, so the harness runs every
 step to ``t_max`` and reports the number of steps in ``diagnostics["steps"]``.
 
-* **bare**: the adapter's own world (``engines.pybullet_scene.World`` /
-  ``engines.pymunk_engine._World``), then only the stepping loop: the
-  base-motion gravity update (d'Alembert load at mid-step, exactly as the
-  adapter computes it) and the engine's step call, ``steps`` times.  World
+* **bare**: the engine's own hooks (:class:`engines.base.Engine`): ``build``,
+  then one ``advance(steps)``: the base-motion gravity update (d'Alembert load
+  at mid-step, exactly as a run computes it) and the engine's step call.  World
   construction is timed apart ("build"; PyBullet: a new DIRECT client, ~5-20 ms)
   and left out of the bare step rate, as issue 3 words it ("bare stepping
   loop"); "ratio incl. build" adds it to the bare side (what a bare *run*
@@ -35,14 +34,8 @@ import sys
 import time
 from dataclasses import replace
 
-from engines._quiet_pybullet import pybullet as pb
-import pymunk
-
 import engines
 from analytic.excitation import Pulse
-from engines import pybullet_engine as pbe
-from engines import pybullet_scene as ps
-from engines import pymunk_engine as pme
 from scenes import load_scene
 
 from . import machine, write
@@ -54,56 +47,25 @@ TARGET = 0.9  # issue 15: the harness keeps >= 90 % of the bare step rate
 
 
 # ------------------------------------------------------------------ bare loops
-def bare_pybullet(scene, excitation, s, steps: int) -> tuple[float, float, float]:
-    """Build the adapter's world, step it ``steps`` times.
+def bare(name: str, scene, excitation, s, steps: int) -> tuple[float, float, float]:
+    """The engine's own hooks without the harness: build its world, ``advance``
+    ``steps`` steps in one call (the same base-motion load as a run), read it once.
 
     Returns (stepping loop [s], construction + teardown [s], final theta)."""
     t_build = time.perf_counter()
-    world = ps.World(scene, excitation, s, pbe.default_friction(scene, excitation))
+    run = engines.get_backend(name)(scene, excitation, s)
+    run.build()
     t_build = time.perf_counter() - t_build
     try:
-        c, dt, g = world.client, s.dt, scene.g
-        accel, set_gravity, step = excitation.acceleration, pb.setGravity, pb.stepSimulation
         t0 = time.perf_counter()
-        for n in range(steps):
-            # The same mid-step load as World.step (gravity base motion).
-            set_gravity(-accel((n + 0.5) * dt), 0.0, -g, physicsClientId=c)
-            step(physicsClientId=c)
+        run.advance(steps)
         wall = time.perf_counter() - t0
-        world.step_index = steps
-        theta_l, theta_r = (ps.column_angle(c, body)[0] for body in world.bodies.columns)
+        left, right = run.read().columns
     finally:
         t_close = time.perf_counter()
-        world.close()
+        run.close()
         t_build += time.perf_counter() - t_close
-    return wall, t_build, 0.5 * (theta_l + theta_r)
-
-
-def bare_pymunk(scene, excitation, s, steps: int) -> tuple[float, float, float]:
-    """Build the adapter's world, step it ``steps`` times.
-
-    Returns (stepping loop [s], construction [s], final theta)."""
-    t_build = time.perf_counter()
-    world = pme._World(scene, s)
-    t_build = time.perf_counter() - t_build
-    space, dt, g = world.space, s.dt, scene.g
-    accel, step = excitation.acceleration, space.step
-    t_gravity_off = excitation.end_time + dt
-    t0 = time.perf_counter()
-    for n in range(steps):
-        t = n * dt
-        if t <= t_gravity_off:  # as the adapter: gravity is constant after the pulse
-            space.gravity = (-accel(t + 0.5 * dt), -g)
-        step(dt)
-    wall = time.perf_counter() - t0
-    cols = world.columns
-    return wall, t_build, 0.5 * (cols[0].angle + cols[1].angle)
-
-
-ENGINES = {
-    "pybullet": (pbe, bare_pybullet, pbe.version),
-    "pymunk": (pme, bare_pymunk, lambda: f"pymunk {pymunk.version}"),
-}
+    return wall, t_build, 0.5 * (left.angle + right.angle)
 
 
 def _harness(name, scene, excitation, s):
@@ -114,8 +76,7 @@ def _harness(name, scene, excitation, s):
 
 def measure(name: str, scene, excitation, repeats: int = REPEATS) -> dict:
     """Interleaved bare / harness timings of one engine and scene."""
-    module, bare, _ = ENGINES[name]
-    s = replace(module.Settings(), t_max=T_MAX)
+    s = replace(engines.get_backend(name).Settings(), t_max=T_MAX)
     _, tr = _harness(name, scene, excitation, s)  # warm-up; also gives the step count
     steps = int(tr.diagnostics["steps"])
     bare(scene, excitation, s, steps)  # warm-up
@@ -125,7 +86,7 @@ def measure(name: str, scene, excitation, repeats: int = REPEATS) -> dict:
         order = ("bare", "harness") if k % 2 == 0 else ("harness", "bare")
         for which in order:
             if which == "bare":
-                wall, build, theta_bare = bare(scene, excitation, s, steps)
+                wall, build, theta_bare = bare(name, scene, excitation, s, steps)
                 t_bare.append(wall)
                 t_build.append(build)
             else:
@@ -160,10 +121,10 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'engine':9} {'scene':12} {'steps':>6} {'bare st/s':>10} {'harness st/s':>12} "
           f"{'ratio':>6}  target {TARGET:.0%}  {'pairwise':>8} {'build ms':>8} "
           f"{'ratio incl. build':>17}")
-    for name in ENGINES:
+    for name in engines.engine_names():
         for label, sc in (("pendulum", scene), ("no pendulum", scene.without_pendulum())):
             r = measure(name, sc, pulse)
-            r["engine_version"] = ENGINES[name][2]()
+            r["engine_version"] = engines.get_backend(name).version()
             rows[f"{name} / {label}"] = r
             ok &= r["same_final_state"]
             flag = "met" if r["ratio"] >= TARGET else "MISSED"

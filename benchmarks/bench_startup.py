@@ -12,7 +12,7 @@ from pathlib import Path
 from . import machine, write
 
 ROOT = Path(__file__).resolve().parent.parent
-CMD = [sys.executable, "-m", "compare.cli", "spectrum", "--omega", "10"]
+CMD = [sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10"]
 
 
 def _env() -> dict:

@@ -41,7 +41,7 @@ def _report(out: Path, *store_args: str) -> tuple[float, float, dict]:
     import resource
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "compare.cli", "report", "--quick", "--out",
+    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "report", "--quick", "--out",
                            str(out), *store_args], cwd=ROOT, capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     wall = time.perf_counter() - t0
@@ -58,7 +58,7 @@ def per_run_overhead() -> dict:
     key (canonical JSON + SHA-256), a missed lookup, the insert (pickle + commit)
     on a miss; the lookup (select + unpickle) on a hit; against the run itself."""
     from analytic.excitation import Pulse
-    from compare.store import RunStore, run_key
+    from compare.run.store import RunStore, run_key
     from engines import get_backend
     from scenes import load_scene
 

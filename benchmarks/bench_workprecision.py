@@ -25,7 +25,7 @@ import sys
 import time
 from pathlib import Path
 
-from compare import atomic
+from compare.run import atomic
 
 from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
     plot_work_precision, write_json
@@ -44,13 +44,16 @@ METRICS = {
 }
 
 
-def run(quick: bool = False, out: Path | None = None, engines=("pybullet", "pymunk"),
+def run(quick: bool = False, out: Path | None = None, engines=None,
         analytic: bool = True, log=print) -> dict:
     """Measure, mark fronts, write JSON, plots and tables; return the payload."""
     from .workprecision_analytic import run_analytic
     from .workprecision_engines import run_engines
 
     out = Path(out) if out is not None else OUT_DIR
+    if engines is None:
+        from engines import engine_names
+        engines = engine_names()
     machine = machine_info()
     start = time.perf_counter()
     points: list[Point] = []
@@ -196,8 +199,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the < 2 min variant")
     parser.add_argument("--out", type=Path, default=None, help=f"output directory [{OUT_DIR}]")
-    parser.add_argument("--engines", default="pybullet,pymunk",
-                        help="comma-separated engines, or 'none' [pybullet,pymunk]")
+    parser.add_argument("--engines", default="all",
+                        help="comma-separated engines, 'all' or 'none' [all]")
     parser.add_argument("--no-analytic", action="store_true", help="skip the analytic paths")
     parser.add_argument("--regenerate", type=Path, default=None, metavar="JSON",
                         help="only rewrite plots and tables from a saved workprecision.json")
@@ -205,10 +208,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.regenerate is not None:
         regenerate(args.regenerate, args.out)
         return 0
-    engines = () if args.engines == "none" else tuple(e for e in args.engines.split(",") if e)
-    for e in engines:
-        if e not in ("pybullet", "pymunk"):
-            raise ValueError(f"--engines: unknown engine {e!r}; allowed: pybullet, pymunk, none")
+    from engines import engine_list
+    engines = () if args.engines == "none" else engine_list(args.engines)
     run(quick=args.quick, out=args.out, engines=engines, analytic=not args.no_analytic)
     return 0
 

@@ -8,7 +8,7 @@ Not part of ``make bench`` (a study, ~5 min on one core)::
 Part 1 runs every case at ``dt`` in {1e-4, 5e-5, 2.5e-5} s with the harness's
 per-step solver settings as they were (``old``: ``frictionERP`` 0.2 and
 ``solverResidualThreshold`` 1e-7 (m/s)^2 at every step) and as they are now
-(``new``: both scaled below 1e-4 s, ``engines.pybullet_scene``).  Part 2 changes
+(``new``: both scaled below 1e-4 s, ``engines.pybullet_.world``).  Part 2 changes
 one suspect at a time at dt = 2.5e-5 s.  Cases:
 
 * where the analytic model is valid: the Fig. 5 trilith at 0.97 and 1.03 of the
@@ -40,11 +40,9 @@ from engines._quiet_pybullet import pybullet as pb
 
 import engines
 from analytic.excitation import Pulse
-from compare.jsonable import plain
-from compare.restitution import measure_restitution
-from engines import pybullet_engine as pbe
-from engines import pybullet_scene as ps
-from engines.base import simulate_world
+from compare.run.jsonable import plain
+from compare.measure.restitution import measure_restitution
+from engines.pybullet_ import PyBulletEngine
 from scenes import load_scene
 
 from . import machine, write
@@ -58,36 +56,34 @@ NEW: dict = {}  # the defaults
 A_STAR = {(12.0, True): 19.948, (16.0, False): 18.932}
 
 
-class LiftWorld(ps.World):
-    """The adapter's world, plus the lintel's seat force read at every sample."""
+class LiftRun(PyBulletEngine):
+    """A PyBullet run that also reads the lintel's seat force at every sample."""
 
-    def __init__(self, *args, **kw):
-        super().__init__(*args, **kw)
+    def build(self):
+        super().build()
         sc = self.scene
         self.weight = (sc.m3 + (sc.m4 if sc.has_pendulum else 0.0)) * sc.g
-        self.diag.update(lintel_lift_t=math.nan, slide_before_lift=0.0, seat_force_min=math.inf)
+        self.lift = dict(lintel_lift_t=math.nan, slide_before_lift=0.0, seat_force_min=math.inf)
 
-    def sample(self):
-        out = super().sample()
-        d, b = self.diag, self.bodies
-        if b.lintel is not None and self.standing and math.isnan(d["lintel_lift_t"]):
+    def read(self):
+        state = super().read()
+        d, b = self.lift, self.bodies
+        if b.lintel is not None and self.diagnostics.standing and math.isnan(d["lintel_lift_t"]):
             force = sum(p[9] for col in b.columns
                         for p in pb.getContactPoints(b.lintel, col, physicsClientId=self.client))
-            d["slide_before_lift"] = d["pivot_sliding_max"]
+            d["slide_before_lift"] = self.diagnostics.values["pivot_sliding_max"]
             if self.step_index > 0:  # no contact exists before the first step
                 d["seat_force_min"] = min(d["seat_force_min"], force / self.weight)
                 if force < LIFT * self.weight:
-                    d["lintel_lift_t"] = self.step_index * self.s.dt
-        return out
+                    d["lintel_lift_t"] = self.step_index * self.settings.dt
+        return state
 
 
 def pulse_run(scene, pulse, dt: float, settings: dict) -> dict:
     s = engines.configure("pybullet", dt=dt, monitor={"t_cap": T_CAP}, **settings)
-    friction = pbe._validate(scene, pulse, s)
-    info = dict(s.describe(), friction_used=friction)
-    tr = simulate_world("pybullet", lambda: LiftWorld(scene, pulse, s, friction), scene, pulse,
-                        s, info)
-    d = tr.diagnostics
+    run = LiftRun(scene, pulse, s)
+    tr = run.run()
+    d = {**tr.diagnostics, **run.lift}
     keys = ("pivot_sliding_max", "penetration_max", "column_mismatch_max",
             "lintel_rotation_max", "out_of_plane_rotation_max", "lintel_lift_t",
             "slide_before_lift", "seat_force_min")
@@ -178,7 +174,7 @@ def main(argv: list[str] | None = None) -> int:
                 rows.append({"part": 2, "case": name, "variant": variant, "dt": DTS[-1], **r})
                 print(_line(name, variant, DTS[-1], r), flush=True)
     path = write("pybullet_small_step", plain({
-        "machine": info, "engine_version": pbe.version(), "t_cap": T_CAP,
+        "machine": info, "engine_version": PyBulletEngine.version(), "t_cap": T_CAP,
         "lift_fraction": LIFT, "old": OLD, "rows": rows,
         "wall_s": time.perf_counter() - t0}))
     print(f"{time.perf_counter() - t0:.0f} s; wrote {path}")

@@ -23,7 +23,7 @@ import numpy as np
 from analytic import Scene, Pulse, fast
 from analytic.simulate import Settings as AccSettings
 from analytic.simulate import simulate as simulate_acc
-from compare import runs  # untimed references only: through the run store (issue 12)
+from compare.run import runs  # untimed references only: through the run store
 
 from .workprecision_common import Point, bisect_threshold, timed
 

@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Callable
 
 
-from compare.jsonable import plain
+from compare.run.jsonable import plain
 
-from compare import atomic
+from compare.run import atomic
 
 __all__ = ["Point", "timed", "pareto_front", "mark_front", "bisect_threshold", "machine_info",
            "write_json", "plot_work_precision", "OUT_DIR"]

@@ -7,7 +7,7 @@ Three errors, all dimensionless:
   free rocking released from ``alpha/2``, worst of two triliths without pendulum:
   Fig. 5 (lam 5) and a squatter lam 3 (where Pymunk's solver iterations matter:
   10 iterations give 3.4 % there and 0.06 % at lam 5);
-  :func:`compare.restitution.measure_restitution`;
+  :func:`compare.measure.restitution.measure_restitution`;
 * ``theta-rms``: RMS of ``theta_engine - theta_analytic`` before the first impact,
   over ``alpha`` (Fig. 5 trilith with pendulum, one-sine 3 m/s^2 at 6 rad/s:
   uplift at 0.26 s, first impact at ~0.9 s);
@@ -31,9 +31,9 @@ import numpy as np
 
 from analytic import Pulse, Scene
 from analytic.simulate import Settings as AccSettings
-from compare import runs  # untimed references only: through the run store (issue 12)
+from compare.run import runs  # untimed references only: through the run store
 from engines import get_backend
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 
 from .workprecision_common import Point, bisect_threshold
 
@@ -171,7 +171,7 @@ def _configs(name: str, quick: bool):
             yield f"{name} {key}", {key: v}
 
 
-def run_engines(quick: bool, engines=("pybullet", "pymunk"), log=print) -> list[Point]:
+def run_engines(quick: bool, engines=("pybullet", "pymunk", "mujoco"), log=print) -> list[Point]:
     ref = _Reference(quick)
     log(f"  analytic references: first impact at {ref.t_impact:.4f} s; threshold "
         f"A = {ref.a_thr:.6g} m/s^2 at Omega = {THR_CASE['omega']} rad/s ({THR_CASE['t_max']} s window)")

@@ -15,12 +15,13 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
+import dataclasses
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 from analytic.bounds import required_friction
 from analytic.excitation import Pulse, SampledRecord, Still
-from analytic.options import RunOptions, check_real
+from analytic.options import MAX_RUN_STEPS, RunOptions, check_real
 from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
 
@@ -41,10 +42,6 @@ CAPABILITIES = {
     "trajectory": "simulate() samples theta(t) (every backend does)",
 }
 BASE_MOTIONS = ("gravity", "ground")
-# Largest run accepted: engine steps (length / dt).  5e6 steps is about 3 min of
-# PyBullet and 1 min of Pymunk on the reference machine (30 and 90 thousand
-# steps/s, README); the default runs need at most 1.3e6 (62.8 s pulse + 60 s).
-MAX_RUN_STEPS = 5_000_000
 # Default friction is at least this multiple of the no-sliding bound
 # (analytic.bounds.required_friction): 20 % headroom over a bound that is itself
 # conservative (it exceeded the exact demand along the analytic runs at A-D).
@@ -111,6 +108,12 @@ class EngineSettings(RunOptions):
         if not isinstance(self.monitor, MonitorSettings):
             raise TypeError(f"{owner}: monitor must be a MonitorSettings, "
                             f"got {type(self.monitor).__name__}")
+
+    def with_solver_iterations(self, n: int) -> EngineSettings:
+        """These settings with ``n`` solver iterations per step (engines declaring
+        ``solver_iterations``; each names its own field, this is the one way to
+        set it)."""
+        return dataclasses.replace(self, solver_iterations=n)
 
 
 def run_steps(settings: EngineSettings, excitation) -> int:
@@ -280,7 +283,8 @@ class Engine:
         s = self.settings
         wall0 = time.perf_counter()
         monitor = RunMonitor(self.scene, self.excitation, s)
-        diagnostics = Diagnostics(self.scene, self.excitation, s.monitor)
+        # Kept on the run: an engine's own extra readings may consult the window.
+        self.diagnostics = diagnostics = Diagnostics(self.scene, self.excitation, s.monitor)
         try:
             self.build()
             while True:

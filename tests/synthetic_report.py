@@ -6,7 +6,7 @@ Time histories are real analytic runs at the paper's points A and B; the
 show something).  Restitution, spectra and timings are made-up numbers with
 the campaign's structure, including a failing threshold point that carries the
 newer ``cause``/``cause_detail``/``convergence`` fields.  Verdicts are computed
-from them by :func:`compare.verdicts.build_verdicts`, as in a real campaign.
+from them by :func:`compare.campaign.verdicts.build_verdicts`, as in a real campaign.
 """
 from __future__ import annotations
 
@@ -16,9 +16,9 @@ import functools
 import numpy as np
 
 from analytic.excitation import Pulse
-from compare import metrics
-from compare.campaign import POINTS, CampaignConfig, CampaignResult
-from compare.verdicts import build_verdicts
+from compare.measure import trajectories as metrics
+from compare.campaign.validation import POINTS, CampaignConfig, CampaignResult
+from compare.campaign.verdicts import build_verdicts
 from scenes import load_scene
 
 ENGINES = ("pybullet", "pymunk")

@@ -14,7 +14,7 @@ from analytic.excitation import Pulse
 from analytic.parameters import Scene
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
-from compare.cli import main
+from compare.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -108,7 +108,7 @@ def test_cli_argparse_errors_exit_2(capsys):
 
 def test_cli_subprocess_one_line_error():
     exe = shutil.which("trilith", path=str(Path(sys.executable).parent))
-    cmd = [exe] if exe else [sys.executable, "-m", "compare.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "compare.cli.main"]
     proc = subprocess.run(cmd + ["simulate", "-A", "5", "-w", "0"], capture_output=True,
                           text=True, cwd=ROOT, timeout=120)
     assert proc.returncode == 2

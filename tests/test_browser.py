@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from compare.provenance import collect
-from compare.report_html import write_report
+from compare.run.provenance import collect
+from compare.report.html import write_report
 
 BROWSER = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome")
                 if shutil.which(n)), None)
@@ -168,7 +168,7 @@ def test_the_overflow_probe_detects_overflow(tmp_path):
 def test_real_quick_report_in_the_browser(tmp_path):
     """A real ``trilith report --quick`` (~1-2 min on 2 busy cores): the QUICK
     banner, the trust table for each engine, and the same browser checks."""
-    from compare.cli import main
+    from compare.cli.main import main
 
     out = tmp_path / "report"
     assert main(["report", "--quick", "--out", str(out)]) == 0

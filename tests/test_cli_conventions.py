@@ -13,8 +13,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from compare.cli import main
-from compare.commands._common import SCHEMA_VERSION, resolve_workers
+from compare.cli.main import main
+from compare.cli.options import SCHEMA_VERSION, resolve_workers
 from scenes import load_record, load_scene, scene_names
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -24,7 +24,7 @@ SAMPLE_AT2 = ROOT / "scenes" / "records" / "sample.AT2"
 
 def _cli(*args, **kwargs) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.Popen([sys.executable, "-m", "compare.cli", *args], cwd=ROOT, env=env,
+    return subprocess.Popen([sys.executable, "-m", "compare.cli.main", *args], cwd=ROOT, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
 
@@ -92,7 +92,7 @@ def test_simulate_json_inputs(capsys):
 
 
 def test_deprecated_engines_spelling_notes_once(monkeypatch, capsys):
-    import compare.commands.bench as bench_cmd
+    import compare.cli.bench as bench_cmd
     fake = SimpleNamespace(run=lambda **kw: {"points": []}, _dominates=lambda p, d: False)
     monkeypatch.setattr(bench_cmd, "_load_bench", lambda: fake)
     assert main(["bench", "--engines", "pymunk"]) == 0
@@ -108,7 +108,7 @@ def _point(family, error, time, default=False):
 @pytest.mark.parametrize("strict", [False, True])
 def test_bench_strict(monkeypatch, capsys, strict):
     import benchmarks.bench_workprecision as real
-    import compare.commands.bench as bench_cmd
+    import compare.cli.bench as bench_cmd
     # The default (error 1e-3 in 1 s) is dominated by 1e-4 in 0.5 s.
     points = [_point("pymunk dt", 1e-3, 1.0, default=True), _point("pymunk dt", 1e-4, 0.5)]
     fake = SimpleNamespace(run=lambda **kw: {"points": points}, _dominates=real._dominates)
@@ -120,16 +120,16 @@ def test_bench_strict(monkeypatch, capsys, strict):
 
 @pytest.mark.parametrize("strict", [False, True])
 def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, strict):
-    import compare.campaign
-    import compare.report_html
+    import compare.campaign.validation
+    import compare.report.html
     verdicts = [{"metric": "restitution vs Eq. 20", "backend": "pymunk",
                  "value": 0.012007074700878338, "tolerance": 0.005, "passed": False,
                  "unit": "relative"},
                 {"metric": "verdicts", "backend": "pymunk", "value": 0, "tolerance": 0,
                  "passed": True, "unit": "count"}]
-    monkeypatch.setattr(compare.campaign, "run_campaign",
+    monkeypatch.setattr(compare.campaign.validation, "run_campaign",
                         lambda config: SimpleNamespace(verdicts=verdicts, versions={}))
-    monkeypatch.setattr(compare.report_html, "write_report",
+    monkeypatch.setattr(compare.report.html, "write_report",
                         lambda result, out, provenance=None: {"html": Path(out) / "index.html"})
     argv = ["report", "--quick", "--out", str(tmp_path / "r")] + (["--strict"] if strict else [])
     assert main(argv) == (1 if strict else 0)
@@ -208,7 +208,7 @@ def test_stored_spectrum_needs_no_numba(tmp_path):
     and the output is the first run's.  (One worker: the first run computes in
     this process, so it must import numba.)"""
     argv = ["spectrum", "--omega", "9:11:1", "--workers", "1", "--cache", str(tmp_path), "--json"]
-    code = (f"import sys; from compare.cli import main; main({argv!r}); "
+    code = (f"import sys; from compare.cli.main import main; main({argv!r}); "
             "print('numba' in sys.modules, file=sys.stderr)")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     first, again = (subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env,

@@ -1,4 +1,4 @@
-"""The Dask path of compare.runs.run_many against the local one, on a real local
+"""The Dask path of compare.run.runs.run_many against the local one, on a real local
 cluster: a scheduler and two worker processes (``LocalCluster(processes=True)``:
 each worker is a separate Python process started by its nanny)."""
 from __future__ import annotations
@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from compare import runs
-from compare.campaign import CampaignConfig, _run_one
-from compare.store import RunStore
+from compare.run import runs
+from compare.campaign.validation import CampaignConfig, _run_one
+from compare.run.store import RunStore
 from test_store import assert_same_trajectory
 
 distributed = pytest.importorskip("distributed")
@@ -63,7 +63,7 @@ def test_dask_workers_fill_the_callers_store(cluster, fig5, tmp_path):
 
 def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
     def spectrum(*extra):
-        proc = subprocess.run([sys.executable, "-m", "compare.cli", "spectrum", "--omega",
+        proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega",
                                "8:14:2", "--json", "--no-cache", *extra], cwd=ROOT,
                               env=os.environ, capture_output=True, text=True, timeout=600)
         assert proc.returncode == 0, proc.stderr
@@ -74,7 +74,7 @@ def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
 
 
 def test_unreachable_scheduler_is_a_usage_error():
-    proc = subprocess.run([sys.executable, "-m", "compare.cli", "spectrum", "--omega", "10",
+    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10",
                            "--no-cache", "--scheduler", "tcp://127.0.0.1:9"], cwd=ROOT,
                           env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
                           text=True, timeout=120)

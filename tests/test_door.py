@@ -17,7 +17,7 @@ import pytest
 
 from analytic.excitation import Pulse, SampledRecord
 from analytic.parameters import Scene
-from compare.cli import main
+from compare.cli.main import main
 from scenes import load_record, load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,28 +35,24 @@ def no_work(monkeypatch):
     import analytic.fast
     import analytic.simulate
     import analytic.spectrum
-    import compare.campaign
-    import compare.commands.bench
-    import compare.commands.record
-    import compare.commands.view
-    import compare.figures
-    import engines.pybullet_engine
-    import compare.restitution
-    import engines.mujoco_engine
-    import engines.pymunk_engine
+    import compare.campaign.validation
+    import compare.cli.bench
+    import compare.cli.record
+    import compare.cli.view
+    import compare.measure.restitution
+    import compare.report.figures
+    import engines.base
 
     def boom(*args, **kwargs):
         raise WorkStarted("work started before the input was checked")
 
     for module, name in ((analytic.simulate, "simulate"), (analytic.fast, "simulate"),
-                         (engines.pymunk_engine, "simulate"),
-                         (engines.pybullet_engine, "simulate"),
-                         (engines.mujoco_engine, "simulate"),
+                         (engines.base.Engine, "run"),  # every registered engine
                          (analytic.spectrum, "overturning_spectrum"),
-                         (compare.campaign, "run_campaign"), (compare.figures, "make_figures"),
-                         (compare.commands.record, "record"), (compare.commands.view, "view"),
-                         (compare.commands.bench, "_load_bench"),
-                         (compare.restitution, "measure_restitution")):
+                         (compare.campaign.validation, "run_campaign"), (compare.report.figures, "make_figures"),
+                         (compare.cli.record, "record"), (compare.cli.view, "view"),
+                         (compare.cli.bench, "_load_bench"),
+                         (compare.measure.restitution, "measure_restitution")):
         monkeypatch.setattr(module, name, boom)
 
 

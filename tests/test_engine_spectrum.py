@@ -10,8 +10,8 @@ import pytest
 import engines
 from analytic.excitation import Pulse
 from analytic.spectrum import SpectrumSettings, overturning_spectrum
-from compare import engine_spectrum as es
-from compare.cli import main
+from compare.measure import engine_spectrum as es
+from compare.cli.main import main
 from scenes import load_scene
 
 
@@ -85,7 +85,7 @@ def test_cause_discretisation_on_a_point_that_converges(fig5_ref):
     scene, ref = fig5_ref
     bare = scene.without_pendulum()
     settings = engines.configure("pymunk")
-    from compare.thresholds import engine_threshold
+    from compare.measure.thresholds import engine_threshold
     point = engine_threshold("pymunk", bare, 12.0, float(ref.a_no_pendulum[0]), settings,
                              rel_tol=5e-3, rel_bracket=0.03)
     assert abs(point.rel_error) > es.DEFAULT_TOL, point.rel_error
@@ -99,8 +99,8 @@ def test_cause_contact_when_the_error_does_not_shrink(monkeypatch, fig5_ref):
     """The classification rule on a point whose error stays at -5 % at dt/2 and dt/4
     (the bisections replaced by fixed results, the model check by a valid one): no
     convergence, so the cause is the contact, with the diagnostic named."""
-    from compare.metrics import Provenance
-    from compare.thresholds import ThresholdPoint
+    from compare.measure.trajectories import Provenance
+    from compare.measure.thresholds import ThresholdPoint
     scene, _ = fig5_ref
     prov = Provenance("pymunk", "", 1e-4, {}, 0.0)
 
@@ -121,8 +121,8 @@ def test_cause_model_where_the_lintel_would_be_thrown_off():
     """Omega 24 with the pendulum: the model's own threshold is 64.66 m/s^2, where its
     lintel normal force is negative (about -0.3 of the weight, docs/model.md): whatever
     the engine says there, the cause is the model's assumption, not the engine."""
-    from compare.metrics import Provenance
-    from compare.thresholds import ThresholdPoint
+    from compare.measure.trajectories import Provenance
+    from compare.measure.thresholds import ThresholdPoint
     scene = load_scene("fig5")
     p = ThresholdPoint(24.0, "sine", 64.66, 66.4, 66.0, "no-impact", "no-impact", 5, 0, 5e-3,
                        Provenance("pymunk", "", 1e-4, {}, 0.0))
@@ -134,8 +134,8 @@ def test_cause_window_where_the_model_survives_again():
     """Omega 9 with the pendulum: the model overturns from 5.64 m/s^2, survives again
     at 5.82-5.92 and overturns from 5.94 (fast path, 0.02 steps); Pymunk and MuJoCo
     both first overturn at 5.95 (measured 2026-11-23): the next onset, a window."""
-    from compare.metrics import Provenance
-    from compare.thresholds import ThresholdPoint
+    from compare.measure.trajectories import Provenance
+    from compare.measure.thresholds import ThresholdPoint
     scene = load_scene("fig5")
     p = ThresholdPoint(9.0, "sine", 5.6417, 5.952, 5.93, "after-impact", "after-impact", 6, 0,
                        5e-3, Provenance("pymunk", "", 1e-4, {}, 0.0))

@@ -13,9 +13,9 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "docs" / "examples"
 
 # Public entry points whose numpydoc Examples must run as written.
 DOCTEST_MODULES = ("analytic.options", "analytic.parameters", "analytic.excitation",
-                   "analytic.reactions", "analytic.contact_forces", "engines",
-                   "compare.restitution", "compare.jsonable", "scenes.points",
-                   "scenes.ground_motion", "engines.mujoco_engine")
+                   "analytic.bounds", "analytic.contact_forces", "engines",
+                   "compare.measure.restitution", "compare.run.jsonable", "scenes.points",
+                   "scenes.ground_motion", "engines.mujoco_")
 
 
 @pytest.mark.parametrize("module", DOCTEST_MODULES)

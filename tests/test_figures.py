@@ -1,4 +1,4 @@
-"""``trilith figures`` (compare/figures.py): the paper's spectrum figures as PNG plus
+"""``trilith figures`` (compare/report/figures.py): the paper's spectrum figures as PNG plus
 figures.json, checked for completeness, internal consistency and agreement with
 ``analytic.spectrum`` called directly."""
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import pytest
 
 from analytic.spectrum import overturning_spectrum
-from compare.cli import main as cli_main
-from compare.figures import (FIGURES, FigureSettings, compute_spectra, figure_size, omega_grid,
+from compare.cli.main import main as cli_main
+from compare.report.figures import (FIGURES, FigureSettings, compute_spectra, figure_size, omega_grid,
                              plot_figure, quick_settings)
 from scenes import load_scene
 

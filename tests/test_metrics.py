@@ -1,4 +1,4 @@
-"""compare.metrics / compare.thresholds on synthetic trajectories and fake backends.
+"""compare.measure.trajectories / compare.measure.thresholds on synthetic trajectories and fake backends.
 
 Expected values come from closed forms (sinusoid differences, Housner's
 restitution), never from running the code under test.
@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-import compare.thresholds as thr
+import compare.measure.thresholds as thr
 from analytic.parameters import Scene
 from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
-from compare import metrics
-from compare.restitution import restitution_from_trajectory
+from compare.measure import trajectories as metrics
+from compare.measure.restitution import restitution_from_trajectory
 
 ALPHA = 0.2
 
@@ -223,10 +223,10 @@ def test_uplift_timed_at_the_same_angle_in_both_runs():
 
 
 def test_tongue_tip_is_where_the_spectrum_mode_changes():
-    """The jump located by compare.spectra sits where analytic.spectrum's first
+    """The jump located by compare.measure.reference_spectra sits where analytic.spectrum's first
     overturning mode switches (an independent scan + bisection)."""
-    from compare.campaign import CampaignConfig
-    from compare.spectra import first_overturning_amplitude, reference_spectrum
+    from compare.campaign.validation import CampaignConfig
+    from compare.measure.reference_spectra import first_overturning_amplitude, reference_spectrum
     from scenes import load_scene
 
     scene = load_scene("no_pendulum")

@@ -19,11 +19,10 @@ import pytest
 
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
-from compare.spectra import first_overturning_amplitude
-from compare.thresholds import engine_threshold
-from engines import mujoco_engine as me
-from engines import mujoco_scene as ms
-from compare.restitution import measure_restitution
+from compare.measure.reference_spectra import first_overturning_amplitude
+from compare.measure.thresholds import engine_threshold
+from engines.mujoco_ import MujocoEngine, Settings
+from compare.measure.restitution import measure_restitution
 from scenes import load_scene
 
 # Issue acceptance: 0.5 %.  Measured at the defaults (docs/mujoco.md): max
@@ -46,10 +45,10 @@ def test_overturning_threshold_within_2_percent():
 
 def test_reruns_are_bit_identical():
     scene, pulse = load_scene("fig5"), Pulse(4.0, 9.0)
-    st = me.Settings(t_max=0.4)
-    first = me.simulate(scene, pulse, st)
-    me.simulate(scene, pulse, dataclasses.replace(st, dampratio=1.0, t_max=0.1))
-    second = me.simulate(scene, pulse, st)
+    st = Settings(t_max=0.4)
+    first = MujocoEngine.simulate(scene, pulse, st)
+    MujocoEngine.simulate(scene, pulse, dataclasses.replace(st, dampratio=1.0, t_max=0.1))
+    second = MujocoEngine.simulate(scene, pulse, st)
     for name in ("t", "theta", "theta_dot", "psi", "psi_dot"):
         assert np.array_equal(getattr(first, name), getattr(second, name)), name
     assert first.max_abs_theta > 1e-3  # it rocked
@@ -70,14 +69,14 @@ def test_bad_settings_raise_before_a_model_is_built(monkeypatch, changes, name):
     monkeypatch.setattr(mujoco.MjModel, "from_xml_string",
                         lambda *a, **k: pytest.fail("model built before validation"))
     with pytest.raises((ValueError, TypeError), match=name):  # at construction or at the run
-        me.simulate(load_scene("fig5"), Pulse(10.0, 9.0),
-                    dataclasses.replace(me.Settings(), **changes))
+        MujocoEngine.simulate(load_scene("fig5"), Pulse(10.0, 9.0),
+                    dataclasses.replace(Settings(), **changes))
 
 
 def test_massless_lintel_with_pendulum_is_refused(monkeypatch):
     monkeypatch.setattr(mujoco.MjModel, "from_xml_string", lambda *a, **k: pytest.fail("built"))
     with pytest.raises(ValueError, match="mu"):
-        me.simulate(Scene(mu=0.0, gamma=0.3), Pulse(3.0, 6.0))
+        MujocoEngine.simulate(Scene(mu=0.0, gamma=0.3), Pulse(3.0, 6.0))
 
 
 def test_model_is_generated_from_the_scene():
@@ -85,7 +84,8 @@ def test_model_is_generated_from_the_scene():
     scene whose every engine-only field differs from its default."""
     scene = Scene(b=0.4, lam=4.0, mu=1.5, gamma=0.2, l=0.9, gap=1.1, lintel_height=0.3,
                   hinge_x=0.2, depth=0.7, J_G=2.0 * Scene(b=0.4, lam=4.0).inertia_J_G)
-    w = ms.World(scene, Still(), me.Settings(), 10.0)
+    w = MujocoEngine(scene, Still(), Settings())
+    w.build()
     m = w.model
 
     def body(name):
@@ -115,7 +115,8 @@ def test_model_is_generated_from_the_scene():
 def test_mu_zero_builds_no_lintel_and_rocks_as_housner():
     """mu = 0: two independent blocks; Eq. 20 is then Housner's 1 - 1.5 sin^2 alpha."""
     scene = load_scene("single_block")
-    w = ms.World(scene, Still(), me.Settings(), 10.0)
+    w = MujocoEngine(scene, Still(), Settings())
+    w.build()
     assert w.model.nbody == 3 and w.lintel is None  # world + two columns
     res = measure_restitution("mujoco", scene, 0.5 * scene.alpha, n_impacts=2)
     assert res.impacts[0].predicted == pytest.approx(1.0 - 1.5 * math.sin(scene.alpha) ** 2,
@@ -129,12 +130,13 @@ def test_tilted_start_rests_on_its_pivots_and_rocks_to_the_other_side(sign):
     start on the ground and the lintel's underside on the raised top corners."""
     scene = load_scene("no_pendulum")
     theta0 = sign * 0.3 * scene.alpha
-    w = ms.World(scene, Still(), me.Settings(theta0=theta0), 10.0)
+    w = MujocoEngine(scene, Still(), Settings(theta0=theta0))
+    w.build()
     mujoco.mj_forward(w.model, w.data)
     assert w.data.ncon > 0
     assert np.min(w.data.contact.dist[:w.data.ncon]) == pytest.approx(0.0, abs=1e-12)
-    assert w.sample()[:2] == (theta0, theta0)
-    tr = me.simulate(scene, Still(), me.Settings(theta0=theta0, t_max=0.8,
+    assert tuple(c.angle for c in w.read().columns) == (theta0, theta0)
+    tr = MujocoEngine.simulate(scene, Still(), Settings(theta0=theta0, t_max=0.8,
                                                  early_stop=False))
     assert tr.theta[0] == theta0
     assert np.sign(tr.theta_dot[5]) == -sign
@@ -145,17 +147,15 @@ def test_tilted_start_rests_on_its_pivots_and_rocks_to_the_other_side(sign):
 def test_mujoco_reset_warning_ends_the_run_as_unstable(monkeypatch):
     """A velocity beyond MuJoCo's limit (1e10) makes mj_step reset the state and
     warn; the run must stop as 'unstable' then, not carry on from the reset."""
-    real = ms.World.advance
+    class Kicked(MujocoEngine):
+        def advance(self, steps):
+            if self.step_index * self.settings.dt >= 0.2:
+                self.data.qvel[0] = 1e11
+            super().advance(steps)
 
-    def kick(self, count):
-        if self.step_index * self.s.dt >= 0.2:
-            self.data.qvel[0] = 1e11
-        real(self, count)
-
-    monkeypatch.setattr(ms.World, "advance", kick)
-    tr = me.simulate(load_scene("fig5"), Pulse(4.0, 9.0), me.Settings(t_max=1.0))
+    tr = Kicked.simulate(load_scene("fig5"), Pulse(4.0, 9.0), Settings(t_max=1.0))
     assert tr.verdict.status == "unstable"
     assert "mjWARN_BADQVEL" in tr.verdict.reason
-    spacing = me.Settings().sample_every * me.Settings().dt  # seen at the next sample
+    spacing = Settings().sample_every * Settings().dt  # seen at the next sample
     assert 0.2 < tr.verdict.time <= 0.2 + spacing + 1e-9
 

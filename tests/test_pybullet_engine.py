@@ -17,9 +17,10 @@ import pybullet
 
 from analytic.excitation import Pulse, Still
 from analytic.parameters import Scene
-from engines import pybullet_engine as pe
-from engines import pybullet_scene as ps
-from compare.restitution import measure_restitution
+from engines.pybullet_ import PyBulletEngine, Settings
+from engines.pybullet_ import bodies as pbb
+from engines.pybullet_ import world as ps
+from compare.measure.restitution import measure_restitution
 from scenes import load_scene
 
 # Restitution tolerance (issue acceptance): 0.5 %.  The measured errors are
@@ -35,9 +36,9 @@ def test_theta_sign_convention():
     """theta0 > 0 leans left: the left column's left bottom corner stays the pivot,
     the trilith falls back towards theta = 0 and rocks onto the right corners."""
     scene = Scene(lam=5.0, mu=1.0, gamma=0.0)
-    st = pe.Settings(theta0=0.3 * scene.alpha, t_max=0.8,
+    st = Settings(theta0=0.3 * scene.alpha, t_max=0.8,
                      early_stop=False)
-    tr = pe.simulate(scene, Still(), st)
+    tr = PyBulletEngine.simulate(scene, Still(), st)
     assert tr.theta[0] == pytest.approx(0.3 * scene.alpha, rel=1e-6)
     assert tr.theta_dot[5] < 0.0
     assert tr.impacts and tr.impacts[0].side == -1
@@ -49,7 +50,7 @@ def test_initial_poses_put_every_contact_at_zero_gap():
     on the raised top corners, so nothing starts penetrating or floating."""
     scene = load_scene("fig5")
     theta0 = 0.1
-    poses = ps.initial_poses(scene, theta0, 0.0)
+    poses = pbb.initial_poses(scene, theta0, 0.0)
     b, h = scene.b, scene.h
     c, s = math.cos(theta0), math.sin(theta0)
     for (x, z), x_left in zip(poses["columns"], (0.0, b + scene.d)):
@@ -79,13 +80,13 @@ def test_bad_settings_raise_before_stepping(monkeypatch, changes, name):
     monkeypatch.setattr(pybullet, "connect", no_engine)
     scene = load_scene("fig5")
     with pytest.raises((ValueError, TypeError), match=name):  # at construction or at the run
-        pe.simulate(scene, Pulse(10.0, 9.0), dataclasses.replace(pe.Settings(), **changes))
+        PyBulletEngine.simulate(scene, Pulse(10.0, 9.0), dataclasses.replace(Settings(), **changes))
 
 
 def test_massless_lintel_with_pendulum_is_refused(monkeypatch):
     monkeypatch.setattr(pybullet, "connect", lambda *a, **k: pytest.fail("stepped"))
     with pytest.raises(ValueError, match="mu"):
-        pe.simulate(Scene(mu=0.0, gamma=0.3), Pulse(3.0, 6.0))
+        PyBulletEngine.simulate(Scene(mu=0.0, gamma=0.3), Pulse(3.0, 6.0))
 
 
 def test_single_block_without_lintel_rocks_as_housner():
@@ -110,10 +111,10 @@ def test_non_finite_state_gives_unstable(monkeypatch):
         # two columns read per sample; samples every sample_every steps
         return (math.nan if calls["n"] > 2 * n_samples else theta), rate, pos, quat
 
-    settings = pe.Settings(t_max=2.0)
+    settings = Settings(t_max=2.0)
     n_samples = round(0.2 / (settings.dt * settings.sample_every))
     monkeypatch.setattr(ps, "column_angle", poisoned)
-    tr = pe.simulate(load_scene("fig5"), Pulse(4.0, 9.0), settings)
+    tr = PyBulletEngine.simulate(load_scene("fig5"), Pulse(4.0, 9.0), settings)
     assert tr.verdict.status == "unstable"
     assert tr.verdict.time == pytest.approx(0.2, abs=2e-3)
     assert np.all(np.isfinite(tr.theta))
@@ -123,11 +124,11 @@ def test_reruns_are_bit_identical_and_isolated():
     """A fresh world per run, every engine parameter reset: the same numbers even
     after a run with other (process-global) contact settings."""
     scene, pulse = load_scene("fig5"), Pulse(4.0, 9.0)
-    st = pe.Settings(t_max=0.6)
-    first = pe.simulate(scene, pulse, st)
-    pe.simulate(scene, pulse, dataclasses.replace(st, contact_breaking_threshold=0.05,
+    st = Settings(t_max=0.6)
+    first = PyBulletEngine.simulate(scene, pulse, st)
+    PyBulletEngine.simulate(scene, pulse, dataclasses.replace(st, contact_breaking_threshold=0.05,
                                                   contact_slop=1e-5, t_max=0.1))
-    second = pe.simulate(scene, pulse, st)
+    second = PyBulletEngine.simulate(scene, pulse, st)
     for field in ("t", "theta", "theta_dot", "psi", "psi_dot"):
         assert np.array_equal(getattr(first, field), getattr(second, field)), field
     assert first.max_abs_theta > 1e-3
@@ -135,13 +136,13 @@ def test_reruns_are_bit_identical_and_isolated():
 
 def test_render_frames_headless():
     scene = load_scene("fig5")
-    frames = pe.render_frames(scene, Pulse(4.0, 9.0), [0.0, 0.5], width=64, height=48)
+    frames = PyBulletEngine.render_frames(scene, Pulse(4.0, 9.0), [0.0, 0.5], width=64, height=48)
     assert len(frames) == 2
     for f in frames:
         assert f.shape == (48, 64, 3) and f.dtype == np.uint8
         assert f.min() < f.max()  # something was drawn
     with pytest.raises(ValueError, match="times"):
-        pe.render_frames(scene, Pulse(4.0, 9.0), [0.5, 0.1])
+        PyBulletEngine.render_frames(scene, Pulse(4.0, 9.0), [0.5, 0.1])
 
 
 # ------------------------------------------------------------ regression: start
@@ -150,19 +151,19 @@ def test_bodies_start_at_rest_on_their_contacts():
     settle.  Placed at zero gap they fell freely through the slop (1e-4 m in
     ~4.5 ms, no contact force, hence no friction) before landing."""
     scene = load_scene("fig5")
-    s = pe.Settings()
-    poses = ps.initial_poses(scene, 0.0, 0.0, sink=1e-4)
+    s = Settings()
+    poses = pbb.initial_poses(scene, 0.0, 0.0, sink=1e-4)
     assert poses["columns"][0][1] == pytest.approx(0.5 * scene.h - 1e-4, abs=1e-12)
     assert poses["lintel"][1] == pytest.approx(
         scene.h + 0.5 * scene.lintel_thickness - 2e-4, abs=1e-12)
-    world = ps.World(scene, Still(), s, pe.default_friction(scene, Still()))
+    engine = PyBulletEngine(scene, Still(), s)
+    engine.build()
     try:
-        z0 = [world._pose(b)[0][2] for b in world.bodies.dynamic]
-        for _ in range(50):  # 5 ms: the old free fall covered 1e-4 m by then
-            world.step()
-        z1 = [world._pose(b)[0][2] for b in world.bodies.dynamic]
+        z0 = [c.y for c in engine.read().columns] + [engine.read().lintel.y]
+        engine.advance(50)  # 5 ms: the old free fall covered 1e-4 m by then
+        z1 = [c.y for c in engine.read().columns] + [engine.read().lintel.y]
     finally:
-        world.close()
+        engine.close()
     # 1e-6 m: 1 % of the old fall; a resting contact moves by solver noise only.
     assert max(abs(a - b) for a, b in zip(z0, z1)) < 1e-6
 
@@ -175,17 +176,17 @@ def test_uplift_time_at_point_a_matches_eq9():
     landing's friction impulse set them rocking 3.9 ms early (theta RMS before
     the first impact 8.5e-3 alpha).  Measured after the fix: -0.17 ms, 2.6e-4 alpha.
     """
-    from compare.metrics import compare_trajectories
+    from compare.measure.trajectories import compare_trajectories
     from analytic.simulate import Settings as AnalyticSettings, simulate as analytic_simulate
 
     scene, pulse = load_scene("fig5"), Pulse(19.0, 15.0)
     t_max = 0.15  # past the first impact of both runs (~0.11 s)
     ref = analytic_simulate(scene, pulse, AnalyticSettings(t_max=t_max))
-    tr = pe.simulate(scene, pulse, pe.Settings(t_max=t_max))
+    tr = PyBulletEngine.simulate(scene, pulse, Settings(t_max=t_max))
     cmp = compare_trajectories(ref, tr)
     # 1 ms: one sample interval of the engine (uplift interpolated between samples).
     assert abs(cmp.uplift_time_error) < 1e-3, cmp.uplift_time_error
-    # 1e-3 alpha: the campaign's theta tolerance (compare.campaign.Tolerances).
+    # 1e-3 alpha: the campaign's theta tolerance (compare.campaign.validation.Tolerances).
     assert cmp.theta_rms_first < 1e-3, cmp.theta_rms_first
     assert cmp.t_first_impact > cmp.t_start + 0.05  # a real window, not a few samples
     assert tr.diagnostics["pivot_sliding_max"] < 1e-5  # no sliding at the default friction
@@ -207,7 +208,7 @@ def test_strong_pulse_overturns_as_in_the_model(run_analytic, name, amplitude, o
     scene = load_scene(name)
     ref = run_analytic(scene, amplitude, omega)
     assert (ref.verdict.status, ref.verdict.mode) == ("overturned", "no-impact")
-    tr = pe.simulate(scene, Pulse(amplitude, omega))
+    tr = PyBulletEngine.simulate(scene, Pulse(amplitude, omega))
     assert tr.verdict.status in ("overturned", "collapsed"), tr.verdict
     if tr.verdict.status == "collapsed":
         assert "out of step" in tr.verdict.reason or "slid" in tr.verdict.reason
@@ -235,7 +236,7 @@ def test_monitor_parting_before_certainty_is_collapse_after_it_is_the_fall():
     frame the model describes no longer exists, 'collapsed' (never 'overturned').
     Once the fall is certain (after the pulse, past alpha with the energy below
     the barrier) the columns may part: the fallen column decides the verdict."""
-    from engines._common import RunMonitor
+    from engines.monitor import RunMonitor
     from engines.base import EngineSettings
 
     scene = load_scene("no_pendulum")

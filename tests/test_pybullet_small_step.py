@@ -17,8 +17,8 @@ import pytest
 
 import engines
 from analytic.excitation import Pulse
-from compare.restitution import measure_restitution
-from engines import pybullet_scene as ps
+from compare.measure.restitution import measure_restitution
+from engines.pybullet_ import world as ps
 from scenes import load_scene
 
 SMALL_DT = 2.5e-5

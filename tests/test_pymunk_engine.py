@@ -19,7 +19,7 @@ from analytic.parameters import Scene
 from analytic.bounds import required_friction
 from engines.pymunk_ import PymunkEngine, Settings
 from engines.pymunk_ import world as pw
-from compare.restitution import measure_restitution
+from compare.measure.restitution import measure_restitution
 
 # ---------------------------------------------------------------- restitution
 # The acceptance bound of the engine contract.  Measured at the defaults, first

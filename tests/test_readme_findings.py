@@ -1,7 +1,7 @@
 """The README's engine findings are not typed by hand: the block between the
-findings markers is exactly what ``compare.findings.render`` makes of the stored
+findings markers is exactly what ``compare.report.findings.render`` makes of the stored
 full-campaign summary (``docs/validation/summary.json``), and that summary's
-trust table is what ``compare.trust`` computes from its own measurements."""
+trust table is what ``compare.report.trust`` computes from its own measurements."""
 from __future__ import annotations
 
 import json
@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from compare.findings import BEGIN, END, render
-from compare.trust import trust_table
-from compare.verdicts import VERDICT_IDS
+from compare.report.findings import BEGIN, END, render
+from compare.report.trust import trust_table
+from compare.campaign.verdicts import VERDICT_IDS
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -28,7 +28,7 @@ def test_readme_block_is_generated_from_the_summary(doc):
     assert text.count(BEGIN) == 1 and text.count(END) == 1
     block = text.split(BEGIN, 1)[1].split(END, 1)[0].strip("\n")
     assert block == render(doc), ("README findings differ from docs/validation/summary.json; "
-                                  "run: python -m compare.findings docs/validation/summary.json "
+                                  "run: python -m compare.report.findings docs/validation/summary.json "
                                   "README.md")
 
 
@@ -36,7 +36,7 @@ def test_stored_summary_is_a_full_campaign_with_a_consistent_trust_table(doc):
     assert doc["schema_version"] == 2 and doc["quick"] is False
     assert "--quick" not in doc["provenance"]["command"]
     assert {v["id"] for v in doc["verdicts"]} == set(VERDICT_IDS)
-    # The stored trust table is what compare.trust computes from the stored
+    # The stored trust table is what compare.report.trust computes from the stored
     # measurements (the conclusion's wording may have been improved since).
     recomputed = trust_table(doc)
     strip = lambda t: {e: {k: v for k, v in row.items() if k != "conclusion"}  # noqa: E731

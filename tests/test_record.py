@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-import scenes.record as rec
+import compare.show.record as rec
 from analytic.excitation import Pulse
 from analytic.trajectory import OverturnCriterion, Trajectory, Verdict
-from compare.cli import main
+from compare.cli.main import main
 from scenes import load_scene
-from scenes.draw import bob_radius, trilith_shape, view_limits
-from scenes.view import display_problem
+from compare.show.draw import bob_radius, trilith_shape, view_limits
+from compare.show.view import display_problem
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 FIG5 = load_scene("fig5")
@@ -346,7 +346,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
     animation steps (the same Panels as recordings)."""
     import matplotlib.pyplot as plt
 
-    import scenes.view as view_mod
+    import compare.show.view as view_mod
 
     shown = {}
 
@@ -368,7 +368,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
 
 
 def test_view_pybullet_uses_its_own_gui(monkeypatch):
-    import scenes.view as view_mod
+    import compare.show.view as view_mod
 
     calls = []
 

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import pytest
 
-from compare.campaign import CampaignConfig, Tolerances, backend_settings
-from compare.spectra import first_overturning_amplitude, monotone_above
-from compare.thresholds import engine_threshold
+from compare.campaign.validation import CampaignConfig, Tolerances, backend_settings
+from compare.measure.reference_spectra import first_overturning_amplitude, monotone_above
+from compare.measure.thresholds import engine_threshold
 from engines import ENGINES
 from scenes import load_scene
 

@@ -13,10 +13,10 @@ import json
 
 import pytest
 
-from compare.campaign import CampaignConfig, run_campaign
-from compare.cli import main
-from compare.report_html import write_report
-from compare.verdicts import VERDICT_IDS
+from compare.campaign.validation import CampaignConfig, run_campaign
+from compare.cli.main import main
+from compare.report.html import write_report
+from compare.campaign.verdicts import VERDICT_IDS
 
 # Narrow window 6-8 rad/s: far from the Fig. 5 mode jump without the pendulum
 # (17.5-18 rad/s), so the one threshold point is away from jumps.
@@ -95,7 +95,7 @@ def test_cli_bad_input_exits_2(argv, needle, capsys, tmp_path):
 
 
 def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
-    import compare.campaign as campaign
+    import compare.campaign.validation as campaign
 
     def broken(name, scene, config=None):
         raise RuntimeError("engine exploded")
@@ -115,7 +115,7 @@ def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
 def synthetic(tmp_path_factory):
     from synthetic_report import synthetic_result
 
-    from compare.provenance import collect
+    from compare.run.provenance import collect
 
     result = synthetic_result()
     out = tmp_path_factory.mktemp("synthetic")
@@ -154,13 +154,13 @@ def test_conclusions_follow_the_numbers(synthetic):
 
 
 def test_missing_cause_reads_not_measured():
-    from compare.trust import threshold_agreement
+    from compare.report.trust import threshold_agreement
 
     pts = [{"omega": 10.0, "a_reference": 20.0, "a_engine": 21.0, "rel_error": 0.05,
             "bracketed": True}]
     out = threshold_agreement(pts, 0.02)
     assert out["agree_up_to"] is None and out["failing"][0]["cause"] is None
-    from compare.trust import conclusion
+    from compare.report.trust import conclusion
     row = {"version": "v", "settings": {}, "thresholds": out,
            "cost": {"run_s": None, "spectrum_s": None}}
     assert "cause: not measured" in conclusion("pymunk", row)
@@ -190,7 +190,7 @@ def test_html_first_screen_provenance_and_layout(synthetic):
 def test_command_line_is_recorded(tmp_path, monkeypatch):
     import argparse
 
-    from compare.provenance import command_line
+    from compare.run.provenance import command_line
 
     args = argparse.Namespace(command="report", scene="fig5", quick=True, out="x y", dt=None)
     assert command_line(args) == "trilith report --scene fig5 --quick --out 'x y'"

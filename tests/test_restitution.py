@@ -19,9 +19,9 @@ from scipy.integrate import quad
 from analytic import equations as eq
 from analytic.parameters import Scene
 from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
-from compare.cli import main
+from compare.cli.main import main
 from engines import BACKENDS
-from compare.restitution import analytic_impact_times, measure_restitution
+from compare.measure.restitution import analytic_impact_times, measure_restitution
 
 
 # ------------------------------------------------------ analytic run length
@@ -57,8 +57,8 @@ def test_analytic_impact_times_match_energy_quadrature():
 
 # ---------------------------------------------------------- fake backend
 def _fake_backend(monkeypatch, impacts, tilt=True):
-    """Register a backend 'fake' (the contract: NAME, CAPABILITIES, a RunOptions
-    Settings, simulate, version) that records the settings it receives and returns
+    """Register a backend 'fake' (what the registry reads: name, capabilities, a
+    RunOptions Settings, simulate, version) that records the settings it receives and returns
     ``impacts`` (a list of Events) as its measured impacts."""
     from analytic.options import RunOptions
     settings_cls = dataclasses.make_dataclass("Settings", [], bases=(RunOptions,), frozen=True)
@@ -78,10 +78,11 @@ def _fake_backend(monkeypatch, impacts, tilt=True):
                           Verdict("survived"), OverturnCriterion(), settings.t_max,
                           settings={"t_max": settings.t_max})
 
-    module.version = version
-    module.simulate = simulate
+    module.Fake = type("Fake", (), dict(
+        name="fake", capabilities=module.CAPABILITIES, Settings=settings_cls,
+        version=staticmethod(version), simulate=staticmethod(simulate)))
     monkeypatch.setitem(sys.modules, "fake_backend", module)
-    monkeypatch.setitem(BACKENDS, "fake", "fake_backend")
+    monkeypatch.setitem(BACKENDS, "fake", "fake_backend:Fake")
     return module
 
 

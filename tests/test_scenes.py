@@ -8,7 +8,7 @@ import re
 import pytest
 
 from analytic import equations as eq
-from compare.cli import main
+from compare.cli.main import main
 from scenes import SCENE_DIR, load_scene, scene_names
 
 FIG8 = [f"fig8_lam{lam}_gamma{gamma}" for lam in (3, 5, 7) for gamma in (0.1, 0.2, 0.3)]

@@ -13,7 +13,7 @@ from analytic import equations as eq
 from analytic.excitation import Pulse, SampledRecord
 from analytic.simulate import NAME, Settings, simulate, version
 from analytic.trajectory import OverturnCriterion
-from compare.commands._common import clean_nan
+from compare.cli.options import clean_nan
 from engines import get_backend
 
 FREE = Pulse(0.0, 1e4)  # zero-amplitude pulse over 0.6 ms: free motion from the initial state
@@ -218,7 +218,7 @@ def test_determinism(fig5):
 
 # --- CLI --------------------------------------------------------------------------------------
 def test_cli_json_csv_plot(tmp_path, capsys):
-    from compare.cli import main
+    from compare.cli.main import main
     csv, png = tmp_path / "run.csv", tmp_path / "run.png"
     code = main(["simulate", "-A", "19", "-w", "15", "--no-pendulum", "--criterion", "alpha",
                  "--json", "--csv", str(csv), "--plot", str(png)])
@@ -232,7 +232,7 @@ def test_cli_json_csv_plot(tmp_path, capsys):
 
 
 def test_cli_human_summary_and_t_max(capsys):
-    from compare.cli import main
+    from compare.cli.main import main
     assert main(["simulate", "-A", "4", "-w", "9", "--t-max", "3", "--pulse", "cosine"]) == 0
     out = capsys.readouterr().out
     assert "verdict: survived" in out and "cosine pulse" in out and "t_end = 3.000 s" in out

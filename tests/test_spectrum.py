@@ -15,8 +15,8 @@ from analytic.excitation import Pulse
 from analytic.parameters import Scene
 from analytic.spectrum import (Spectrum, SpectrumSettings, first_overturn_amplitude,
                                overturning_spectrum)
-from compare.cli import main as cli_main
-from compare.commands._common import parse_omega_range
+from compare.cli.main import main as cli_main
+from compare.cli.options import parse_omega_range
 
 FIG5_OMEGA = np.arange(3.0, 31.0, 1.0)  # the paper's Fig. 5 range
 

@@ -1,4 +1,4 @@
-"""The run store (compare/store.py, compare/runs.py) and atomic outputs (compare/atomic.py).
+"""The run store (compare/run/store.py, compare/run/runs.py) and atomic outputs (compare/run/atomic.py).
 
 Every store here lives in ``tmp_path``: tests never touch the user's cache.
 """
@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from analytic.excitation import Pulse, SampledRecord, Still
-from compare import atomic, runs
-from compare.store import RunStore, default_cache_dir, run_key
+from compare.run import atomic
+from compare.run import runs
+from compare.run.store import RunStore, default_cache_dir, run_key
 from engines import get_backend
 
 # Short pymunk run (0.3 s of simulated time at 5e-4 s steps): milliseconds.

@@ -285,16 +285,12 @@ ENGINE_GRID = (  # (lam, mu, gamma, l/h, A/g, Omega, dt): corners of the brief's
 
 
 def _engine_settings(name, scene, pulse, **changes):
-    """Engine defaults with ``changes``; enough friction for rocking without sliding
-    (the engines refuse less, see their ``required_friction``), 1 sample per step
-    at coarse steps."""
+    """Engine defaults with ``changes`` (their default friction follows the pulse,
+    ``engines.base.FRICTION_MARGIN``), 1 sample per step at coarse steps."""
     from engines import get_backend
 
     backend = get_backend(name)
     base = backend.Settings()
-    if name == "pymunk":
-        changes.setdefault("friction", max(base.friction,
-                                           1.01 * backend.required_friction(scene, pulse)))
     if "dt" in changes:
         changes.setdefault("sample_every", max(1, round(1e-3 / changes["dt"])))
     import dataclasses
@@ -387,7 +383,7 @@ def test_pybullet_blowup_is_unstable():
     ("pymunk", 1e-5),
     ("pybullet", 1e-4),
     # Was a strict xfail: with a fixed 1e-4 m contact slop the columns crept apart
-    # at 1e-5 s; the slop now scales with dt (pybullet_scene.effective_slop).
+    # at 1e-5 s; the slop now scales with dt (engines.pybullet_.world.effective_slop).
     ("pybullet", 1e-5),
     ("mujoco", 1e-5),
 ])
@@ -402,7 +398,7 @@ def test_engine_small_step_stays_at_rest_before_uplift(name, dt):
     tr = backend.simulate(scene, pulse, st)
     assert tr.verdict.status == "survived", tr.verdict
     # Contact compliance tilts a resting engine trilith by ~1e-6 rad and lets a
-    # pivot creep by micrometres (engines/_common.MonitorSettings.uplift_angle
+    # pivot creep by micrometres (engines.monitor.MonitorSettings.uplift_angle
     # is 1e-4 rad); 1e-4 rad and 1 mm are far above both.
     assert tr.max_abs_theta < 1e-4
     assert tr.diagnostics["pivot_sliding_max"] < 1e-3

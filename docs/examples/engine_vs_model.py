@@ -5,8 +5,8 @@ Run: .venv/bin/python docs/examples/engine_vs_model.py [ENGINE]   (default pymun
 import sys
 
 import engines
-from compare.metrics import compare_trajectories
-from compare.restitution import measure_restitution
+from compare.measure.trajectories import compare_trajectories
+from compare.measure.restitution import measure_restitution
 from scenes import load_scene, point_pulse
 
 engine = sys.argv[1] if len(sys.argv) > 1 else "pymunk"

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 
 from analytic.spectrum import overturning_spectrum
-from compare.engine_spectrum import engine_spectrum
+from compare.measure.engine_spectrum import engine_spectrum
 from scenes import load_scene
 
 lo, hi = (float(sys.argv[1]), float(sys.argv[2])) if len(sys.argv) > 2 else (3.0, 30.0)

@@ -16,6 +16,7 @@ analytic plane; ``psi`` is ``psi0`` plus the bob's rotation.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import pymunk
@@ -80,6 +81,9 @@ class Settings(EngineSettings):
     def solver_iterations(self) -> int:
         """The contract's name for ``iterations`` (convergence studies double it)."""
         return self.iterations
+
+    def with_solver_iterations(self, n: int) -> Settings:
+        return dataclasses.replace(self, iterations=n)
 
     def __post_init__(self) -> None:
         super().__post_init__()

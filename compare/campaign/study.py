@@ -1,0 +1,220 @@
+"""A declared study (``trilith campaign FILE.toml``): engine overturning thresholds
+over scenes x engines x pulses x Omega x time steps, through the run store.
+
+Each job is one engine threshold (:func:`compare.measure.thresholds.engine_threshold`,
+a bisection bracketed by the analytic threshold) at one (scene, case, pulse,
+Omega, engine, dt).  The analytic reference is the compiled path's first
+overturning amplitude (:func:`analytic.spectrum.first_overturn_amplitude`).
+Every engine run and every finished job is kept in the store, so a killed
+campaign resumes where it stopped, and a finished one re-renders in seconds.
+
+The file::
+
+    [campaign]
+    name = "paper"
+    scenes = ["fig8_*", "fig9_*", "fig11_*"]    # names or globs over scenes/data
+    engines = ["pybullet", "pymunk"]            # or ["all"]
+    pulses = ["sine"]                           # sine, cosine
+    omega = "4:28:4"                            # START:STOP:STEP or a list [rad/s]
+    steps = [1e-4, 5e-4]                        # engine time steps [s]; 0 = calibrated
+    cases = ["pendulum", "no_pendulum"]         # optional (default both)
+    rel_tol = 0.004                             # optional: final bracket / A_ref
+"""
+from __future__ import annotations
+
+import fnmatch
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from engines import ENGINES
+from scenes import load_scene, scene_names
+
+__all__ = ["Study", "load_study", "reference_jobs", "threshold_jobs", "run_reference",
+           "run_threshold", "JOB_RUNS"]
+
+# Runs per threshold job, for estimates: 2 bracket runs + log2(2 rel_bracket /
+# rel_tol) bisection runs (thresholds.py); 6 at the defaults.
+JOB_RUNS = 6
+_KEYS = {"name", "scenes", "engines", "pulses", "omega", "steps", "cases", "rel_bracket",
+         "rel_tol", "workers"}
+
+
+@dataclass(frozen=True)
+class Study:
+    """A resolved campaign file (see the module doc)."""
+
+    name: str
+    scenes: tuple[str, ...]
+    engines: tuple[str, ...]
+    pulses: tuple[str, ...]
+    omegas: tuple[float, ...]
+    steps: tuple[float, ...]  # 0.0: the engine's calibrated step
+    cases: tuple[str, ...] = ("pendulum", "no_pendulum")
+    rel_bracket: float = 0.03  # as the validation campaign: engines within ~1-2 % of the model
+    rel_tol: float = 4e-3  # a fifth of the 2 % acceptance (the --quick report's value)
+    workers: int = 2  # the target machine has 2 cores
+
+    def describe(self) -> dict:
+        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+
+
+def _list(table: dict, key: str, where: str) -> list:
+    value = table.get(key)
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not value:
+        raise ValueError(f"{where}: 'campaign.{key}' must be a non-empty list")
+    return value
+
+
+def load_study(path) -> Study:
+    """Read and validate a campaign file; ``ValueError`` naming the key."""
+    from analytic.excitation import PULSE_KINDS
+    from compare.campaign.grids import parse_omega_range
+
+    path = Path(path)
+    where = str(path)
+    try:
+        table = tomllib.loads(path.read_text())["campaign"]
+    except FileNotFoundError:
+        raise ValueError(f"campaign file {where!r} does not exist") from None
+    except (tomllib.TOMLDecodeError, KeyError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{where}: not a campaign file (a [campaign] table is needed: "
+                         f"{exc})") from None
+    unknown = set(table) - _KEYS
+    if unknown:
+        raise ValueError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}; allowed: "
+                         f"{', '.join(sorted(_KEYS))}")
+    names = []
+    for pattern in _list(table, "scenes", where):
+        hits = [n for n in scene_names() if fnmatch.fnmatchcase(n, str(pattern))]
+        if not hits:
+            raise ValueError(f"{where}: scenes: {pattern!r} matches no scene; allowed: "
+                             f"{', '.join(scene_names())} (or globs)")
+        names += [n for n in hits if n not in names]
+    engines = [str(e) for e in _list(table, "engines", where)]
+    engines = list(ENGINES) if engines == ["all"] else engines
+    for e in engines:
+        if e not in ENGINES:
+            raise ValueError(f"{where}: engines: unknown engine {e!r}; allowed: "
+                             f"{', '.join(ENGINES)} or all")
+    pulses = [str(p) for p in _list(table, "pulses", where)] if "pulses" in table else ["sine"]
+    for p in pulses:
+        if p not in PULSE_KINDS:
+            raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_KINDS)}")
+    omega = table.get("omega")
+    text = ",".join(str(float(w)) for w in omega) if isinstance(omega, list) else omega
+    omegas = parse_omega_range(str(text), f"{where}: campaign.omega")
+    steps = [float(s) for s in _list(table, "steps", where)] if "steps" in table else [0.0]
+    for s in steps:
+        if not (math.isfinite(s) and 0.0 <= s <= 0.01):
+            raise ValueError(f"{where}: steps: each time step must be in [0, 0.01] s "
+                             f"(0: calibrated), got {s!r}")
+    cases = [str(c) for c in _list(table, "cases", where)] if "cases" in table else [
+        "pendulum", "no_pendulum"]
+    for c in cases:
+        if c not in ("pendulum", "no_pendulum"):
+            raise ValueError(f"{where}: cases: {c!r} is not pendulum or no_pendulum")
+    rel_bracket = float(table.get("rel_bracket", Study.rel_bracket))
+    rel_tol = float(table.get("rel_tol", Study.rel_tol))
+    if not (0.0 < rel_tol < rel_bracket < 0.5):
+        raise ValueError(f"{where}: need 0 < rel_tol < rel_bracket < 0.5, got "
+                         f"{rel_tol!r}, {rel_bracket!r}")
+    workers = table.get("workers", Study.workers)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"{where}: workers must be an integer >= 1, got {workers!r}")
+    return Study(name=str(table.get("name", path.stem)), scenes=tuple(names),
+                 engines=tuple(engines), pulses=tuple(pulses),
+                 omegas=tuple(float(w) for w in np.asarray(omegas)), steps=tuple(steps),
+                 cases=tuple(cases), rel_bracket=rel_bracket, rel_tol=rel_tol,
+                 workers=workers)
+
+
+def _scene(name: str, case: str):
+    scene = load_scene(name)
+    return scene if case == "pendulum" else scene.without_pendulum()
+
+
+def reference_jobs(study: Study) -> list[tuple]:
+    """``(scene name, case, pulse, omega)`` for every analytic reference point."""
+    return [(n, c, p, w) for n in study.scenes for c in study.cases for p in study.pulses
+            for w in study.omegas]
+
+
+def run_reference(job: tuple) -> tuple[float, str | None]:
+    """The analytic first overturning amplitude and mode, through the store (the
+    same entry as the validation report's reference spectra)."""
+    from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
+
+    from compare.run import runs
+    from compare.run.store import scene_dict
+
+    name, case, pulse, omega = job
+    scene, ss = _scene(name, case), SpectrumSettings(pulse=pulse)
+    res = runs.memo("point", {"scene": scene_dict(scene), "omega": float(omega),
+                              "settings": ss.describe()},
+                    lambda: first_overturn_amplitude(scene, float(omega), ss))
+    return float(res[0]), res[2]
+
+
+def threshold_jobs(study: Study, references: dict) -> list[tuple]:
+    """``(scene, case, pulse, omega, a_ref, mode_ref, engine, dt, rel_bracket, rel_tol)``
+    for every reference point that overturns (NaN references have nothing to bracket)."""
+    jobs = []
+    for (n, c, p, w), (a_ref, mode) in references.items():
+        if not math.isfinite(a_ref):
+            continue
+        for e in study.engines:
+            for dt in study.steps:
+                jobs.append((n, c, p, w, a_ref, mode, e, dt, study.rel_bracket, study.rel_tol))
+    return jobs
+
+
+def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float):
+    """The validation campaign's pulse settings (friction raised for the largest
+    pulse of the bisection) at time step ``dt`` (0: calibrated)."""
+    from compare.campaign.validation import CampaignConfig, _pulse_settings
+
+    config = CampaignConfig(engines=(engine,), engine_dt=dt or None)
+    return _pulse_settings(engine, config, scene, 2.0 * a_ref, omega)
+
+
+def threshold_description(job: tuple) -> dict:
+    """Everything that determines a threshold job's result (its store key)."""
+    from compare.run.store import _engine_version, scene_dict, settings_dict
+
+    n, c, p, w, a_ref, mode, e, dt, rb, rt = job
+    scene = _scene(n, c)
+    return {"engine": e, "version": _engine_version(e), "scene": scene_dict(scene),
+            "pulse": p, "omega": w, "a_ref": a_ref, "mode_ref": mode,
+            "settings": settings_dict(job_settings(e, dt, scene, a_ref, w)),
+            "rel_bracket": rb, "rel_tol": rt}
+
+
+def run_threshold(job: tuple) -> dict:
+    """One engine threshold (a row of the combined report), through the store."""
+    from compare.run import runs
+    from compare.measure.thresholds import engine_threshold
+
+    n, c, p, w, a_ref, mode, e, dt, rb, rt = job
+    scene = _scene(n, c)
+
+    def compute():
+        settings = job_settings(e, dt, scene, a_ref, w)
+        return engine_threshold(e, scene, w, a_ref, settings, kind=p, mode_reference=mode,
+                                rel_bracket=rb, rel_tol=rt)
+    row = {"scene": n, "case": c, "pulse": p, "omega": w, "engine": e, "dt": dt or None,
+           "a_reference": a_ref, "mode_reference": mode}
+    try:
+        point = runs.memo("threshold", threshold_description(job), compute,
+                          label=f"threshold {e} dt={dt:g}", code=runs.ALL_CODE)
+    except Exception as exc:  # noqa: BLE001 - one bad run must not sink hours of work
+        return {**row, "error": f"{type(exc).__name__}: {exc}"}
+    return {**row, "a_engine": point.a_engine, "a_low": point.a_low,
+            "rel_error": point.rel_error, "bracketed": point.bracketed,
+            "mode_engine": point.mode_engine, "n_runs": point.n_runs,
+            "irregular_runs": point.irregular_runs, "wall_time": point.provenance.wall_time}

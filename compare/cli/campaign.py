@@ -1,0 +1,214 @@
+"""``trilith campaign FILE.toml``: a declared study, resumable, one combined report.
+
+``trilith campaign campaigns/paper.toml [--out DIR] [--workers N] [--scheduler ADDR]
+[--estimate]`` runs every job of the file (see :mod:`compare.campaign.study`) through the
+run store and writes ``DIR/campaign.json`` and ``DIR/index.html`` (swapped in
+whole).  Killed, it resumes on the next call: finished engine runs and jobs
+come from the store.  ``--estimate`` prints the job count and the expected time
+(from the run costs measured in the store) and runs nothing.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import math
+import sys
+import time
+from pathlib import Path
+
+from compare.cli.options import add_store_args, use_store
+
+# Cost of one engine run [s] before the store has measured any (median of the
+# Fig. 5 threshold runs at the calibrated step on the 2-core target machine).
+PRIOR_RUN_COST = 0.4
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser("campaign", help="run a declared study (TOML) through the run "
+                                               "store, resumable, with one combined report",
+                              description=__doc__,
+                              formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("file", metavar="FILE.toml", help="campaign file (see campaigns/paper.toml)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory [campaign-<name>]")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local processes, >= 1 [the file's, else 2]")
+    p.add_argument("--estimate", action="store_true",
+                   help="print the number of jobs and the expected time; run nothing")
+    add_store_args(p, scheduler=True)
+
+
+def _run_cost(engine: str, dt: float, costs: dict) -> float:
+    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: calibrated):
+    the mean measured in the store at that step, else the measured step nearest
+    to it scaled by the step ratio (steps per simulated second), else a prior."""
+    from engines import get_backend
+
+    dt = dt or getattr(get_backend(engine).Settings(), "dt", 1e-4)
+    measured = {}
+    for label, (mean, _n) in costs.items():
+        name, _, step = label.partition(" dt=")
+        if name == engine and step:
+            measured[float(step)] = mean
+    if not measured:
+        return PRIOR_RUN_COST
+    if dt in measured:
+        return measured[dt]
+    near = min(measured, key=lambda s: abs(math.log(s / dt)))
+    return measured[near] * near / dt
+
+
+def _estimates(jobs, store) -> list[float]:
+    """Expected cost [s] of each threshold job: runs per job x the run cost."""
+    from compare.campaign.study import JOB_RUNS
+
+    costs = store.mean_costs("run") if store is not None else {}
+    return [JOB_RUNS * _run_cost(job[6], job[7], costs) for job in jobs]
+
+
+def run(args: argparse.Namespace) -> int:
+    from compare.run import atomic
+    from compare.run import runs
+    from compare.campaign.study import (load_study, reference_jobs, run_reference, run_threshold,
+                               threshold_jobs)
+
+    study = load_study(args.file)
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    workers = args.workers or study.workers
+    out = Path(args.out or f"campaign-{study.name}")
+    if out.is_file():
+        raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
+    store = use_store(args)
+    t0 = time.perf_counter()
+    # --estimate writes nothing: it leaves the output location (and its lock) alone.
+    with contextlib.nullcontext() if args.estimate else atomic.output_lock(out):
+        ref_jobs = reference_jobs(study)
+        references = dict(zip(ref_jobs, runs.run_many(run_reference, ref_jobs,
+                                                       workers=workers)))
+        jobs = threshold_jobs(study, references)
+        unique, index = distinct(jobs)
+        est = _estimates(unique, store)
+        print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
+              f"points, {len(jobs)} engine threshold jobs ({len(unique)} distinct); at most {_duration(sum(est))} of "
+              f"CPU, ~{_duration(sum(est) / workers)} on {workers} workers (jobs already in "
+              "the store cost nothing)", file=sys.stderr, flush=True)
+        if args.estimate:
+            return 0
+        bar = _bar(sum(est))
+        done = list(runs.run_many(run_threshold, unique, workers=workers,
+                                  on_done=lambda i, r: bar.update(est[i])))
+        bar.close()
+        rows = [{**done[i], "scene": job[0], "case": job[1]} for job, i in zip(jobs, index)]
+        doc = {"study": study.describe(), "references": [
+            {"scene": n, "case": c, "pulse": p, "omega": w, "a_reference": a, "mode": m}
+            for (n, c, p, w), (a, m) in references.items()], "rows": rows,
+            "summary": summarise(rows), "versions": _versions(study),
+            "wall_time": time.perf_counter() - t0}
+        with atomic.report_dir(out, lock=False) as tmp:
+            write_campaign(doc, tmp)
+    print(runs.stats_line(), file=sys.stderr)
+    print(f"campaign written to {out / 'index.html'} ({len(rows)} jobs, "
+          f"{sum('error' in r for r in rows)} errors, {time.perf_counter() - t0:.0f} s)")
+    return 0
+
+
+def distinct(jobs: list) -> tuple[list, list[int]]:
+    """The jobs with distinct store keys, and for each job the index of its
+    distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
+    the scene name is a label)."""
+    from compare.run.store import digest
+    from compare.campaign.study import threshold_description
+
+    seen: dict[str, int] = {}
+    unique, index = [], []
+    for job in jobs:
+        key = digest(threshold_description(job))
+        if key not in seen:
+            seen[key] = len(unique)
+            unique.append(job)
+        index.append(seen[key])
+    return unique, index
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
+
+
+def _bar(total: float):
+    from tqdm import tqdm
+    # Units are seconds of estimated work: tqdm's rate is then the measured speed
+    # against the measured costs, and its ETA the remaining estimated work at it.
+    return tqdm(total=round(total, 1), unit="s", unit_scale=False, desc="campaign",
+                disable=not sys.stderr.isatty(), leave=False,
+                bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} s of work [{elapsed}<{remaining}]")
+
+
+def _versions(study) -> dict:
+    from compare.run.store import _engine_version, project_version
+    return {"project": project_version(), "analytic-fast": _engine_version("analytic-fast"),
+            **{e: _engine_version(e) for e in study.engines}}
+
+
+def summarise(rows: list[dict]) -> list[dict]:
+    """Per engine and time step: jobs, bracketed, median and worst |rel. error|."""
+    import math
+
+    import numpy as np
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["engine"], r["dt"]), []).append(r)
+    out = []
+    for (engine, dt), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1] or 0)):
+        errs = [abs(r["rel_error"]) for r in rs if math.isfinite(r.get("rel_error", math.nan))]
+        out.append({"engine": engine, "dt": dt, "jobs": len(rs),
+                    "errors": sum("error" in r for r in rs), "bracketed": len(errs),
+                    "median_abs_rel_error": float(np.median(errs)) if errs else None,
+                    "max_abs_rel_error": max(errs) if errs else None})
+    return out
+
+
+def write_campaign(doc: dict, out: Path) -> None:
+    """``campaign.json`` (strict JSON) and a plain ``index.html`` table."""
+    import html
+    import json
+
+    from compare.run import atomic
+
+    from compare.cli.options import clean_nan
+
+    atomic.write_text(out / "campaign.json", json.dumps(clean_nan(doc), indent=1,
+                                                        allow_nan=False))
+
+    def table(rows, cols):
+        head = "".join(f"<th>{html.escape(c)}</th>" for c in cols)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(_fmt(r.get(c)))}</td>"
+                                         for c in cols) + "</tr>" for r in rows)
+        return f"<table><tr>{head}</tr>{body}</table>"
+    cols = ["scene", "case", "pulse", "omega", "engine", "dt", "a_reference", "a_engine",
+            "rel_error", "mode_reference", "mode_engine", "n_runs", "error"]
+    study = doc["study"]
+    page = ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>campaign "
+            f"{html.escape(study['name'])}</title><style>body{{font-family:sans-serif}}"
+            "table{border-collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;"
+            "padding:2px 6px;text-align:right}</style></head><body>"
+            f"<h1>Campaign {html.escape(study['name'])}</h1>"
+            f"<p>{len(study['scenes'])} scenes, engines {', '.join(study['engines'])}, "
+            f"steps {study['steps']}, Omega {study['omegas']} rad/s; engine overturning "
+            "threshold against the analytic one (rel_error = A_engine/A_analytic - 1).</p>"
+            "<h2>Summary</h2>" + table(doc["summary"], list(doc["summary"][0]) if
+                                       doc["summary"] else [])
+            + "<h2>Every job</h2>" + table(doc["rows"], cols)
+            + f"<h2>Versions</h2>{table([doc['versions']], list(doc['versions']))}"
+            "</body></html>\n")
+    atomic.write_text(out / "index.html", page)
+
+
+def _fmt(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.5g}"
+    return str(value)

@@ -1,0 +1,169 @@
+"""``trilith map``: the overturn map (amplitude x frequency) of the analytic model,
+and of an engine on a coarser grid beside it (Zhang & Makris 2001 style)."""
+from __future__ import annotations
+
+import argparse
+import math
+
+from engines import engine_names
+
+from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_workers_arg,
+                      check_output_path, clean_nan, parse_omega_range, parse_range,
+                      print_json, resolve_workers, scene_from_args)
+
+DEFAULT_OMEGA = "3:30:0.5"
+DEFAULT_AMPLITUDE = "0.5:100:0.5"
+ENGINE_POINTS = 8  # default engine grid: at most 8 x 8 of the analytic grid's values
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "map", help="overturn map: verdict per (Omega, A), with the first-overturning curve",
+        description="Verdict of every pulse on an amplitude x frequency grid (overturned "
+                    "without / after impact, survived, or an engine's other statuses), the "
+                    "first-overturning curve on it, as a PNG, JSON or CSV.")
+    add_scene_args(parser)
+    add_pulse_kind_arg(parser)
+    parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
+                        help="frequencies [rad/s], STOP included")
+    parser.add_argument("--amplitude", default=DEFAULT_AMPLITUDE, metavar="A0:A1:dA",
+                        help="amplitudes [m/s^2], A1 included")
+    parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]",
+                        help=f"also map these engines ({', '.join(engine_names())}, or all), "
+                             "each on a coarser grid beside the analytic map")
+    parser.add_argument("--engine-omega", default=None, metavar="START:STOP:STEP",
+                        help=f"engine frequencies (default: {ENGINE_POINTS} of --omega)")
+    parser.add_argument("--engine-amplitude", default=None, metavar="A0:A1:dA",
+                        help=f"engine amplitudes (default: {ENGINE_POINTS} of --amplitude)")
+    parser.add_argument("--max-engine-runs", type=int, default=100, metavar="N",
+                        help="refuse engine grids with more runs than this in all")
+    add_workers_arg(parser)
+    parser.add_argument("--json", action="store_true", help="print a JSON object")
+    parser.add_argument("--csv", metavar="FILE", help="write the cells as CSV")
+    parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
+    return parser
+
+
+def _subsample(values, n: int):
+    import numpy as np
+    if values.size <= n:
+        return values
+    return values[np.unique(np.round(np.linspace(0, values.size - 1, n)).astype(int))]
+
+
+def _engine_grid(args, omegas, amps, n_engines: int):
+    w = (parse_omega_range(args.engine_omega, "--engine-omega") if args.engine_omega
+         else _subsample(omegas, ENGINE_POINTS))
+    a = (parse_range(args.engine_amplitude, "--engine-amplitude", "m/s^2")
+         if args.engine_amplitude else _subsample(amps, ENGINE_POINTS))
+    if n_engines * w.size * a.size > args.max_engine_runs:
+        raise ValueError(f"the engine grids need {n_engines * w.size * a.size} runs, more than "
+                         f"--max-engine-runs {args.max_engine_runs}: coarsen --engine-omega/"
+                         f"--engine-amplitude or raise --max-engine-runs")
+    return w, a
+
+
+class _EngineRun:
+    """``(A, Omega) -> Verdict`` of one backend with its default settings."""
+
+    def __init__(self, name: str, scene, pulse: str):
+        from engines import get_backend
+        self.backend, self.scene, self.pulse = get_backend(name), scene, pulse
+
+    def __call__(self, amplitude: float, omega: float):
+        from analytic.excitation import Pulse
+        return self.backend.simulate(self.scene, Pulse(amplitude, omega, self.pulse)).verdict
+
+
+def plot_maps(maps, path) -> None:
+    """One panel per map: cells coloured by label, the analytic first-overturning
+    curve (black line) on every panel."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    colours = {"survived": "white", "overturned (no-impact)": "0.35",
+               "overturned (after-impact)": "0.7", "unstable": "tab:red",
+               "undecided": "tab:orange", "collapsed": "tab:purple"}
+    first = maps[0]
+    ncols = min(2, len(maps))  # two panels a row: readable on a page or a phone
+    nrows = -(-len(maps) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 4.6 * nrows), squeeze=False)
+    for ax in axes.ravel()[len(maps):]:
+        ax.set_visible(False)
+    for ax, m in zip(axes.ravel(), maps):
+        cols = [colours.get(lab, "tab:blue") for lab in m.labels]
+        ax.pcolormesh(m.omega, m.amplitude, m.cells, cmap=ListedColormap(cols),
+                      vmin=-0.5, vmax=len(cols) - 0.5, shading="nearest")
+        ax.plot(first.omega, first.first, "k-", lw=1.2, label="first overturning (analytic)")
+        present = [i for i, n in enumerate(np.bincount(m.cells.ravel(),
+                                                       minlength=len(m.labels))) if n]
+        handles = [Patch(facecolor=cols[i], edgecolor="k", label=m.labels[i]) for i in present]
+        ax.legend(handles=handles + ax.get_legend_handles_labels()[0], fontsize=7,
+                  loc="upper left")
+        ax.set_xlabel(r"$\Omega$ [rad/s]")
+        ax.set_ylabel(r"$A_s$ [m/s$^2$]")
+        sc = m.scene
+        ax.set_title(f"{m.backend}: {m.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
+                     f"gamma={sc.gamma:g}", fontsize=9)
+    used = axes.ravel()[:len(maps)]
+    for get, set_ in (("get_xlim", "set_xlim"), ("get_ylim", "set_ylim")):
+        lims = [getattr(ax, get)() for ax in used]  # one extent: panels compare by eye
+        for ax in used:
+            getattr(ax, set_)(min(lo for lo, _ in lims), max(hi for _, hi in lims))
+    fig.tight_layout()
+    from compare.run.atomic import savefig
+    savefig(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = scene_from_args(args)
+    omegas = parse_omega_range(args.omega, "--omega")
+    amps = parse_range(args.amplitude, "--amplitude", "m/s^2")
+    workers = resolve_workers(args.workers)
+    if not (1 <= args.max_engine_runs <= 100_000):
+        raise ValueError(f"--max-engine-runs must be in [1, 100000], got {args.max_engine_runs}")
+    if args.csv:
+        check_output_path(args.csv, "--csv")
+    if args.plot:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    engines, eng_grid = (), None
+    if args.engine is not None:
+        from engines import engine_list
+        engines = engine_list(args.engine)  # unknown name: ValueError before any work
+        eng_grid = _engine_grid(args, omegas, amps, len(engines))
+    from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
+    from analytic.spectrum import SpectrumSettings
+    if omegas.size * amps.size > MAX_CELLS:
+        raise ValueError(f"--omega x --amplitude gives {omegas.size * amps.size} cells, "
+                         f"more than {MAX_CELLS}")
+    maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
+                         workers=workers)]
+    for name in engines:
+        maps.append(verdict_map(_EngineRun(name, scene, args.pulse), scene, *eng_grid,
+                                backend=name, pulse=args.pulse, workers=workers))
+    if args.csv:
+        from compare.run.atomic import write_text
+        rows = ["backend,omega,amplitude,verdict"] + [
+            f"{m.backend},{w:.12g},{a:.12g},{lab}" for m in maps for w, a, lab in m.csv_rows()]
+        write_text(args.csv, "\n".join(rows) + "\n")
+    if args.plot:
+        plot_maps(maps, args.plot)
+    if args.json:
+        print_json(clean_nan({"maps": [m.to_dict() for m in maps]}))
+        return 0
+    for m in maps:
+        print(f"{m.backend}: scene {scene.name}, {m.pulse} pulse, {m.omega.size} frequencies x "
+              f"{m.amplitude.size} amplitudes in {m.wall_time:.2f} s")
+        for lab, n in m.counts().items():
+            if n:
+                print(f"  {lab:>26}: {n}")
+    first = maps[0].first
+    n_miss = int(sum(1 for a in first if not math.isfinite(a)))
+    if n_miss:
+        print(f"note: {n_miss} frequencies do not overturn up to the grid's top amplitude")
+    return 0

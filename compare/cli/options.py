@@ -1,0 +1,364 @@
+"""Options and checks shared by the subcommands: scene, overrides, pulse or record,
+engines, workers, output paths, run budget, JSON envelope and number formatting.
+
+Every check here runs before any simulation ("at the door") and raises
+``ValueError`` naming the option; ``compare.cli.main`` turns it into one
+``error: ...`` line and exit code 2.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from analytic.excitation import PULSE_KINDS, Pulse
+from analytic.options import MAX_RUN_STEPS
+from analytic.parameters import Scene
+from scenes import load_scene
+
+from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
+from compare.run.jsonable import plain
+
+SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel_height",
+            "hinge_x", "depth", "g")
+# Version of the --json documents (simulate, restitution, spectrum); bumped when a
+# key changes meaning or disappears.  1: inputs echoed, 'engine', 'timings' block.
+SCHEMA_VERSION = 1
+# Formats matplotlib writes without extra packages (--plot).
+PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps",
+                 ".webp")
+# -q / -v, set by compare.cli.main from the subcommand's flags: -1 quiet, 0 normal, 1 verbose.
+VERBOSITY = 0
+
+
+def info(message: str) -> None:
+    """A line for a person (file written, warnings); silenced by ``-q``."""
+    if VERBOSITY >= 0:
+        print(message)
+
+
+def detail(message: str) -> None:
+    """A line shown only with ``-v`` (timings, versions, settings)."""
+    if VERBOSITY > 0:
+        print(message)
+
+
+def add_scene_args(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scene", default="fig5",
+                        help="scene name (scenes/data/*.toml, see 'trilith scenes') or path "
+                             "to a TOML file")
+    parser.add_argument("--set", dest="overrides", action="append", default=[],
+                        metavar="NAME=VALUE",
+                        help=f"override a scene value; NAME in {', '.join(SETTABLE)}")
+    parser.add_argument("--no-pendulum", action="store_true", help="remove the pendulum (gamma = 0)")
+
+
+def parse_overrides(items: list[str]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep:
+            raise ValueError(f"--set expects NAME=VALUE, got {item!r}")
+        if name not in SETTABLE:
+            raise ValueError(f"--set: unknown name {name!r}; allowed: {', '.join(SETTABLE)}")
+        try:
+            number = float(value)
+        except ValueError:
+            raise ValueError(f"--set {name}: {value!r} is not a number") from None
+        if not math.isfinite(number):
+            raise ValueError(f"--set {name}: must be finite, got {value!r}")
+        out[name] = number
+    return out
+
+
+def scene_from_args(args: argparse.Namespace) -> Scene:
+    """The scene file first (its errors name the file), then the ``--set``
+    overrides (their errors name ``--set``), then ``--no-pendulum``."""
+    overrides = parse_overrides(args.overrides)
+    scene = load_scene(args.scene)
+    if overrides:
+        try:
+            scene = scene.replace(**overrides)
+        except (TypeError, ValueError) as exc:
+            shown = " ".join(f"{k}={v:g}" for k, v in overrides.items())
+            raise ValueError(f"--set {shown}: {exc}") from None
+    if getattr(args, "no_pendulum", False):
+        scene = scene.without_pendulum()
+    return scene
+
+
+def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--pulse", choices=PULSE_KINDS, default="sine",
+                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
+
+
+def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
+    add_pulse_kind_arg(parser)
+    parser.add_argument("--amplitude", "-A", type=float, required=required,
+                        help="pulse amplitude A [m/s^2], |A| <= 1e4")
+    parser.add_argument("--omega", "-w", type=float, required=required,
+                        help="pulse circular frequency Omega [rad/s], in [0.1, 1e4]")
+
+
+def pulse_from_args(args: argparse.Namespace) -> Pulse:
+    return Pulse(args.amplitude, args.omega, args.pulse)
+
+
+def add_record_arg(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--record", metavar="FILE", default=None,
+                        help="a recorded ground motion instead of a pulse: CSV with two "
+                             "columns t [s], a [m/s^2], or a PEER NGA .AT2 file "
+                             "(scenes/records/sample.csv is a synthetic example)")
+
+
+def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] | None = None):
+    """``--record FILE`` (a :class:`analytic.excitation.SampledRecord`) or the pulse
+    ``-A/-w`` (``default`` fills in what is not given).  A record excludes ``-A/-w``."""
+    record = getattr(args, "record", None)
+    given = [f for f, v in (("--amplitude", args.amplitude), ("--omega", args.omega))
+             if v is not None]
+    if record is not None:
+        if given:
+            raise ValueError(f"--record replaces the pulse: drop {' and '.join(given)}")
+        from scenes.ground_motion import load_record
+        return load_record(record, option="--record")
+    amplitude = args.amplitude if args.amplitude is not None else (default or (None, None))[0]
+    omega = args.omega if args.omega is not None else (default or (None, None))[1]
+    if amplitude is None or omega is None:
+        missing = " and ".join(f for f, v in (("-A/--amplitude", amplitude),
+                                              ("-w/--omega", omega)) if v is None)
+        raise ValueError(f"give {missing} for a pulse, or --record FILE")
+    return Pulse(amplitude, omega, args.pulse)
+
+
+def excitation_inputs(excitation) -> dict:
+    """The excitation as echoed in JSON (pulse: kind, amplitude, omega, period)."""
+    return excitation.describe()
+
+
+def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",
+                   allowed: tuple[str, ...] | None = None) -> None:
+    from engines import backend_names
+    names = allowed or backend_names()
+    parser.add_argument("--engine", default=default, metavar="NAME",
+                        help=f"backend: {', '.join(names)}")
+
+
+class _DeprecatedAlias(argparse.Action):
+    """``--engines`` (old spelling): stored in ``--engine``'s place; ``compare.cli.main``
+    prints a one-line note on stderr once the command succeeded (an error
+    stays one line)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        notes = list(getattr(namespace, "deprecation_notes", None) or [])
+        notes.append(f"note: {option_string} is deprecated, use --engine "
+                     f"(the same NAME[,NAME...] list)")
+        namespace.deprecation_notes = notes
+        setattr(namespace, self.dest, values)
+
+
+def add_engine_list_arg(parser: argparse.ArgumentParser, allowed: tuple[str, ...],
+                        default: tuple[str, ...], none_ok: bool = False) -> None:
+    """``--engine NAME[,NAME...]`` (and the deprecated ``--engines``)."""
+    extra = " or none" if none_ok else ""
+    parser.add_argument("--engine", dest="engine", default=",".join(default),
+                        metavar="NAME[,NAME...]",
+                        help=f"comma-separated engines from {', '.join(allowed)}{extra}")
+    parser.add_argument("--engines", dest="engine", action=_DeprecatedAlias,
+                        help=argparse.SUPPRESS)
+
+
+def parse_engine_list(text: str, allowed: tuple[str, ...], option: str = "--engine",
+                      none_ok: bool = False) -> tuple[str, ...]:
+    """``'a,b'`` -> ``('a', 'b')``; refuses an empty list, unknown or repeated names."""
+    if none_ok and text.strip() == "none":
+        return ()
+    names = tuple(n.strip() for n in text.split(","))
+    if not any(names):
+        raise ValueError(f"{option} must name at least one of {', '.join(allowed)}"
+                         + (" (or none)" if none_ok else "") + f", got {text!r}")
+    for n in names:
+        if n not in allowed:
+            raise ValueError(f"{option}: unknown engine {n!r}; allowed: {', '.join(allowed)}"
+                             + (" or none" if none_ok else ""))
+    if len(set(names)) != len(names):
+        raise ValueError(f"{option}: an engine is named twice in {text!r}")
+    return names
+
+
+def add_workers_arg(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--workers", type=int, default=-1, metavar="N",
+                        help="parallel processes; -1 = all cores, -2 = all but one (as "
+                             "scikit-learn's n_jobs); results do not depend on it")
+
+
+def resolve_workers(n: int, option: str = "--workers") -> int:
+    """``n >= 1`` as given (at most 256); ``n <= -1``: ``cpu_count + 1 + n``."""
+    cores = os.cpu_count() or 1
+    if n == 0 or n > 256 or n < -cores:
+        raise ValueError(f"{option} must be in [1, 256] or in [-{cores}, -1] (-1 = all "
+                         f"{cores} cores), got {n}")
+    return n if n > 0 else cores + 1 + n
+
+
+def check_output_path(path: str | os.PathLike, option: str, *, directory: bool = False,
+                      suffixes: tuple[str, ...] | None = None) -> Path:
+    """Check an output path before any work; returns it as a Path.
+
+    A file (``directory=False``): not an existing directory nor a special file,
+    its suffix in ``suffixes`` when given, and its parent directory must exist
+    (refused otherwise: a typo should not create directories) and be writable.
+    A directory (``directory=True``): not an existing file; created with its
+    parents when missing, then checked writable.  Writability is probed by
+    creating a temporary file, which also holds for root on read-only mounts.
+    """
+    text = os.fspath(path)
+    if not text.strip():
+        raise ValueError(f"{option}: empty path")
+    p = Path(text)
+    if directory:
+        if p.exists() and not p.is_dir():
+            raise ValueError(f"{option} must be a directory, but {text!r} is a file")
+        try:
+            p.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"{option}: cannot create directory {text!r} "
+                             f"({exc.strerror or exc})") from None
+        _probe_writable(p, option, text)
+        return p
+    if p.is_dir():
+        raise ValueError(f"{option} must be a file, but {text!r} is a directory")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{option}: {text!r} is not a regular file (a FIFO or device)")
+    if suffixes is not None and p.suffix.lower() not in suffixes:
+        raise ValueError(f"{option} must end in {', '.join(suffixes)}, got {text!r}")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        what = "is not a directory" if parent.exists() else "does not exist"
+        raise ValueError(f"{option}: directory {str(parent)!r} {what} (create it first)")
+    _probe_writable(parent, option, text)
+    if p.exists() and not os.access(p, os.W_OK):
+        raise ValueError(f"{option}: {text!r} exists and is not writable")
+    return p
+
+
+def _probe_writable(directory: Path, option: str, text: str) -> None:
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".trilith-probe-", dir=directory)
+    except OSError as exc:
+        raise ValueError(f"{option}: cannot write in {str(directory)!r} for {text!r} "
+                         f"({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
+
+
+def run_length(excitation, t_max: float | None, t_cap: float) -> float:
+    """Longest simulated time [s] of a run: ``t_max`` when fixed, otherwise the
+    excitation's end plus the backend's ``t_cap`` (the monitor's safety net)."""
+    return float(t_max) if t_max is not None else float(excitation.end_time) + float(t_cap)
+
+
+def check_run_budget(engine: str, settings, excitation, option: str = "--t-max",
+                     length: float | None = None) -> int:
+    """Refuse a run whose steps (engine ``dt``) or samples (analytic ``sample_dt``)
+    exceed :data:`MAX_RUN_STEPS`; returns the count.  ``length`` overrides the
+    run length (recordings run a fixed duration)."""
+    if length is None:
+        # analytic: settings.t_cap; engines: settings.monitor.t_cap; a backend with
+        # neither gets the longest cap of the others (120 s, analytic/events.py).
+        t_cap = getattr(settings, "t_cap", None)
+        if t_cap is None:
+            t_cap = getattr(getattr(settings, "monitor", None), "t_cap", None)
+        if t_cap is None:
+            t_cap = 120.0
+        length = run_length(excitation, settings.t_max, t_cap)
+    dt = getattr(settings, "dt", None) or getattr(settings, "sample_dt", None)
+    if not dt:
+        return 0
+    steps = int(math.ceil(length / dt))
+    if steps > MAX_RUN_STEPS:
+        unit = "steps" if getattr(settings, "dt", None) else "samples"
+        raise ValueError(f"{option}: a {engine} run of {length:.4g} s at {dt:g} s is "
+                         f"{steps:.3g} {unit}, over the budget of {MAX_RUN_STEPS:.0e} "
+                         f"(excitation {excitation.end_time:.4g} s); shorten the run")
+    return steps
+
+
+def envelope(command: str, inputs: dict, body: dict, timings: dict) -> dict:
+    """The --json document: schema version, command, inputs, the result's keys,
+    and last the wall times, so that everything before ``timings`` is
+    byte-identical between reruns."""
+    doc = {"schema_version": SCHEMA_VERSION, "command": command, "inputs": inputs}
+    doc.update(body)
+    doc["timings"] = timings
+    return doc
+
+
+def sig(value, digits: int = 4) -> str:
+    """``value`` with ``digits`` significant digits (``'-'`` for None, ``nan`` kept)."""
+    if value is None:
+        return "-"
+    if isinstance(value, (int,)) and not isinstance(value, bool):
+        return str(value)
+    return f"{float(value):.{digits}g}"
+
+
+def format_quantity(value, unit: str) -> str:
+    """A measured value in its unit for a person: relative errors in percent."""
+    if value is None:
+        return "not measured"
+    if unit == "relative":
+        return f"{100.0 * float(value):.3g} %"
+    if unit == "count":
+        return f"{int(value)}"
+    return f"{float(value):.3g} {unit}".rstrip()
+
+
+def print_json(obj) -> None:
+    """``obj`` as strict JSON on stdout (:func:`compare.run.jsonable.plain`)."""
+    json.dump(plain(obj), sys.stdout, indent=2, allow_nan=False)
+    sys.stdout.write("\n")
+
+
+clean_nan = plain  # the one JSON cleaner (compare.run.jsonable); old name kept for callers
+
+
+# --- run store, scheduler and interruption (issue 12; appended by the store12 helper) ---
+def add_store_args(parser: argparse.ArgumentParser, scheduler: bool = False) -> None:
+    """``--cache DIR``, ``--no-cache`` and, with ``scheduler``, ``--scheduler ADDRESS``."""
+    from compare.run.store import default_cache_dir
+
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--cache", metavar="DIR", default=None,
+                       help="run store directory: finished runs are reused, a killed run "
+                            f"resumes [$TRILITH_CACHE or {default_cache_dir()}]")
+    group.add_argument("--no-cache", action="store_true",
+                       help="compute everything, store nothing")
+    if scheduler:
+        parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                            help="run on a Dask distributed cluster, e.g. tcp://host:8786 "
+                                 "(default: local processes)")
+
+
+def use_store(args: argparse.Namespace):
+    """Activate the run store (and scheduler) the options ask for; returns the store
+    (None with ``--no-cache``).  Call before any work: a bad ``--cache`` or
+    ``--scheduler`` is a usage error."""
+    from compare.run import runs
+    from compare.run.store import RunStore, default_cache_dir
+
+    address = getattr(args, "scheduler", None)
+    if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
+                                                        "ucx://")) and "://" in address):
+        raise ValueError(f"--scheduler must be an address like tcp://host:8786, got {address!r}")
+    runs.set_scheduler(address)
+    runs.STATS.clear()
+    store = None if getattr(args, "no_cache", False) else RunStore(
+        args.cache if getattr(args, "cache", None) else default_cache_dir())
+    runs.activate(store)
+    return store

@@ -1,0 +1,77 @@
+"""``trilith record``: write a GIF/MP4 of a run, headless (see ``compare/show/record.py``)."""
+from __future__ import annotations
+
+import argparse
+
+from engines import backend_names
+
+from compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, FORMATS,
+                           RecordSettings, check_output, default_duration, record,
+                           resolve_engines)
+
+from compare.cli.options import (add_pulse_args, add_record_arg, add_scene_args, check_output_path,
+                      check_run_budget, excitation_from_args, scene_from_args)
+
+
+def add_watch_args(parser: argparse.ArgumentParser) -> None:
+    """Options shared by ``view`` and ``record``."""
+    add_scene_args(parser)
+    parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
+                        help="backends side by side on one time base "
+                             f"({', '.join(backend_names())}), or all "
+                             f"({', '.join(ALL_ENGINES)})")
+    add_pulse_args(parser, required=False)
+    parser.set_defaults(amplitude=None, omega=None)
+    for action in parser._actions:  # the defaults live in compare.show.record: show them
+        if action.dest == "amplitude":
+            action.help += f" (default: {DEFAULT_AMPLITUDE:g}, the paper's case A)"
+        elif action.dest == "omega":
+            action.help += f" (default: {DEFAULT_OMEGA:g})"
+    add_record_arg(parser)
+    parser.add_argument("--fps", type=float, default=30.0, help="frames per second")
+    parser.add_argument("--duration", type=float, default=None, metavar="S",
+                        help="seconds to show (default: ten pulse periods, the paper's t_max)")
+
+
+def watch_inputs(args: argparse.Namespace) -> tuple:
+    """``(scene, excitation, settings)``, all checked, and the run budget of each
+    backend over the recorded span."""
+    from engines import get_backend
+
+    settings = RecordSettings(fps=args.fps, duration=args.duration,
+                              panel_width=getattr(args, "width", 480),
+                              panel_height=getattr(args, "height", 360))
+    scene = scene_from_args(args)
+    excitation = excitation_from_args(args, default=(DEFAULT_AMPLITUDE, DEFAULT_OMEGA))
+    names = resolve_engines(args.engine)
+    duration = args.duration if args.duration is not None else default_duration(excitation)
+    for name in names:
+        check_run_budget(name, get_backend(name).Settings(), excitation, option="--duration",
+                         length=duration)
+    return scene, excitation, settings
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "record", help="record a run to a GIF or MP4 (no display needed)",
+        description="Simulate a scene in one backend (or all, side by side on the same "
+                    "time base) and write an animation. GIF needs only Pillow; MP4 needs "
+                    "ffmpeg on PATH.")
+    add_watch_args(parser)
+    parser.add_argument("--out", required=True, metavar="FILE",
+                        help="output file, .gif or .mp4 (its directory must exist)")
+    parser.add_argument("--width", type=int, default=480, help="pixels per panel")
+    parser.add_argument("--height", type=int, default=360, help="pixels per panel")
+
+
+def run(args: argparse.Namespace) -> int:
+    scene, excitation, settings = watch_inputs(args)
+    check_output_path(args.out, "--out", suffixes=FORMATS)
+    check_output(args.out)  # the encoder (ffmpeg for .mp4)
+    result = record(scene, excitation, args.engine, args.out, settings)
+    verdicts = ", ".join(f"{name}: {traj.verdict.status}"
+                         + (f" at {traj.verdict.time:.3f} s" if traj.overturned else "")
+                         for name, traj in result.trajectories.items())
+    print(f"wrote {result.path}: {result.n_frames} frames at {result.fps:g} fps "
+          f"({result.duration:.3f} s); {verdicts}")
+    return 0

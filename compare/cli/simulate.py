@@ -1,0 +1,137 @@
+"""``trilith simulate``: one run of one backend under a pulse or a recorded ground motion."""
+from __future__ import annotations
+
+import argparse
+import math
+
+from analytic.contact_forces import violations
+
+from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
+                      add_scene_args, check_output_path, check_run_budget, clean_nan, detail,
+                      envelope, excitation_from_args, info, print_json, scene_from_args, sig)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "simulate",
+        help="simulate one pulse (or record) in one backend; verdict, events, optional CSV/plot",
+        description="Run the trilith under a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse, "
+                    "or a recorded ground motion (--record), in one backend and report the "
+                    "verdict (overturned or not, mode, time), the events and the backend's "
+                    "diagnostics.")
+    add_scene_args(parser)
+    add_pulse_args(parser, required=False)
+    add_record_arg(parser)
+    add_engine_arg(parser)
+    parser.add_argument("--criterion", choices=("topple", "alpha"), default=None,
+                        help="overturned at |theta| = 1.5 rad (topple) or at alpha "
+                             "(default: the backend's, topple)")
+    parser.add_argument("--t-max", type=float, default=None, metavar="S",
+                        help="fixed run length [s], > 0 (default: until the verdict is "
+                             "decided exactly, docs/overturning.md)")
+    parser.add_argument("--json", action="store_true",
+                        help="print the inputs and the trajectory summary as strict JSON")
+    parser.add_argument("--csv", metavar="FILE", default=None,
+                        help="write t, theta, theta_dot, psi, psi_dot samples")
+    parser.add_argument("--plot", metavar="FILE.png", default=None,
+                        help="write theta(t)/alpha and psi(t) (PNG, PDF or SVG)")
+    return parser
+
+
+def _settings(name: str, criterion: str | None, t_max: float | None):
+    """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied."""
+    from engines import configure
+    if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
+        raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
+    options = {}
+    if criterion is not None:  # configure keeps the backend's topple angle
+        options["criterion"] = criterion
+    if t_max is not None:
+        options["t_max"] = t_max
+    return configure(name, **options)
+
+
+def _plot(traj, scene, path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = 2 if scene.has_pendulum else 1
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.6 * rows), squeeze=False)
+    ax = axes[0, 0]
+    ax.plot(traj.t, traj.theta / scene.alpha, lw=1.0)
+    ax.axhline(1.0, color="0.6", lw=0.6, ls="--")
+    ax.axhline(-1.0, color="0.6", lw=0.6, ls="--")
+    ax.set_ylabel(r"$\theta/\alpha$")
+    for e in traj.impacts:
+        ax.axvline(e.t, color="0.85", lw=0.5, zorder=0)
+    v = traj.verdict
+    ax.set_title(f"{traj.backend}: {v.status}" + (f" ({v.mode}, t = {v.time:.3f} s)"
+                                                    if v.overturned else ""), fontsize=9)
+    if scene.has_pendulum:
+        axes[1, 0].plot(traj.t, traj.psi, lw=1.0, color="C1")
+        axes[1, 0].set_ylabel(r"$\psi$ [rad]")
+    axes[-1, 0].set_xlabel("t [s]")
+    fig.tight_layout()
+    from compare.run.atomic import savefig
+    savefig(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def _describe_excitation(excitation) -> str:
+    d = excitation.describe()
+    if d["type"] == "pulse":
+        return (f"{d['kind']} pulse A = {sig(d['amplitude'])} m/s^2, "
+                f"Omega = {sig(d['omega'])} rad/s")
+    return (f"record {d['label']} ({d['n_samples']} samples, {sig(d['end_time'])} s, "
+            f"peak {sig(d['peak'])} m/s^2)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from engines import get_backend
+
+    # Every check before the run: scene, excitation, engine, settings, budget, outputs.
+    scene = scene_from_args(args)
+    excitation = excitation_from_args(args)
+    backend = get_backend(args.engine)
+    settings = _settings(args.engine, args.criterion, args.t_max)
+    check_run_budget(args.engine, settings, excitation)
+    if args.csv is not None:
+        check_output_path(args.csv, "--csv")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    traj = backend.simulate(scene, excitation, settings)
+    if args.csv is not None:
+        from compare.run.atomic import atomic_path
+        with atomic_path(args.csv) as tmp:
+            traj.to_csv(tmp)
+    if args.plot is not None:
+        _plot(traj, scene, args.plot)
+    if args.json:
+        summary = traj.summary()
+        timings = summary.pop("timings")
+        inputs = {"scene": scene.to_dict(), "excitation": excitation.describe(),
+                  "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max}
+        body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
+        print_json(clean_nan(envelope("simulate", inputs, body, timings)))
+        return 0
+    v = traj.verdict
+    print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
+          f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}")
+    line = f"verdict: {v.status}"
+    if v.overturned:
+        line += f" ({v.mode}) at t = {v.time:.4f} s"
+    print(line + (f" -- {v.reason}" if v.reason else ""))
+    up = traj.uplift_time
+    print(f"uplift: {'none' if up is None else f'{up:.4f} s'}, impacts: {traj.n_impacts}, "
+          f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "
+          f"t_end = {traj.t[-1]:.3f} s")
+    detail(f"engine {backend.version()}, wall time {traj.wall_time:.3f} s")
+    if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
+        info(f"warning: the analytic model is not valid along this run: "
+             f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")
+    if args.csv is not None:
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        info(f"wrote {args.plot}")
+    return 0

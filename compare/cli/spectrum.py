@@ -1,0 +1,268 @@
+"""``trilith spectrum``: overturning spectra with and without the pendulum (Fig. 5)."""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from engines import engine_names
+
+from compare.cli import options as _common
+from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
+                      add_workers_arg, check_output_path, clean_nan, envelope, info,
+                      parse_omega_range, print_json, resolve_workers, scene_from_args,
+                      use_store)
+
+DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
+ENGINE = "analytic-fast"  # the spectra's backend (compiled model, same verdicts)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "spectrum",
+        help="overturning spectrum: first overturning amplitude per frequency, with and "
+             "without pendulum, and the gain Delta (Fig. 5)",
+        description="For each pulse frequency, raise the amplitude from the uplift "
+                    "acceleration until the first overturning, then bisect to --tol. Both "
+                    "curves (with and without the pendulum), the gain "
+                    "Delta = 100 (A_yp - A_np)/A_np and the overturning modes.")
+    add_scene_args(parser)
+    add_pulse_kind_arg(parser)
+    parser.add_argument("--omega", default=DEFAULT_OMEGA, metavar="START:STOP:STEP",
+                        help="frequencies [rad/s] in [0.1, 1e4], STOP included, or a comma "
+                             "list; at most 100000")
+    parser.add_argument("--tol", type=float, default=None, metavar="A",
+                        help="bisection resolution of the amplitude [m/s^2], in (1e-6, 10] "
+                             "(default: 0.01)")
+    parser.add_argument("--scan-step", type=float, default=None, metavar="A",
+                        help="scan step floor [m/s^2], in (1e-4, 100]; windows narrower than "
+                             "the step can be missed (default: 0.1)")
+    add_workers_arg(parser)
+    parser.add_argument("--criterion", choices=("topple", "alpha"), default="topple",
+                        help="overturned at |theta| = 1.5 rad (topple) or at alpha")
+    parser.add_argument("--t-max", type=float, default=None, metavar="S",
+                        help="fixed run length [s] (default: exact survival rules)")
+    parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
+                        help="analytic (the model's spectrum), or engines to bisect on the same "
+                             f"grid around it: {', '.join(engine_names())}, or all")
+    parser.add_argument("--dt", type=float, default=None, metavar="S",
+                        help="engine time step [s], in (0, 0.01] (default: each engine's "
+                             "calibrated step)")
+    parser.add_argument("--convergence", action="store_true",
+                        help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
+                             "solver iterations to classify the cause")
+    parser.add_argument("--json", action="store_true", help="print a JSON object")
+    parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
+    parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
+    add_store_args(parser, scheduler=True)
+    return parser
+
+
+def _cached_frequency(payload):
+    """One frequency (both curves) through the run store: the key is the scene,
+    the search settings (pulse kind included) and Omega."""
+    from compare.run import runs
+    fn, description, omega = payload
+    return runs.memo("spectrum-point", {**description, "omega": omega}, lambda: fn(omega))
+
+
+def _stored_frequency(payload):
+    """The stored result of :func:`_cached_frequency`, or None (looked up in this
+    process: a warm rerun starts no pool and loads no kernel)."""
+    from compare.run import runs
+    _fn, description, omega = payload
+    return runs.lookup("spectrum-point", {**description, "omega": omega})
+
+
+def _map_fn(scene, settings, workers: int):
+    """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
+    through the store, on local processes or the ``--scheduler`` cluster."""
+    from compare.run import runs
+    from compare.run.store import scene_dict
+
+    description = {"scene": scene_dict(scene), "settings": settings.describe()}
+
+    def map_fn(fn, omegas):
+        return runs.run_many(_cached_frequency, [(fn, description, w) for w in omegas],
+                             workers=workers, lookup=_stored_frequency)
+    return map_fn
+
+
+def _settings(args: argparse.Namespace):
+    from analytic.spectrum import SpectrumSettings, search_run_settings
+    from analytic.trajectory import OverturnCriterion
+
+    if args.t_max is not None and not (math.isfinite(args.t_max) and 0 < args.t_max <= 1e5):
+        raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {args.t_max!r}")
+    if args.tol is not None and not (math.isfinite(args.tol) and 1e-6 < args.tol <= 10):
+        raise ValueError(f"--tol must be in (1e-06, 10] m/s^2, got {args.tol!r}")
+    if args.scan_step is not None and not (math.isfinite(args.scan_step)
+                                           and 1e-4 < args.scan_step <= 100):
+        raise ValueError(f"--scan-step must be in (0.0001, 100] m/s^2, got {args.scan_step!r}")
+    fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
+    kw = {"pulse": args.pulse, "fast": fast}
+    if args.tol is not None:
+        kw["tol"] = args.tol
+    if args.scan_step is not None:
+        kw["scan_step"] = args.scan_step
+    if kw.get("tol", 0.01) > kw.get("scan_step", SpectrumSettings.scan_step):
+        raise ValueError("--tol must not exceed --scan-step")
+    return SpectrumSettings(**kw)
+
+
+def plot_spectrum(spec, path) -> None:
+    """Fig. 5 layout: both curves on top (dashed = without pendulum), Delta below."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.4),
+                                   gridspec_kw={"height_ratios": [2, 1]})
+    ax1.plot(spec.omega, spec.a_pendulum, "k-", label="with pendulum")
+    ax1.plot(spec.omega, spec.a_no_pendulum, "k--", label="without pendulum")
+    for jump in spec.mode_jumps():
+        ax1.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0)
+    ax1.set_ylabel(r"overturning amplitude $A_s$ [m/s$^2$]")
+    sc = spec.scene
+    ax1.set_title(f"{spec.settings.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
+                  f"gamma={sc.gamma:g}, mu={sc.mu:g}; {spec.criterion.kind}, "
+                  f"t_max={spec.t_max}", fontsize=9)
+    ax1.legend(fontsize=8)
+    ax2.plot(spec.omega, spec.gain_percent, "k-")
+    ax2.axhline(0.0, color="0.6", lw=0.8)
+    ax2.set_xlabel(r"$\Omega$ [rad/s]")
+    ax2.set_ylabel(r"gain $\Delta$ [%]")
+    fig.tight_layout()
+    from compare.run.atomic import savefig
+    savefig(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def _number(value: float, width: int) -> str:
+    return f"{value:{width}.4g}" if math.isfinite(value) else f"{'nan':>{width}}"
+
+
+def run(args: argparse.Namespace) -> int:
+    from analytic.fast_settings import version
+    from analytic.spectrum import overturning_spectrum
+    from compare.run import atomic
+
+    scene = scene_from_args(args)
+    omegas = parse_omega_range(args.omega, "--omega")
+    settings = _settings(args)
+    workers = resolve_workers(args.workers)
+    if args.csv is not None:
+        check_output_path(args.csv, "--csv")
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    # A bar only for a person watching (TTY); it shows up after 1 s of work.
+    progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
+    engines_wanted = _engines(args)
+    use_store(args)
+    spec = overturning_spectrum(scene, omegas, settings, progress=progress,
+                                map_fn=_map_fn(scene, settings, workers))
+    if engines_wanted:
+        return _run_engines(args, scene, spec, engines_wanted, workers)
+    if args.csv is not None:
+        with atomic.atomic_path(args.csv) as tmp:
+            spec.to_csv(tmp)
+    if args.plot is not None:
+        plot_spectrum(spec, args.plot)
+    if args.json:
+        body = spec.to_dict()
+        timings = {"wall_time": body.pop("wall_time"), "workers": workers}
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+                  "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
+                  "scan_step": args.scan_step, "engine": ENGINE}
+        body = {"engine": ENGINE, "engine_version": version(), **body}
+        print_json(clean_nan(envelope("spectrum", inputs, body, timings)))
+        return 0
+    print(f"scene {scene.name}: lam = {scene.lam:.4g}, b = {scene.b:.4g} m, mu = {scene.mu:.4g}, "
+          f"gamma = {scene.gamma:.4g}; {settings.pulse} pulse; criterion "
+          f"{settings.criterion.kind}, t_max = {settings.t_max}, tol = {settings.tol:g} m/s^2, "
+          f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)")
+    print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13} {'A_yp [m/s^2]':>12} "
+          f"{'mode_yp':>13} {'Delta [%]':>9}")
+    gain = spec.gain_percent
+    for i, w in enumerate(spec.omega):
+        print(f"{w:13.4g} {_number(spec.a_no_pendulum[i], 12)} "
+              f"{spec.mode_no_pendulum[i] or '-':>13} {_number(spec.a_pendulum[i], 12)} "
+              f"{spec.mode_pendulum[i] or '-':>13} {_number(gain[i], 9)}")
+    for jump in spec.mode_jumps():
+        print(f"mode jump ({jump['curve']}): {jump['mode_before']} at Omega = "
+              f"{jump['omega_before']:g} rad/s -> {jump['mode_after']} at "
+              f"{jump['omega_after']:g} rad/s")
+    missing = int(sum(1 for a in list(spec.a_no_pendulum) + list(spec.a_pendulum)
+                      if not math.isfinite(a)))
+    if missing:
+        info(f"warning: {missing} point(s) did not overturn up to a_max = "
+             f"{settings.a_max:g} m/s^2 (shown as nan)")
+    if spec.n_undecided:
+        info(f"warning: {spec.n_undecided} run(s) undecided (counted as not overturned)")
+    info(f"{spec.n_runs} runs in {spec.wall_time:.2f} s on {workers} worker(s)")
+    if args.csv is not None:
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        info(f"wrote {args.plot}")
+    return 0
+
+
+def _engines(args: argparse.Namespace) -> tuple[str, ...]:
+    """The engines asked for (empty for the analytic spectrum); checked up front."""
+    from engines import engine_list
+    if args.engine.strip() == "analytic":
+        if args.dt is not None or args.convergence:
+            raise ValueError("--dt and --convergence need --engine NAME (an engine)")
+        return ()
+    names = engine_list(args.engine)
+    if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= 0.01):
+        raise ValueError(f"--dt must be in (0, 0.01] s, got {args.dt!r}")
+    return names
+
+
+def _run_engines(args, scene, spec, names, workers: int) -> int:
+    from pathlib import Path
+
+    from compare.run import atomic
+    from compare.measure import engine_spectrum as es
+    from compare.measure import engine_spectrum_files as files
+
+    import time
+
+    options = {} if args.dt is None else {"dt": args.dt}
+    results, walls = [], {}
+    for name in names:
+        t0 = time.perf_counter()
+        results.append(es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
+                                          convergence=args.convergence, **options))
+        walls[name] = time.perf_counter() - t0
+    if args.csv:
+        with atomic.atomic_path(args.csv) as tmp:
+            files.write_csv(results, tmp)
+    if args.plot:
+        with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
+            files.plot(spec, results, tmp)
+    if args.json:
+        from analytic.fast_settings import version
+        analytic = spec.to_dict()
+        timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
+                   "workers": workers}
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+                  "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
+                  "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
+                  "convergence": args.convergence}
+        body = {"engine": list(names),
+                "engine_version": {"analytic": version(), **{r.engine: r.version for r in results}},
+                "analytic": analytic, "engines": {r.engine: r.to_dict() for r in results}}
+        print_json(envelope("spectrum", inputs, body, timings))
+        return 0
+    for r in results:
+        print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, bracket "
+              f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %")
+        print(f"{'curve':>11} {'Omega':>6} {'A_model':>8} {'A_engine':>8} {'error':>7}  cause")
+        for curve, points in r.curves.items():
+            for p in points:
+                print(f"{curve:>11} {p.omega:6.3g} {p.a_analytic:8.3f} {p.a_engine:8.3f} "
+                      f"{100 * p.rel_error:+6.2f}%  {p.cause}"
+                      + ("" if p.cause == "agrees" else f": {p.cause_detail}"))
+    return 0

@@ -1,0 +1,26 @@
+"""``trilith view``: watch a run in a window (see ``compare/show/view.py``).
+
+Without a display it exits with code 2 and a message pointing at ``trilith record``.
+"""
+from __future__ import annotations
+
+import argparse
+
+from compare.show.view import view
+
+from compare.cli.record import add_watch_args, watch_inputs
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "view", help="watch a run in a window (PyBullet GUI or matplotlib animation)",
+        description="Simulate a scene and show it live. Needs a display; otherwise use "
+                    "'trilith record' (exit code 2).")
+    add_watch_args(parser)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene, excitation, _ = watch_inputs(args)
+    view(scene, excitation, args.engine, fps=args.fps, duration=args.duration,
+         scene_arg=args.scene)
+    return 0
