@@ -21,13 +21,14 @@ add to gravity).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import pydrake
 
 from analytic.options import check_real
 from engines.base import Engine, EngineSettings
 from engines.diagnostics import PlaneState, Pose
+from engines.monitor import MonitorSettings
 
 from .world import CONTACT_MODELS, SOLVERS, DrakeWorld
 
@@ -72,10 +73,11 @@ class Settings(EngineSettings):
         Pressure-field modulus [Pa] of the compliant boxes (hydroelastic only).
     """
 
+    monitor: MonitorSettings = field(default_factory=lambda: MonitorSettings(impact_window=5e-3))
     contact_model: str = "point"
     solver: str = "sap"
     sink_fraction: float = 3e-5
-    damping_ratio: float = 3.0
+    damping_ratio: float = 2.5
     relaxation_time: float | None = None
     dissipation: float = 20.0
     sphere_fraction: float = 1.7e-4
@@ -122,6 +124,12 @@ class DrakeEngine(Engine):
     color = "tab:brown"
     marker = "P"
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
+    known_failures = {
+        "pendulum_follows_eq1": "compliant contact: the swinging pendulum tilts the frame "
+                                "elastically by 3.3e-6 rad, above the check's 1e-6 rad for "
+                                "'stayed down' (uplift is 1e-4 rad); psi follows Eq. 1 within "
+                                "9.2e-6 rad, 2.8e-4 rad/s (tests/test_drake_engine.py)",
+    }
     default_friction = 10.0
     Settings = Settings
 
