@@ -190,7 +190,8 @@ def test_sampled_record_falls_back_to_accurate(fig5):
 
 def test_contract_and_validation(fig5):
     backend = get_backend("analytic-fast")
-    assert backend is fast and fast.NAME == "analytic-fast" and "numba" in fast.version()
+    assert backend.name == fast.NAME == "analytic-fast" and backend.Settings is fast.Settings
+    assert "numba" in fast.version() and backend.version() == fast.version()
     assert dataclasses.is_dataclass(fast.Settings) and fast.Settings.__dataclass_params__.frozen
     for bad in ({"t_max": -1.0}, {"t_max": math.inf}, {"rtol": 0.0}, {"atol": -1.0},
                 {"rest_velocity": math.nan}, {"sample_dt": 0.0}, {"max_steps": 5},

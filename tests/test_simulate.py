@@ -22,7 +22,7 @@ FREE = Pulse(0.0, 1e4)  # zero-amplitude pulse over 0.6 ms: free motion from the
 # --- contract ----------------------------------------------------------------------------
 def test_backend_contract():
     backend = get_backend("analytic")
-    assert backend.NAME == NAME == "analytic"
+    assert backend.name == NAME == "analytic" and backend.Settings is Settings
     assert version().startswith("analytic-")
     assert dataclasses.is_dataclass(Settings) and Settings.__dataclass_params__.frozen
     assert {"criterion", "t_max"} <= {f.name for f in dataclasses.fields(Settings)}

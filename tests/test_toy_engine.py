@@ -50,3 +50,16 @@ def test_the_toy_engine_is_pymunk_bit_for_bit(fig5):
     for field in ("t", "theta", "theta_dot", "psi", "psi_dot"):
         assert np.array_equal(getattr(toy, field), getattr(ref, field)), field
     assert toy.verdict == ref.verdict and toy.diagnostics.keys() == ref.diagnostics.keys()
+
+
+def test_an_installed_package_registers_by_entry_point(monkeypatch):
+    from importlib.metadata import EntryPoint
+    ep = EntryPoint("toy", "toy_engine:ToyEngine", engines.ENTRY_POINT_GROUP)
+    monkeypatch.setattr("importlib.metadata.entry_points",
+                        lambda group=None: [ep] if group == engines.ENTRY_POINT_GROUP else [])
+    engines._installed.cache_clear()
+    try:
+        assert engines.engine_names()[-1] == "toy" and engines.get_backend("toy") is ToyEngine
+        assert engines.engine_list("all") == engines.ENGINES + ("toy",)
+    finally:
+        engines._installed.cache_clear()

@@ -18,7 +18,7 @@ __all__ = ["trust_table", "threshold_agreement", "engine_cost", "key_settings", 
 
 # Settings that are bookkeeping, not the engine's numerical choices.
 _NOT_SETTINGS = {"criterion", "t_max", "theta0", "psi0", "monitor", "engine_version", "t_cap",
-                 "base_motion"}
+                 "base_motion", "blowup_distance", "blowup_speed"}
 
 
 def label(name: str) -> str:
