@@ -33,8 +33,9 @@ Phase semantics
   the threshold, and its ``reason`` says so.  :func:`simulate` never exits
   early: a trajectory always shows the whole fall.
 
-Sampled records are not compiled: :func:`simulate` hands them to the accurate
-path (``analytic.simulate``) and says so in the trajectory's diagnostics.
+Sampled records and the pulses of :mod:`analytic.pulses` are not compiled:
+:func:`simulate` hands them to the accurate path (``analytic.simulate``) and
+says so in the trajectory's diagnostics.
 """
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ import time
 import numpy as np
 
 from . import _fast_kernels as _k
-from .excitation import Pulse, SampledRecord
+from .excitation import Pulse
 from .fast_settings import Settings, version
 from .parameters import Scene
 from .trajectory import Event, Trajectory, Verdict
@@ -135,8 +136,9 @@ def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
 def _check(scene, excitation, settings) -> Settings:
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
-    if not isinstance(excitation, (Pulse, SampledRecord)):
-        raise ValueError("excitation must be a Pulse or a SampledRecord, got "
+    if not (hasattr(excitation, "acceleration") and hasattr(excitation, "end_time")):
+        raise ValueError("excitation must be a ground motion (Pulse, Ricker, "
+                         "MavroeidisPapageorgiou, SampledRecord), got "
                          f"{type(excitation).__name__}")
     settings = Settings() if settings is None else settings
     if not isinstance(settings, Settings):
@@ -159,15 +161,17 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     """Run ``scene`` under ``excitation``; returns a :class:`Trajectory`.
 
     Samples on the ``sample_dt`` grid plus one row at every event (the state
-    after it).  A :class:`SampledRecord` is handed to the accurate path.
+    after it).  Any other ground motion than a one-sine or one-cosine
+    :class:`Pulse` (a record, a Ricker wavelet, ...) is handed to the accurate path.
     """
     settings = _check(scene, excitation, settings)
-    if isinstance(excitation, SampledRecord):
+    if not isinstance(excitation, Pulse):
         from . import simulate as accurate  # the fallback the docstring promises
         acc_settings = accurate.Settings(criterion=settings.criterion, t_max=settings.t_max,
                                          rest_velocity=settings.rest_velocity)
         traj = accurate.simulate(scene, excitation, acc_settings)
-        traj.diagnostics["fast_path_fallback"] = "sampled record: accurate path used"
+        traj.diagnostics["fast_path_fallback"] = (f"{type(excitation).__name__}: accurate "
+                                                  "path used")
         return traj
     t0 = time.perf_counter()
     # No early exit here: a trajectory shows the fall up to the threshold.

@@ -16,8 +16,10 @@ Phases (the compiled fast path ``analytic/fast.py`` implements the same):
 
 Integration segments never straddle a discontinuity of ``xg_ddot`` (the ends of
 the excitation window); REST segments also stop at the pulse's ``|xg_ddot|`` peaks
-(a record's samples), where the margin is smallest, so a short dip below zero is
-not stepped over.  An uplift whose rocking stays below the integrator's
+(``peak_times``), and check the margin at a record's samples (integrated in
+blocks of up to 4096 samples; a sample past the margin sends the interval
+before it to a one-sample segment), where the margin is smallest, so a short
+dip below zero is not stepped over.  An uplift whose rocking stays below the integrator's
 resolution (``s*theta`` never positive: a margin dip of nanoseconds) keeps the
 trilith down until the margin is positive again, then Event('rest').
 Without a pendulum (``gamma = 0``) ``psi`` and
@@ -70,6 +72,9 @@ REASON_REST = "at rest after the pulse without pendulum"
 REASON_PERIOD = "at rest after the pulse: no uplift during one free-pendulum period"
 REASON_WINDOW = "t_max reached without overturning (fixed window)"
 REASON_CAP = "t_cap reached after the pulse before the outcome was certain"
+# Record samples per REST integration: doubled after each block without uplift,
+# back to one at an uplift (so at most one block is integrated in vain).
+REST_BLOCK_MAX = 4096
 
 
 def version() -> str:
@@ -94,15 +99,13 @@ class _Run:
         self.breaks = sorted({x for x in (self.t_on, self.t_off) if 0.0 < x < self.t_stop})
         times = getattr(excitation, "times", None)
         # A record's xg_ddot has kinks at its samples, where the (then piecewise
-        # linear) margin has its minima: REST segments stop at every sample.
+        # linear) margin has its minima: REST checks the margin at every sample.
         self.kinks = np.asarray(times, dtype=float) if times is not None else None
+        self.rest_block = 1  # kinks per REST integration, grows while at rest
         # A pulse's |xg_ddot| extrema, where the margin has its minima: REST
         # segments stop there too, so a short dip below zero cannot hide inside
         # one step (exact without a pendulum, whose margin depends on t only).
-        kind = getattr(excitation, "kind", None)
-        quarter = 0.25 * excitation.end_time
-        self.peaks = ([quarter, 3.0 * quarter] if kind == "sine" else
-                      [2.0 * quarter] if kind == "cosine" else [])
+        self.peaks = list(getattr(excitation, "peak_times", ()))
         self.t = 0.0
         self.theta, self.theta_dot = st.theta0, st.theta_dot0
         self.psi, self.psi_dot = st.psi0, st.psi_dot0
@@ -204,6 +207,7 @@ class _Run:
             if self.t + period < t_b:
                 t_b = period_end = self.t + period
         b, h, mu, gamma, j, l, g = self.args
+        block_kinks = None
         if self.pend:
             def fun(t, y):
                 return (y[1], eq.rest_pendulum_acceleration(y[0], xg(t), l, g))
@@ -221,19 +225,42 @@ class _Run:
             # checks per small-amplitude period (the error control takes smaller steps).
             max_step = 2.0 * math.pi * math.sqrt(l / g) / 100.0
         elif self.kinks is not None:
+            # Between kinks xg_ddot is linear: the margin's minima are at the kinks
+            # (no pendulum) or on the pendulum's slow time scale.  One integration
+            # covers a block of kinks (the margin is then checked at each kink),
+            # so the cost per sample is not that of one solve_ivp call.
             k = int(np.searchsorted(self.kinks, self.t, side="right"))
+            block = 1 if recover else self.rest_block
             if k < len(self.kinks):
-                t_b = min(t_b, float(self.kinks[k]))
-            max_step = math.inf  # between kinks xg_ddot is linear: the margin's minima
-            # are at the kinks (no pendulum) or on the pendulum's slow time scale
+                k_end = min(k + block, len(self.kinks)) - 1
+                t_b = min(t_b, float(self.kinks[k_end]))
+                block_kinks = self.kinks[k:k_end + 1]
+            max_step = (2.0 * math.pi * math.sqrt(l / g) / 100.0 if self.pend and block > 1
+                        else math.inf)
         else:
             t_b = min([t_b] + [p for p in self.peaks if p > self.t])
             max_step = self.st.rest_step_fraction * self.excitation.end_time
         events = ([margin_event(recover, +1)] if recover else
                   [margin_event(1), margin_event(-1)])
-        sol = self.solve(fun, t_b, [self.psi, self.psi_dot], events, max_step=max_step)
-        hit = self.first_event(sol)
-        t1 = float(sol.t[-1]) if hit is None else hit[1]
+        while True:
+            sol = self.solve(fun, t_b, [self.psi, self.psi_dot], events, max_step=max_step)
+            hit = self.first_event(sol)
+            t1 = float(sol.t[-1]) if hit is None else hit[1]
+            if block_kinks is None:
+                break
+            # The margin may cross zero between two kinks inside a long step: the
+            # first kink past it bounds the crossing, whose interval is then
+            # integrated alone (one kink, the events resolve the root).
+            i = (None if block_kinks.size < 2 else
+                 self._first_kink_past_margin(sol.sol, xg, block_kinks[block_kinks < t1]))
+            if i is None:
+                self.rest_block = min(2 * self.rest_block, REST_BLOCK_MAX) if hit is None else 1
+                break
+            self.rest_block = 1
+            if i > 0:
+                t1, hit = float(block_kinks[i - 1]), None
+                break
+            t_b, block_kinks, max_step = float(block_kinks[0]), block_kinks[:1], math.inf
         side = 0
         if hit is not None:
             side = recover or (1 if hit[0] == 0 else -1)
@@ -252,6 +279,17 @@ class _Run:
             self.uplift(side)
         elif period_end is not None and t1 == period_end:
             self.survive(REASON_PERIOD)
+
+    def _first_kink_past_margin(self, dense, xg, kinks: np.ndarray) -> int | None:
+        """Index of the first of ``kinks`` (record samples inside a REST segment)
+        where the uplift margin of either side is ``<= 0``; None if there is none."""
+        if kinks.size == 0:
+            return None
+        psi, psi_dot = dense(kinks)
+        for i, (tk, p, pd) in enumerate(zip(kinks.tolist(), psi.tolist(), psi_dot.tolist())):
+            if min(self.margins(xg(tk), p, pd)) <= 0.0:
+                return i
+        return None
 
     def _nudge(self, dense, xg, side, t1, recover=False):
         b, h, mu, gamma, j, l, g = self.args

@@ -37,6 +37,8 @@ ENGINE_CLASSES: dict[str, str] = {
     "pybullet": "engines.pybullet_:PyBulletEngine",
     "pymunk": "engines.pymunk_:PymunkEngine",
     "mujoco": "engines.mujoco_:MujocoEngine",
+    "dart": "engines.dart_:DartEngine",
+    "drake": "engines.drake_:DrakeEngine",
 }
 BACKENDS: dict[str, str] = {
     "analytic": "engines.analytic_:Analytic",

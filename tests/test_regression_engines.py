@@ -30,7 +30,8 @@ CONFIG = CampaignConfig()  # calibrated engine settings, theta0 = alpha/2, 4 imp
 # without it at 12.5 rad/s (after-impact branch, 5 rad/s below its jump at
 # 17.5-18).  Below ~10 rad/s the pendulum curve has narrow overturning windows
 # (see analytic/spectrum.py), where "the" threshold is ill-posed for a bisection.
-CASES = {"pybullet": ("no_pendulum", 12.5), "pymunk": ("fig5", 13.0), "mujoco": ("fig5", 12.5)}
+CASES = {"pybullet": ("no_pendulum", 12.5), "pymunk": ("fig5", 13.0), "mujoco": ("fig5", 12.5),
+         "dart": ("no_pendulum", 12.5), "drake": ("fig5", 13.0)}
 
 
 @pytest.mark.slow

@@ -98,12 +98,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     modules = {}
     for name in COMMANDS:
-        try:
-            module = importlib.import_module(f"compare.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"compare.cli.{name}":
-                continue
-            raise
+        module = importlib.import_module(f"compare.cli.{name}")
         module.add_parser(sub)
         modules[name] = module
     return parser, modules

@@ -99,15 +99,18 @@ def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
 
 
 def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
+    """``--pulse``, ``-A`` (m/s^2 or ``0.5g``), ``-w`` (rad/s or ``2Hz``) or
+    ``--period`` [s]; read by :func:`excitation_from_args` (units: ``cli/units.py``)."""
     add_pulse_kind_arg(parser)
-    parser.add_argument("--amplitude", "-A", type=float, required=required,
-                        help="pulse amplitude A [m/s^2], |A| <= 1e4")
-    parser.add_argument("--omega", "-w", type=float, required=required,
-                        help="pulse circular frequency Omega [rad/s], in [0.1, 1e4]")
-
-
-def pulse_from_args(args: argparse.Namespace) -> Pulse:
-    return Pulse(args.amplitude, args.omega, args.pulse)
+    parser.add_argument("--amplitude", "-A", required=required, metavar="A",
+                        help="pulse amplitude A [m/s^2] or with a g suffix (0.5g), "
+                             "|A| <= 1e4 m/s^2")
+    parser.add_argument("--omega", "-w", default=None, metavar="OMEGA",
+                        help="pulse circular frequency Omega [rad/s] or with an Hz suffix "
+                             "(2Hz), in [0.1, 1e4] rad/s")
+    parser.add_argument("--period", default=None, metavar="T",
+                        help="pulse period T [s] instead of --omega (Omega = 2 pi / T), "
+                             "in [6.3e-4, 62.8] s")
 
 
 def add_record_arg(parser: argparse.ArgumentParser) -> None:
@@ -115,24 +118,69 @@ def add_record_arg(parser: argparse.ArgumentParser) -> None:
                         help="a recorded ground motion instead of a pulse: CSV with two "
                              "columns t [s], a [m/s^2], or a PEER NGA .AT2 file "
                              "(scenes/records/sample.csv is a synthetic example)")
+    scale = parser.add_mutually_exclusive_group()
+    scale.add_argument("--scale", default=None, metavar="F",
+                       help="multiply the record by F > 0")
+    scale.add_argument("--pga", default=None, metavar="A",
+                       help="scale the record to a peak ground acceleration [m/s^2] or "
+                            "with a g suffix (0.3g)")
+    scale.add_argument("--pgv", default=None, metavar="V",
+                       help="scale the record to a peak ground velocity [m/s] or with "
+                            "cm/s (25cm/s)")
+
+
+def _omega_from_args(args: argparse.Namespace) -> float | None:
+    from .units import parse_frequency, parse_period
+    omega, period = args.omega, getattr(args, "period", None)
+    if omega is not None and period is not None:
+        raise ValueError("give -w/--omega or --period, not both")
+    if period is not None:
+        return parse_period(period, "--period")
+    return None if omega is None else parse_frequency(omega, "-w/--omega")
+
+
+def scaled_record(record, args: argparse.Namespace):
+    """``record`` scaled by ``--scale``, ``--pga`` or ``--pgv`` (at most one)."""
+    from .units import parse_acceleration, parse_velocity
+    try:
+        if getattr(args, "scale", None) is not None:
+            try:
+                factor = float(args.scale)
+            except ValueError:
+                raise ValueError(f"--scale: {args.scale!r} is not a number") from None
+            return record.scaled(factor)
+        if getattr(args, "pga", None) is not None:
+            return record.to_pga(parse_acceleration(args.pga, "--pga"))
+        if getattr(args, "pgv", None) is not None:
+            return record.to_pgv(parse_velocity(args.pgv, "--pgv"))
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
+    return record
 
 
 def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] | None = None):
-    """``--record FILE`` (a :class:`analytic.excitation.SampledRecord`) or the pulse
-    ``-A/-w`` (``default`` fills in what is not given).  A record excludes ``-A/-w``."""
+    """``--record FILE`` (a :class:`analytic.excitation.SampledRecord`, scaled by
+    ``--scale/--pga/--pgv``) or the pulse ``-A`` with ``-w`` or ``--period``
+    (``default`` fills in what is not given).  A record excludes the pulse options."""
+    from .units import parse_acceleration
     record = getattr(args, "record", None)
-    given = [f for f, v in (("--amplitude", args.amplitude), ("--omega", args.omega))
-             if v is not None]
+    given = [f for f, v in (("--amplitude", args.amplitude), ("--omega", args.omega),
+                            ("--period", getattr(args, "period", None))) if v is not None]
     if record is not None:
         if given:
             raise ValueError(f"--record replaces the pulse: drop {' and '.join(given)}")
         from scenes.ground_motion import load_record
-        return load_record(record, option="--record")
-    amplitude = args.amplitude if args.amplitude is not None else (default or (None, None))[0]
-    omega = args.omega if args.omega is not None else (default or (None, None))[1]
+        return scaled_record(load_record(record, option="--record"), args)
+    scaling = [f for f in ("scale", "pga", "pgv") if getattr(args, f, None) is not None]
+    if scaling:
+        raise ValueError(f"--{scaling[0]} scales a --record; a pulse's amplitude is -A")
+    amplitude = (parse_acceleration(args.amplitude, "-A/--amplitude")
+                 if args.amplitude is not None else (default or (None, None))[0])
+    omega = _omega_from_args(args)
+    omega = omega if omega is not None else (default or (None, None))[1]
     if amplitude is None or omega is None:
         missing = " and ".join(f for f, v in (("-A/--amplitude", amplitude),
-                                              ("-w/--omega", omega)) if v is None)
+                                              ("-w/--omega (or --period)", omega)) if v is None)
         raise ValueError(f"give {missing} for a pulse, or --record FILE")
     return Pulse(amplitude, omega, args.pulse)
 

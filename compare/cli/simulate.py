@@ -6,6 +6,7 @@ import math
 
 from analytic.contact_forces import violations
 
+from compare.cli.units import acceleration_text, frequency_text, velocity_text
 from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
                       add_scene_args, check_output_path, check_run_budget, clean_nan, detail,
                       envelope, excitation_from_args, info, print_json, scene_from_args, sig)
@@ -84,10 +85,10 @@ def _plot(traj, scene, path: str) -> None:
 def _describe_excitation(excitation) -> str:
     d = excitation.describe()
     if d["type"] == "pulse":
-        return (f"{d['kind']} pulse A = {sig(d['amplitude'])} m/s^2, "
-                f"Omega = {sig(d['omega'])} rad/s")
+        return (f"{d['kind']} pulse A = {acceleration_text(d['amplitude'])}, "
+                f"Omega = {frequency_text(d['omega'])}")
     return (f"record {d['label']} ({d['n_samples']} samples, {sig(d['end_time'])} s, "
-            f"peak {sig(d['peak'])} m/s^2)")
+            f"PGA {acceleration_text(d['peak'])}, PGV {velocity_text(d['pgv'])})")
 
 
 def run(args: argparse.Namespace) -> int:

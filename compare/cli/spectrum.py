@@ -8,6 +8,7 @@ import sys
 from engines import engine_names
 
 from compare.cli import options as _common
+from compare.cli.fragility import add_ida_args, record_spectrum
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
                       add_workers_arg, check_output_path, clean_nan, envelope, info,
                       parse_omega_range, print_json, resolve_workers, scene_from_args,
@@ -54,6 +55,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
+    parser.add_argument("--record", metavar="FILE", default=None,
+                        help="a recorded ground motion (CSV or PEER .AT2) instead of pulses: "
+                             "its first overturning intensity by incremental dynamic "
+                             "analysis (--im, --im-range, ...; see 'trilith fragility')")
+    scale = parser.add_mutually_exclusive_group()
+    scale.add_argument("--scale", default=None, metavar="F", help="multiply the record by F")
+    scale.add_argument("--pga", default=None, metavar="A", help=argparse.SUPPRESS)
+    scale.add_argument("--pgv", default=None, metavar="V", help=argparse.SUPPRESS)
+    add_ida_args(parser)
     add_store_args(parser, scheduler=True)
     return parser
 
@@ -148,6 +158,8 @@ def run(args: argparse.Namespace) -> int:
     from compare.run import atomic
 
     scene = scene_from_args(args)
+    if args.record is not None:
+        return _record_spectrum(args, scene)
     omegas = parse_omega_range(args.omega, "--omega")
     settings = _settings(args)
     workers = resolve_workers(args.workers)
@@ -206,6 +218,19 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         info(f"wrote {args.plot}")
     return 0
+
+
+def _record_spectrum(args: argparse.Namespace, scene) -> int:
+    """``--record``: the pulse options do not apply; the engines are those asked for."""
+    given = [f"--{n.replace('_', '-')}" for n in ("tol", "scan_step", "dt", "t_max", "csv", "plot")
+             if getattr(args, n) is not None]
+    if args.omega != DEFAULT_OMEGA:
+        given.insert(0, "--omega")
+    if given or args.convergence:
+        raise ValueError(f"--record searches the record's intensity: drop "
+                         f"{' and '.join(given) or '--convergence'}")
+    backends = ("analytic",) + (() if args.engine.strip() == "analytic" else _engines(args))
+    return record_spectrum(args, scene, backends, resolve_workers(args.workers))
 
 
 def _engines(args: argparse.Namespace) -> tuple[str, ...]:

@@ -1,0 +1,277 @@
+"""``trilith fragility``: incremental dynamic analysis over a suite of records and
+the fragility curves P(overturn | IM) of the model and of each engine.
+
+For each record and backend: the lowest intensity that overturns
+(:mod:`analytic.ida`, window-aware, with the survival islands above it); then per
+backend the empirical curve and a lognormal fit with a bootstrap band
+(:mod:`compare.measure.fragility`), and each engine's agreement with the model.
+Every run goes through the run store (a killed command resumes); records run in
+parallel (``--workers``) or on a Dask cluster (``--scheduler``).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+from analytic.excitation import G_STANDARD
+from analytic.ida import IM_UNITS, IDASettings
+from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
+                                 check_output_path, info, parse_engine_list, resolve_workers,
+                                 scene_from_args, use_store)
+
+IM_TEXT = {"pga": "PGA", "pgv": "PGV", "scale": "scale factor"}
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    from engines import ENGINES
+    parser = subparsers.add_parser(
+        "fragility", help="IDA over a record suite; fragility curves of the model and engines",
+        description=__doc__)
+    add_scene_args(parser)
+    parser.add_argument("--records", required=True, metavar="DIR|SUITE",
+                        help="a directory of PEER .AT2 / CSV records, or 'sample'")
+    add_ida_args(parser)
+    parser.add_argument("--engine", default="none", metavar="NAME[,NAME...]",
+                        help=f"engines beside the model: {', '.join(ENGINES)}, or none")
+    parser.add_argument("--out", default="fragility", metavar="DIR",
+                        help="writes fragility.json, fragility.csv and fragility.png")
+    add_workers_arg(parser)
+    add_store_args(parser, scheduler=True)
+    return parser
+
+
+DEFAULT_RANGES = {"pga": (0.5, 20.0), "pgv": (0.05, 2.0), "scale": (0.1, 10.0)}
+
+
+def _im_range(args) -> tuple[float, float]:
+    from compare.cli.units import parse_acceleration, parse_velocity
+    if args.im_range is None:
+        return DEFAULT_RANGES[args.im]
+    lo, sep, hi = args.im_range.partition(":")
+    if not sep:
+        raise ValueError(f"--im-range expects LO:HI, got {args.im_range!r}")
+    parse = {"pga": parse_acceleration, "pgv": parse_velocity,
+             "scale": lambda t, o: float(t)}[args.im]
+    try:
+        return parse(lo, "--im-range"), parse(hi, "--im-range")
+    except ValueError as exc:
+        raise ValueError(str(exc) if str(exc).startswith("--im-range") else
+                         f"--im-range: {args.im_range!r} is not LO:HI") from None
+
+
+def ida_job(item):
+    """One record, one backend: its :class:`analytic.ida.IDAResult` as plain data,
+    through the run store (each run stored, the whole search memoised)."""
+    import engines
+
+    from analytic.ida import first_overturn_intensity
+    from compare.run import runs
+    from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
+    backend, scene, record, st = item
+    extra = {"sample_dt": 0.01} if backend == "analytic" else {}
+
+    def settings_for(motion):
+        return engines.configure(backend, t_max=motion.end_time + st.tail, **extra)
+
+    def overturns(motion) -> bool:
+        return runs.simulate(backend, scene, motion, settings_for(motion)).verdict.overturned
+
+    def compute():
+        res = first_overturn_intensity(record, overturns, st)
+        return {**res.describe(), "runs": [[v, o] for v, o in res.runs]}
+    what = {"backend": backend, "scene": scene_dict(scene),
+            "record": digest(excitation_dict(record)), "ida": st.describe(),
+            "settings": settings_dict(settings_for(record))}
+    return runs.memo("ida", what, compute, label=f"ida {backend} {record.label}")
+
+
+def run(args: argparse.Namespace) -> int:
+    from engines import ENGINES
+    from scenes.ground_motion import load_suite
+
+    scene = scene_from_args(args)
+    engines_ = parse_engine_list(args.engine, ENGINES, none_ok=True)
+    st = ida_settings(args)
+    workers = resolve_workers(args.workers)
+    out = check_output_path(args.out, "--out", directory=True)
+    suite = load_suite(args.records)
+    store = use_store(args)
+    backends = ("analytic",) + engines_
+    items = [(b, scene, r, st) for b in backends for r in suite]
+    results = _run_all(items, workers, args.scheduler)
+    doc = _summarise(scene, suite, backends, st, results)
+    _write(out, doc, st)
+    _print(doc, st)
+    if store is not None:
+        from compare.run.runs import stats_line
+        info(stats_line())
+    return 0
+
+
+def _run_all(items, workers: int, scheduler):
+    import sys
+
+    from tqdm import tqdm
+
+    from compare.run.runs import run_many
+    bar = tqdm(total=len(items), unit="record", desc="fragility",
+               disable=not sys.stderr.isatty())
+    try:
+        return list(run_many(ida_job, items, workers=workers, scheduler=scheduler,
+                             on_done=lambda i, r: bar.update(1)))
+    finally:
+        bar.close()
+
+
+def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
+    from compare.measure.fragility import agreement, fragility
+    n = len(suite)  # results come in the order of the items: backend-major
+    per = {b: results[i * n:(i + 1) * n] for i, b in enumerate(backends)}
+    fits = {b: fragility([math.inf if r["censored"] else r["im_overturn"] for r in per[b]],
+                         censored_at=st.im_hi) for b in backends}
+    ref = fits["analytic"]
+    return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
+            "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
+                         "duration": r.end_time, "n_samples": len(r.times)} for r in suite],
+            "backends": {b: {"fit": fits[b].describe(), "records": per[b],
+                             **({} if b == "analytic" else
+                                {"agreement": agreement(ref, fits[b])})}
+                         for b in backends},
+            "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+
+
+def _write(out, doc: dict, st: IDASettings) -> None:
+    import json
+
+    from compare.run.atomic import write_text
+    from compare.run.jsonable import plain
+    write_text(out / "fragility.json", json.dumps(plain(doc), indent=1, allow_nan=False))
+    rows = ["backend,record,im,unit,im_overturn,im_safe,censored,islands,n_runs"]
+    for b, body in doc["backends"].items():
+        for r in body["records"]:
+            islands = ";".join(f"{a:.6g}-{c:.6g}" for a, c in r["islands"])
+            rows.append(",".join(str(x) for x in (
+                b, r["label"], st.im, IM_UNITS[st.im] or "-",
+                "" if r["im_overturn"] is None else f"{r['im_overturn']:.6g}",
+                "" if r["im_safe"] is None else f"{r['im_safe']:.6g}",
+                r["censored"], islands, r["n_runs"])))
+    write_text(out / "fragility.csv", "\n".join(rows) + "\n")
+    _plot(out / "fragility.png", doc, st)
+
+
+def _plot(path, doc: dict, st: IDASettings) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from scipy import stats
+
+    from compare.run.atomic import savefig
+    from compare.measure.fragility import empirical_curve
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    colours = {"analytic": "k", "pybullet": "C0", "pymunk": "C1", "mujoco": "C2"}
+    for b, body in doc["backends"].items():
+        fit, c = body["fit"], colours.get(b, None)
+        ims = np.array([math.inf if v is None else v for v in fit["im"]])
+        x, f = empirical_curve(ims)
+        if x.size:
+            ax.step(np.concatenate([[x[0] / 2], x]), np.concatenate([[0.0], f]), where="post",
+                    color=c, alpha=0.6, lw=1.0)
+        grid = np.array(fit["band"]["im"])
+        if fit["median"] is not None:
+            curve = stats.norm.cdf(np.log(grid / fit["median"]) / fit["beta"])
+            ax.plot(grid, curve, color=c, lw=1.8,
+                    label=f"{b}: median {fit['median']:.3g}, beta {fit['beta']:.2f}")
+            lo = np.array([np.nan if v is None else v for v in fit["band"]["lower"]])
+            hi = np.array([np.nan if v is None else v for v in fit["band"]["upper"]])
+            ax.fill_between(grid, lo, hi, color=c, alpha=0.12, lw=0)
+    ax.set_xscale("log")
+    unit = IM_UNITS[st.im]
+    ax.set_xlabel(f"{IM_TEXT[st.im]}" + (f" [{unit}]" if unit else ""))
+    if st.im == "pga":
+        sec = ax.secondary_xaxis("top", functions=(lambda a: a / G_STANDARD,
+                                                   lambda g: g * G_STANDARD))
+        sec.set_xlabel("PGA [g]")
+    ax.set_ylabel("P(overturn | IM)")
+    ax.set_ylim(0.0, 1.0)
+    if ax.get_legend_handles_labels()[1]:  # no fit (fewer than 2 overturns): no line
+        ax.legend(fontsize=8, loc="upper left")
+    pendulum = "" if doc["scene"].get("gamma", 0.0) > 0.0 else " without pendulum"
+    ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records "
+                 "(steps: empirical; lines: lognormal fit, 90 % band)",
+                 fontsize=9)
+    fig.tight_layout()
+    savefig(fig, path, dpi=120)
+    plt.close(fig)
+
+
+def _print(doc: dict, st: IDASettings) -> None:
+    unit = IM_UNITS[st.im]
+    for b, body in doc["backends"].items():
+        fit = body["fit"]
+        med = fit["median"]
+        shown = "no fit (fewer than 2 overturns)" if med is None else (
+            f"median {med:.4g} {unit}" + (f" ({med / G_STANDARD:.3g} g)" if st.im == "pga" else "")
+            + f", beta {fit['beta']:.3f}")
+        print(f"{b}: {fit['n']} records, {fit['n_censored']} never overturned up to "
+              f"{st.im_hi:g} {unit}; {shown}")
+        islands = sum(len(r["islands"]) for r in body["records"])
+        if islands:
+            print(f"  {islands} survival islands above a first overturn (see fragility.csv)")
+        ag = body.get("agreement")
+        if ag:
+            ratio = "n/a" if ag["median_ratio"] is None else f"{ag['median_ratio']:.3f}"
+            print(f"  vs model: median ratio {ratio}, largest distance fitted "
+                  f"{ag['max_distance_fit'] if ag['max_distance_fit'] is not None else 'n/a'}"
+                  f", empirical {ag['max_distance_empirical']:.3f}")
+
+
+def add_ida_args(parser: argparse.ArgumentParser) -> None:
+    """The IDA search options shared by ``fragility`` and ``spectrum --record``."""
+    parser.add_argument("--im", choices=("pga", "pgv", "scale"), default="pga",
+                        help="intensity measure: PGA [m/s^2], PGV [m/s] or the scale factor")
+    parser.add_argument("--im-range", default=None, metavar="LO:HI",
+                        help="search range of the intensity (PGA accepts a g suffix: "
+                             "0.05g:2g; default 0.5:20 m/s^2, 0.05:2 m/s, 0.1:10)")
+    parser.add_argument("--rel-step", type=float, default=0.15, metavar="R",
+                        help="grid step ratio minus one, in (0, 10]: overturning windows "
+                             "narrower than one step may be missed")
+    parser.add_argument("--rtol", type=float, default=0.01, metavar="R",
+                        help="relative width of the final bracket, below --rel-step")
+    parser.add_argument("--tail", type=float, default=5.0, metavar="S",
+                        help="seconds run after each record ends (the same fixed window "
+                             "for every backend)")
+
+
+def ida_settings(args) -> IDASettings:
+    lo, hi = _im_range(args)
+    return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step, rtol=args.rtol,
+                       tail=args.tail)
+
+
+def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:
+    """``trilith spectrum --record FILE``: the record's first overturning intensity
+    (and islands) for each backend; ``--json`` prints them as one object."""
+    from compare.cli.options import print_json, scaled_record
+    from scenes.ground_motion import load_record
+    st = ida_settings(args)
+    record = scaled_record(load_record(args.record, option="--record"), args)
+    use_store(args)
+    results = _run_all([(b, scene, record, st) for b in backends], workers, args.scheduler)
+    if args.json:
+        print_json({"command": "spectrum", "record": record.describe(), "ida": st.describe(),
+                    "backends": dict(zip(backends, results))})
+        return 0
+    unit = IM_UNITS[st.im]
+    print(f"record {record.label}: PGA {record.pga:.4g} m/s^2 ({record.pga / G_STANDARD:.3g} g), "
+          f"PGV {record.pgv:.4g} m/s; first overturning {IM_TEXT[st.im]} "
+          f"(grid step {100 * st.rel_step:g} %, bracket {100 * st.rtol:g} %):")
+    for b, r in zip(backends, results):
+        if r["censored"]:
+            print(f"  {b}: none up to {st.im_hi:g} {unit}")
+            continue
+        g = f" ({r['im_overturn'] / G_STANDARD:.3g} g)" if st.im == "pga" else ""
+        isl = "".join(f", survives again {a:.4g}-{c:.4g}" for a, c in r["islands"])
+        print(f"  {b}: {r['im_overturn']:.4g} {unit}{g}{isl}")
+    return 0

@@ -1,0 +1,147 @@
+"""Fragility curves: P(overturn | IM) over a suite of ground motions.
+
+Each motion contributes its first overturning intensity ``IM_i``
+(:func:`analytic.ida.first_overturn_intensity`), or is right-censored at the
+search's ``im_hi`` when it never overturned.  Then
+
+* the empirical curve ``F(x) = #{IM_i <= x} / N`` (all ``N`` motions, censored
+  ones included in ``N``: with a common censoring level it is exact below it);
+* a lognormal fit ``F(x) = Phi(ln(x / median) / beta)`` by maximum likelihood
+  with the censored motions as such (:class:`scipy.stats.CensoredData`,
+  ``scipy.stats.lognorm.fit`` with ``floc=0``: ``s = beta``, ``scale = median``);
+* a confidence band: the pointwise percentiles of the fitted curve over a
+  bootstrap of the motions (resampled with replacement; default 400 resamples,
+  90 %).
+
+The agreement of two curves (an engine's against the model's): the ratio of
+their medians and the largest vertical distance between the fitted curves and
+between the empirical ones (the Kolmogorov-Smirnov statistic of the two samples).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+__all__ = ["FragilityFit", "fit_lognormal", "empirical_curve", "fragility",
+           "agreement"]
+
+
+@dataclass(frozen=True)
+class FragilityFit:
+    """A fragility curve of one backend.
+
+    ``median`` [IM unit] and ``beta`` (the lognormal dispersion) of the
+    maximum-likelihood fit (NaN when fewer than two motions overturned: no
+    dispersion can be fitted); ``band``: ``(im_grid, lower, upper)`` of the
+    bootstrap band; ``im`` the sorted first overturning intensities (``inf`` =
+    censored)."""
+
+    median: float
+    beta: float
+    n: int
+    n_censored: int
+    im: tuple
+    band: tuple
+    level: float
+
+    def cdf(self, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if not (math.isfinite(self.median) and math.isfinite(self.beta)):
+            return np.full(x.shape, math.nan)
+        return stats.norm.cdf(np.log(x / self.median) / self.beta)
+
+    def describe(self) -> dict:
+        grid, lo, hi = self.band
+        fin = lambda v: float(v) if math.isfinite(v) else None  # noqa: E731
+        return {"median": fin(self.median), "beta": fin(self.beta), "n": self.n,
+                "n_censored": self.n_censored, "im": [fin(v) for v in self.im],
+                "band_level": self.level,
+                "band": {"im": [float(v) for v in grid], "lower": [fin(v) for v in lo],
+                         "upper": [fin(v) for v in hi]}}
+
+
+def fit_lognormal(im: np.ndarray, censored_at: float) -> tuple[float, float]:
+    """``(median, beta)`` by maximum likelihood; ``inf`` entries of ``im`` are
+    right-censored at ``censored_at``.  NaNs when fewer than two are uncensored."""
+    im = np.asarray(im, dtype=float)
+    seen = im[np.isfinite(im)]
+    if seen.size < 2 or np.ptp(seen) == 0.0 and seen.size == im.size:
+        return math.nan, math.nan
+    n_cens = int(np.sum(~np.isfinite(im)))
+    if n_cens == 0:
+        # The closed form: the MLE of a lognormal is the mean and (biased)
+        # standard deviation of ln IM.
+        logs = np.log(seen)
+        return float(math.exp(logs.mean())), float(logs.std())
+    data = stats.CensoredData(uncensored=seen, right=np.full(n_cens, censored_at))
+    s, _loc, scale = stats.lognorm.fit(data, floc=0.0)
+    return float(scale), float(s)
+
+
+def empirical_curve(im: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, F)``: the steps of the empirical curve at the uncensored ``IM_i``."""
+    im = np.asarray(im, dtype=float)
+    x = np.sort(im[np.isfinite(im)])
+    return x, np.arange(1, x.size + 1) / im.size
+
+
+def fragility(im, censored_at: float, grid=None, n_boot: int = 400, level: float = 0.9,
+              seed: int = 0) -> FragilityFit:
+    """The fit and its bootstrap band (module docstring).
+
+    Parameters
+    ----------
+    im : sequence of float
+        First overturning intensities, ``inf`` for a motion that never overturned.
+    censored_at : float
+        The search's upper end (``IDASettings.im_hi``).
+    grid : array, optional
+        Intensities of the band (default: 60 points, geometric, over the data).
+    n_boot, level, seed
+        Bootstrap resamples, band level, random seed (results are reproducible).
+    """
+    im = np.asarray(im, dtype=float)
+    if im.size < 1:
+        raise ValueError("fragility needs at least one ground motion")
+    median, beta = fit_lognormal(im, censored_at)
+    seen = im[np.isfinite(im)]
+    if grid is None:
+        lo = float(seen.min()) / 2.0 if seen.size else censored_at / 10.0
+        grid = np.geomspace(lo, censored_at, 60)
+    grid = np.asarray(grid, dtype=float)
+    rng = np.random.default_rng(seed)
+    curves = []
+    for _ in range(n_boot):
+        m, b = fit_lognormal(rng.choice(im, size=im.size, replace=True), censored_at)
+        if math.isfinite(m) and math.isfinite(b) and b > 0.0:
+            curves.append(stats.norm.cdf(np.log(grid / m) / b))
+    if curves:
+        q = (1.0 - level) / 2.0
+        lower, upper = np.quantile(np.array(curves), [q, 1.0 - q], axis=0)
+    else:
+        lower = upper = np.full(grid.shape, math.nan)
+    return FragilityFit(median, beta, int(im.size), int(im.size - seen.size),
+                        tuple(np.sort(im).tolist()), (grid, lower, upper), level)
+
+
+def agreement(a: FragilityFit, b: FragilityFit) -> dict:
+    """How ``b`` (an engine) departs from ``a`` (the model): ``median_ratio``
+    (b / a), ``max_distance_fit`` (largest ``|F_b - F_a|`` of the fitted curves
+    on ``a``'s band grid) and ``max_distance_empirical`` (the two-sample
+    Kolmogorov-Smirnov statistic of the empirical curves)."""
+    grid = np.asarray(a.band[0], dtype=float)
+    d_fit = float(np.max(np.abs(b.cdf(grid) - a.cdf(grid))))
+    xs = np.unique(np.concatenate([np.asarray(a.im), np.asarray(b.im)]))
+    xs = xs[np.isfinite(xs)]
+
+    def steps(fit, x):
+        ims = np.asarray(fit.im, dtype=float)
+        return np.array([np.sum(ims <= v) / ims.size for v in x])
+    d_emp = float(np.max(np.abs(steps(a, xs) - steps(b, xs)))) if xs.size else 0.0
+    ratio = b.median / a.median if a.median and math.isfinite(a.median) else math.nan
+    fin = lambda v: float(v) if math.isfinite(v) else None  # noqa: E731
+    return {"median_ratio": fin(ratio), "max_distance_fit": fin(d_fit),
+            "max_distance_empirical": d_emp}
