@@ -169,8 +169,10 @@ def test_missing_cause_reads_not_measured():
 def test_html_first_screen_provenance_and_layout(synthetic):
     _, doc, out = synthetic
     html = (out / "index.html").read_text(encoding="utf-8")
-    # The trust table comes before any evidence; settings are folded away at the end.
-    assert html.index("Trust table") < html.index("Verdicts") < html.index("<details>")
+    # The recommendation and the trust table come before any evidence; the scene and
+    # configuration are folded away at the end.
+    assert (html.index("Recommendation") < html.index("Trust table") < html.index("Verdicts")
+            < html.index("Engine settings") < html.index("<details><summary>Scene"))
     assert "QUICK RUN" in html and doc["quick"] is True
     assert "name='viewport'" in html and "max-width:100%" in html
     assert html.count("class='scroll'") >= 5  # every table scrolls inside its own box
@@ -183,8 +185,10 @@ def test_html_first_screen_provenance_and_layout(synthetic):
     for key in ("date", "commit", "command", "versions", "machine"):
         assert prov[key]
     assert {"python", "numpy", "scipy", "pybullet", "pymunk"} <= set(prov["versions"])
-    # Percentages where the tolerance is a percentage.
-    assert "≤ 0.5 %" in html and "within 2 %" in html
+    # Percentages where the tolerance is a percentage (a no-break space keeps the
+    # number on the line of its unit).
+    text = html.replace("\u00a0", " ")
+    assert "≤ 0.5 %" in text and "within 2 %" in text
 
 
 def test_command_line_is_recorded(tmp_path, monkeypatch):
