@@ -36,9 +36,10 @@ from scenes import load_scene, scene_names
 __all__ = ["Study", "load_study", "reference_jobs", "threshold_jobs", "run_reference",
            "run_threshold", "JOB_RUNS"]
 
-# Runs per threshold job, for estimates: 2 bracket runs + log2(2 rel_bracket /
-# rel_tol) bisection runs (thresholds.py); 6 at the defaults.
-JOB_RUNS = 6
+# Runs per threshold job, for estimates: the guard, 2 bracket runs, log2(2 rel_bracket /
+# rel_tol) bisection runs and 4 robustness runs (compare/measure/thresholds.py); 10 at the
+# defaults.
+JOB_RUNS = 10
 _KEYS = {"name", "scenes", "engines", "pulses", "omega", "steps", "cases", "rel_bracket",
          "rel_tol", "workers"}
 
@@ -198,15 +199,15 @@ def threshold_description(job: tuple) -> dict:
 def run_threshold(job: tuple) -> dict:
     """One engine threshold (a row of the combined report), through the store."""
     from compare.run import runs
-    from compare.measure.thresholds import engine_threshold
+    from compare.measure.engine_spectrum import measure_point
 
     n, c, p, w, a_ref, mode, e, dt, rb, rt = job
     scene = _scene(n, c)
 
-    def compute():
+    def compute():  # the one threshold measurement; causes without the reruns
         settings = job_settings(e, dt, scene, a_ref, w)
-        return engine_threshold(e, scene, w, a_ref, settings, kind=p, mode_reference=mode,
-                                rel_bracket=rb, rel_tol=rt)
+        return measure_point(e, scene, w, a_ref, mode, case=c, kind=p, rel_tol=rt,
+                             rel_bracket=rb, convergence=False, settings=settings)
     row = {"scene": n, "case": c, "pulse": p, "omega": w, "engine": e, "dt": dt or None,
            "a_reference": a_ref, "mode_reference": mode}
     try:
@@ -214,7 +215,10 @@ def run_threshold(job: tuple) -> dict:
                           label=f"threshold {e} dt={dt:g}", code=runs.ALL_CODE)
     except Exception as exc:  # noqa: BLE001 - one bad run must not sink hours of work
         return {**row, "error": f"{type(exc).__name__}: {exc}"}
-    return {**row, "a_engine": point.a_engine, "a_low": point.a_low,
-            "rel_error": point.rel_error, "bracketed": point.bracketed,
-            "mode_engine": point.mode_engine, "n_runs": point.n_runs,
-            "irregular_runs": point.irregular_runs, "wall_time": point.provenance.wall_time}
+    return {**row, "a_engine": point.a_engine, "a_survives": point.a_survives,
+            "rel_error": point.rel_error, "rel_resolution": point.rel_resolution,
+            "bracketed": point.bracketed, "mode_engine": point.mode_engine,
+            "n_runs": point.n_runs, "irregular_runs": point.irregular_runs,
+            "isolated": len(point.isolated), "cause": point.cause, "valid": point.valid,
+            "cpu_s": point.cpu_s, "cpu_s_spent": point.point.cpu_s_spent,
+            "from_store": point.point.from_store}

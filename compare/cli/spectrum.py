@@ -225,6 +225,7 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
     from compare.measure import engine_spectrum as es
     from compare.measure import engine_spectrum_files as files
 
+    import os
     import time
 
     options = {} if args.dt is None else {"dt": args.dt}
@@ -244,7 +245,8 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         from analytic.fast_settings import version
         analytic = spec.to_dict()
         timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
-                   "workers": workers}
+                   "engine_cpu_s": {r.engine: r.cost() for r in results},
+                   "load_average": list(os.getloadavg()), "workers": workers}
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
@@ -255,12 +257,16 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         print_json(envelope("spectrum", inputs, body, timings))
         return 0
     for r in results:
-        print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, bracket "
-              f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %")
+        cost = r.cost()
+        print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, robust bracket "
+              f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %; {cost['runs']} runs, "
+              f"{cost['cpu_s']:.1f} CPU s when computed ({cost['cpu_s_spent']:.1f} spent now, "
+              f"{cost['points_from_store']} of {cost['points']} points from the run store)")
         print(f"{'curve':>11} {'Omega':>6} {'A_model':>8} {'A_engine':>8} {'error':>7}  cause")
         for curve, points in r.curves.items():
             for p in points:
-                print(f"{curve:>11} {p.omega:6.3g} {p.a_analytic:8.3f} {p.a_engine:8.3f} "
-                      f"{100 * p.rel_error:+6.2f}%  {p.cause}"
+                iso = f" [{len(p.isolated)} isolated]" if p.isolated else ""
+                print(f"{curve:>11} {p.omega:6.3g} {p.a_reference:8.3f} {p.a_engine:8.3f} "
+                      f"{100 * p.rel_error:+6.2f}%  {p.cause}{iso}"
                       + ("" if p.cause == "agrees" else f": {p.cause_detail}"))
     return 0

@@ -11,11 +11,12 @@ __all__ = ["write_csv", "plot", "CSV_FIELDS"]
 
 # Labels of the error panel: the cause of each point outside the tolerance.
 _SHORT = {"model": "model", "jump": "jump", "window": "window", "discretisation": "dt",
-          "contact": "contact", "unknown": "?", "no-bracket": "none"}
+          "iterations": "iter", "contact": "contact", "sensitivity": "sens", "unknown": "?",
+          "no-bracket": "none"}
 
-CSV_FIELDS = ("engine", "curve", "omega", "a_analytic", "a_engine", "a_survives", "rel_error",
-              "mode_analytic", "mode_engine", "runs", "collapsed_below", "near_jump", "cause",
-              "cause_detail")
+CSV_FIELDS = ("engine", "curve", "omega", "a_reference", "a_engine", "a_survives", "rel_error",
+              "rel_resolution", "mode_reference", "mode_engine", "n_runs", "collapsed_below",
+              "valid", "cause", "cause_detail", "cpu_s")
 
 
 def write_csv(spectra: list[EngineSpectrum], path) -> None:
@@ -24,12 +25,13 @@ def write_csv(spectra: list[EngineSpectrum], path) -> None:
     import io
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(CSV_FIELDS)
+    w.writerow(CSV_FIELDS + ("isolated",))
     for es in spectra:
         for curve, points in es.curves.items():
             for p in points:
                 d = p.to_dict()
-                w.writerow([es.engine, curve] + [d[k] for k in CSV_FIELDS[2:]])
+                w.writerow([es.engine, curve] + [d[k] for k in CSV_FIELDS[2:]]
+                           + ["; ".join(f"{i['amplitude']:.6g}" for i in d["isolated"])])
     from pathlib import Path
     Path(path).write_text(buf.getvalue())
 

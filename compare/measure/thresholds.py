@@ -1,15 +1,33 @@
-"""Overturning thresholds of a backend, measured cheaply around the analytic ones.
+"""The one engine threshold search: a robust first-overturning bracket.
 
-An engine run costs ~0.1-1 s, so an engine spectrum is not scanned: at each
+An engine run costs ~0.05-1 CPU s, so an engine spectrum is not scanned: at each
 frequency the engine's first overturning amplitude is bisected inside a bracket
-centred on the analytic threshold ``A_ref (1 -/+ rel_bracket)``, widened
-(doubling) only when the engine disagrees by more than the bracket.  With the
-defaults a point costs 2 bracket runs plus ~5 bisection runs.
+around the analytic threshold ``A_ref``, widened (doubling) only where the engine
+disagrees.  Every caller (``trilith report``, ``spectrum --engine``, ``campaign``,
+``map --engine``) uses :func:`engine_threshold` with :data:`SEARCH`.
+
+Robustness.  An engine's verdict near its threshold can hang on a knife-edge:
+Pymunk at Omega 12 (Fig. 5, no pendulum) overturns at exactly 0.97 A_ref and
+survives at 0.9699 and 0.9701 A_ref.  So the bracket's ends are checked against
+a stated perturbation set, :data:`PERTURBATIONS`, that a real test would not
+control:
+
+* the overturning end ``a_engine`` must also overturn at ``a_engine (1 + 1e-4)``
+  and with an initial tilt of 1e-6 rad (each 1/50 of the 0.5 % bracket or less);
+* the surviving end ``a_survives`` must also survive at ``a_survives (1 - 1e-4)``
+  and with the same tilt.
+
+An overturn that its perturbed neighbours do not reproduce is *isolated*: kept in
+``isolated`` (amplitude, neighbours' verdicts), never taken as the threshold; the
+search goes on above it.  A perturbed run that overturns where the nominal one
+survives is isolated as well (a perturbation flipped the verdict).  Cost: 4 runs
+more per point than a plain bisection (2 per end), plus 2 per isolated overturn.
+A shift of the pulse's start by a fraction of a step is not in the set: a pulse
+has no start time to shift (:class:`analytic.excitation.Pulse`).
 
 Near a mode jump (the threshold curve is discontinuous in Omega) a small
 frequency shift moves the threshold a lot, so jumps are measured separately, as a
-frequency: at an amplitude between the two threshold levels of the jump the
-verdict flips across the jump frequency; that flip is bisected in Omega.
+frequency (:func:`compare.measure.jump_shift.engine_jump_frequency`).
 """
 from __future__ import annotations
 
@@ -22,8 +40,19 @@ from analytic.excitation import Pulse
 
 from compare.measure.trajectories import Provenance, settings_provenance
 
-__all__ = ["ThresholdPoint", "JumpShift", "engine_threshold", "engine_jump_frequency",
+__all__ = ["Probe", "ThresholdPoint", "Search", "SEARCH", "PERTURBATIONS", "engine_threshold",
            "overturns"]
+
+# Relative amplitude step of the neighbours and the initial tilt [rad] of the
+# robustness check.  1e-4 is 1/50 of the 0.5 % bracket and 1/200 of the 2 %
+# tolerance: a neighbour that flips the verdict is a knife-edge, not a threshold.
+# 1e-6 rad is 5e-6 of Fig. 5's alpha (0.197 rad) and 1/100 of the monitor's
+# 1e-4 rad uplift angle: no test bench controls a column's plumb that well.
+REL_NEIGHBOUR = 1e-4
+TILT = 1e-6
+PERTURBATIONS = {"above": f"amplitude x (1 + {REL_NEIGHBOUR:g})",
+                 "below": f"amplitude x (1 - {REL_NEIGHBOUR:g})",
+                 "tilt": f"initial tilt theta0 = {TILT:g} rad"}
 
 
 def _check_positive(name: str, value: float) -> float:
@@ -33,56 +62,113 @@ def _check_positive(name: str, value: float) -> float:
     return value
 
 
-def overturns(backend: str, scene, omega: float, amplitude: float, settings=None,
-              kind: str = "sine") -> tuple[bool, str, str | None]:
-    """One run: ``(overturned, status, mode)`` of ``backend`` under a pulse.
+@dataclass(frozen=True)
+class Probe:
+    """One run of a search: its verdict and cost.
 
-    'collapsed', 'unstable' and 'undecided' runs count as not overturned; their
-    status is returned so callers can flag them.  The run stops as soon as the
-    verdict is certain (``verdict_only``).
+    ``perturbation`` is '' for a probe of the search, else a key of
+    :data:`PERTURBATIONS`; ``cpu_s`` the CPU seconds the run cost when it was
+    computed (NaN if the backend does not report it); ``from_store`` True when
+    the run store served it (then it cost nothing now); ``sim_s`` the simulated
+    time [s] (a verdict-only run stops when its verdict is certain).
+    """
+
+    amplitude: float
+    status: str
+    mode: str | None
+    perturbation: str = ""
+    cpu_s: float = math.nan
+    from_store: bool = False
+    sim_s: float = math.nan
+
+    @property
+    def overturned(self) -> bool:
+        return self.status == "overturned"
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def overturns(backend: str, scene, omega: float, amplitude: float, settings=None,
+              kind: str = "sine") -> Probe:
+    """One run of ``backend`` under a pulse: its :class:`Probe`.
+
+    'collapsed', 'unstable' and 'undecided' runs do not count as overturned.
+    The run stops as soon as the verdict is certain (``verdict_only``).
     """
     from engines import configure
-    from compare.run.runs import simulate
-    # Only the verdict is needed: stop as soon as it is certain, overturning included.
+    from compare.run import runs
     settings = configure(backend, settings, verdict_only=True)
-    traj = simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
-    return traj.overturned, traj.verdict.status, traj.verdict.mode
+    hits = runs.STATS["hits"]
+    traj = runs.simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
+    cpu = traj.diagnostics.get("cpu_time", math.nan)
+    return Probe(float(amplitude), traj.verdict.status, traj.verdict.mode, "",
+                 float(cpu) if cpu is not None else math.nan, runs.STATS["hits"] > hits,
+                 float(traj.t[-1]) if len(traj.t) else 0.0)
+
+
+@dataclass(frozen=True)
+class Search:
+    """The parameters of the one threshold search (see :func:`engine_threshold`).
+
+    ``rel_tol`` 0.5 %: a quarter of the 2 % acceptance tolerance.  ``rel_bracket``
+    0.45 rel_tol: where the engine agrees, the guard, the first bracket and its
+    two robustness checks decide a point.  ``guard`` 3 %: probed first (1.5x
+    the tolerance), so a narrow bracket cannot hide an overturn up to 3 % below
+    the model.  ``max_expand`` 9: widenings up to 0.45 rel_tol 2^9 (115 % at
+    0.5 %).  ``max_isolated`` 6: isolated overturns tolerated before the point
+    is given up as not robustly bracketed.
+    """
+
+    rel_tol: float = 5e-3
+    rel_bracket: float = 0.45 * 5e-3
+    guard: float = 0.03
+    max_expand: int = 9
+    stop_on_collapse: bool = True
+    robust: bool = True
+    max_isolated: int = 6
+
+    def with_rel_tol(self, rel_tol: float) -> "Search":
+        return dataclasses.replace(self, rel_tol=rel_tol, rel_bracket=0.45 * rel_tol)
+
+
+SEARCH = Search()
 
 
 @dataclass(frozen=True)
 class ThresholdPoint:
     """A backend's first overturning amplitude at one frequency.
 
-    ``a_engine`` is the lowest amplitude found to overturn (upper end of the final
-    bracket ``[a_low, a_engine]``, whose width is ``<= rel_tol * a_reference``);
-    NaN when no bracket was found within ``max_expand`` widenings.
+    The engine survives robustly at ``a_survives`` and overturns robustly at
+    ``a_engine`` (``a_engine - a_survives <= rel_tol * a_reference``); both NaN
+    when no robust bracket was found.  ``isolated``: overturns (amplitude,
+    perturbation, the neighbours' verdicts) that were not reproduced.
+    ``cpu_s``: CPU seconds of every probe when computed; ``cpu_s_spent``: spent
+    now (0 when the store served every probe).
     """
 
     omega: float
     kind: str
     a_reference: float
     a_engine: float
-    a_low: float
+    a_survives: float
     mode_reference: str | None
     mode_engine: str | None
     n_runs: int
     irregular_runs: int
     rel_tol: float
     provenance: Provenance
-    probes: tuple = ()  # (amplitude, status, mode) of every run, in order
-
-    @property
-    def a_survives(self) -> float:
-        """Highest amplitude below ``a_engine`` seen to *survive* (NaN if none:
-        e.g. only collapsed runs below it)."""
-        below = [a for a, st, _ in self.probes if st == "survived" and a < self.a_engine]
-        return max(below) if below else math.nan
+    probes: tuple = ()  # Probe, in order
+    isolated: tuple = ()  # dicts: amplitude, mode, perturbation, neighbours
+    cpu_s: float = math.nan
+    cpu_s_spent: float = math.nan
 
     @property
     def collapsed_below(self) -> bool:
         """True when a run below ``a_engine`` ended 'collapsed': the engine's frame
         broke before it overturned (the threshold is then that of a broken frame)."""
-        return any(st == "collapsed" and a < self.a_engine for a, st, _ in self.probes)
+        top = self.a_engine if self.bracketed else math.inf
+        return any(p.status == "collapsed" and p.amplitude < top for p in self.probes)
 
     @property
     def bracketed(self) -> bool:
@@ -93,185 +179,201 @@ class ThresholdPoint:
         """``(A_engine - A_analytic)/A_analytic``."""
         return (self.a_engine - self.a_reference) / self.a_reference
 
+    @property
+    def rel_resolution(self) -> float:
+        """Width of the robust bracket over ``A_analytic``: ``rel_error``'s resolution."""
+        return (self.a_engine - self.a_survives) / self.a_reference
+
+    @property
+    def from_store(self) -> bool:
+        return bool(self.probes) and all(p.from_store for p in self.probes)
+
+    @property
+    def sim_s(self) -> float:
+        """Simulated seconds of every probe."""
+        return math.fsum(p.sim_s for p in self.probes)
+
+    @property
+    def cpu_per_sim_s(self) -> float:
+        """Real-time factor: CPU seconds per simulated second (when computed)."""
+        return self.cpu_s / self.sim_s if self.sim_s > 0 else math.nan
+
     def to_dict(self) -> dict:
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         out.update(provenance=self.provenance.to_dict(), rel_error=self.rel_error,
-                   bracketed=self.bracketed, a_survives=self.a_survives,
-                   collapsed_below=self.collapsed_below,
-                   probes=[list(p) for p in self.probes])
+                   rel_resolution=self.rel_resolution, bracketed=self.bracketed,
+                   collapsed_below=self.collapsed_below, from_store=self.from_store,
+                   sim_s=self.sim_s, cpu_per_sim_s=self.cpu_per_sim_s,
+                   probes=[p.to_dict() for p in self.probes], isolated=list(self.isolated))
         return out
+
+
+class _Runs:
+    """The probes of one search, in order, with the CPU time they cost here."""
+
+    def __init__(self, backend, scene, omega, settings, kind):
+        self.backend, self.scene, self.omega, self.kind = backend, scene, omega, kind
+        self.settings, self._tilted = settings, None
+        self.probes: list[Probe] = []
+        self.nominal: dict[float, Probe] = {}
+        self.spent = 0.0
+
+    def run(self, amplitude: float, perturbation: str = "") -> Probe:
+        settings = self.settings
+        if perturbation == "tilt":
+            if self._tilted is None:
+                from engines import configure
+                self._tilted = configure(self.backend, self.settings, theta0=TILT)
+            settings = self._tilted
+        c0 = time.process_time()
+        p = overturns(self.backend, self.scene, self.omega, amplitude, settings, self.kind)
+        self.spent += time.process_time() - c0
+        p = dataclasses.replace(p, amplitude=float(amplitude), perturbation=perturbation)
+        self.probes.append(p)
+        if not perturbation:
+            self.nominal[p.amplitude] = p
+        return p
+
+    def over(self, amplitude: float) -> bool:
+        return self.run(amplitude).overturned
+
+    def survived(self, amplitude: float) -> bool:
+        p = self.nominal.get(amplitude)
+        return p is not None and not p.overturned
+
+
+def _isolated(p: Probe, neighbours) -> dict:
+    return {"amplitude": p.amplitude, "mode": p.mode, "perturbation": p.perturbation,
+            "neighbours": [n.to_dict() for n in neighbours]}
 
 
 def engine_threshold(backend: str, scene, omega: float, a_reference: float, settings=None, *,
                      kind: str = "sine", mode_reference: str | None = None,
-                     rel_bracket: float = 0.03, rel_tol: float = 2e-3,
-                     max_expand: int = 5, guard: float = 0.0,
-                     stop_on_collapse: bool = False) -> ThresholdPoint:
-    """Bisect ``backend``'s overturning threshold at ``omega`` around ``a_reference``.
+                     search: Search = SEARCH, **changes) -> ThresholdPoint:
+    """``backend``'s robust first-overturning bracket at ``omega`` around ``a_reference``.
 
     Parameters
     ----------
-    rel_bracket : float
-        Initial half-width of the bracket relative to ``a_reference``, in (0, 0.5).
-        3 %: engines agree with the model within ~1-2 % away from jumps.
-    rel_tol : float
-        Final bracket width relative to ``a_reference``, in (0, 0.5).  With
-        ``2 rel_bracket <= rel_tol`` the first two runs already decide a point where
-        the engine agrees (the engine spectrum does this).
-        0.2 %: a tenth of the 2 % acceptance tolerance.
-    max_expand : int
-        Widenings (doubling the step) allowed on each side before giving up.
-    guard : float
-        If larger than ``rel_bracket``: first probe ``a_reference (1 - guard)``; if
-        the engine overturns there already, search downwards from it, else it is a
-        known survivor that bounds the downward search (one run, so that a narrow
-        bracket cannot hide an overturn up to ``guard`` below the model).
-    stop_on_collapse : bool
-        Stop widening upwards at the first 'collapsed' run: above it the engine's
-        bodies are no longer the model's mechanism, so there is no threshold of
-        the model's to find (the point is reported unbracketed, with the collapse).
+    backend, scene, omega, a_reference, settings, kind
+        The engine, scene, pulse frequency [rad/s], the model's threshold
+        [m/s^2] (the bracket's centre), the engine's settings, the pulse kind.
+    mode_reference : str, optional
+        The model's overturning mode, carried into the result.
+    search : Search
+        The search's parameters (default :data:`SEARCH`, shared by every caller).
+    **changes
+        Fields of ``search`` to replace (``rel_tol`` alone also sets
+        ``rel_bracket = 0.45 rel_tol``).
+
+    Returns
+    -------
+    ThresholdPoint
+        NaN ends when no robust bracket was found: no overturn within
+        ``max_expand`` widenings, a collapse above the model with
+        ``stop_on_collapse``, or more than ``max_isolated`` isolated overturns.
+
+    Notes
+    -----
+    First the guard ``A_ref (1 - guard)``: an overturn there makes the search go
+    downwards from it, a survival bounds it.  Then the bracket
+    ``A_ref (1 -/+ rel_bracket)``, doubled outwards until it holds the first
+    overturn, bisected to ``rel_tol``.  Then both ends are checked against
+    :data:`PERTURBATIONS` (module docstring); an overturning end that is not
+    reproduced is isolated and the search continues above it.
     """
     omega = _check_positive("omega", omega)
     a_ref = _check_positive("a_reference", a_reference)
-    if not 0.0 < rel_bracket < 0.5:
-        raise ValueError(f"rel_bracket must be in (0, 0.5), got {rel_bracket!r}")
-    if not 0.0 < rel_tol < 0.5:
-        raise ValueError(f"rel_tol must be in (0, 0.5), got {rel_tol!r}")
+    if "rel_tol" in changes and "rel_bracket" not in changes:
+        changes["rel_bracket"] = 0.45 * changes["rel_tol"]
+    s = dataclasses.replace(search, **changes)
+    if not 0.0 < s.rel_bracket < 0.5:
+        raise ValueError(f"rel_bracket must be in (0, 0.5), got {s.rel_bracket!r}")
+    if not 0.0 < s.rel_tol < 0.5:
+        raise ValueError(f"rel_tol must be in (0, 0.5), got {s.rel_tol!r}")
     t0 = time.perf_counter()
-    runs = irregular = 0
-    modes: dict[float, str | None] = {}
-    probes: list[tuple[float, str, str | None]] = []
-
-    def probe(a: float) -> bool:
-        nonlocal runs, irregular
-        runs += 1
-        over, status, mode = overturns(backend, scene, omega, a, settings, kind)
-        irregular += status not in ("overturned", "survived")
-        modes[a] = mode
-        probes.append((a, status, mode))
-        return over
-
-    lo, hi = a_ref * (1.0 - rel_bracket), a_ref * (1.0 + rel_bracket)
-    ok, moved_down, survivor = True, False, None
-    step = rel_bracket
-    if guard > rel_bracket:
-        g = a_ref * (1.0 - guard)
-        if probe(g):  # overturns well below the model: search downwards from there
-            hi, step, moved_down = g, 2.0 * guard, True
-            ok, lo = step < 0.95, a_ref * (1.0 - 2.0 * guard)
-        else:
-            survivor = g
-    while ok and probe(lo):  # lo overturns: the engine's threshold is lower
-        hi, step, moved_down = lo, 2.0 * step, True
-        if survivor is not None and step >= guard:
-            lo = survivor  # known to survive: bisect between it and hi
-            break
-        ok = step <= max(rel_bracket * 2 ** max_expand, 2.0 * guard) and step < 0.95
-        lo = a_ref * (1.0 - step)
-    step = rel_bracket
-    while ok and not moved_down and not probe(hi):  # hi survives: threshold is higher
-        if stop_on_collapse and probes[-1][1] == "collapsed":
-            ok = False  # the frame broke above the model's threshold: nothing to bracket
-            break
-        lo, step = hi, 2.0 * step
-        ok = step <= rel_bracket * 2 ** max_expand
-        hi = a_ref * (1.0 + step)
-    if not ok:
-        a_eng, lo = math.nan, math.nan
-    else:
-        while (hi - lo) > rel_tol * a_ref:
+    r = _Runs(backend, scene, omega, settings, kind)
+    ok, lo, hi = _first_bracket(r, a_ref, s)
+    isolated: list[dict] = []
+    while ok:
+        while (hi - lo) > s.rel_tol * a_ref or not r.survived(lo):
+            if hi - lo <= 1e-9 * a_ref:  # every amplitude in between overturned: degenerate
+                ok = False
+                break
             mid = 0.5 * (lo + hi)
-            if probe(mid):
+            if r.over(mid):
                 hi = mid
             else:
                 lo = mid
-        a_eng = hi
-    return ThresholdPoint(omega, kind, a_ref, a_eng, lo, mode_reference,
-                          modes.get(a_eng) if math.isfinite(a_eng) else None, runs, irregular,
-                          rel_tol, settings_provenance(backend, settings,
-                                                       time.perf_counter() - t0),
-                          tuple(probes))
-
-
-@dataclass(frozen=True)
-class JumpShift:
-    """Where a backend's verdict flips across a mode jump at a fixed amplitude.
-
-    ``omega_reference`` comes from the same bisection on the reference backend,
-    so the shift compares like with like; NaN when the flip was not bracketed.
-    """
-
-    amplitude: float
-    kind: str
-    omega_reference: float
-    omega_engine: float
-    omega_tol: float
-    n_runs: int
-    provenance: Provenance
-
-    @property
-    def shift(self) -> float:
-        return self.omega_engine - self.omega_reference
-
-    def to_dict(self) -> dict:
-        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        out.update(provenance=self.provenance.to_dict(), shift=self.shift)
-        return out
-
-
-def _flip_frequency(backend: str, scene, amplitude: float, w_lo: float, w_hi: float,
-                    settings, kind: str, omega_tol: float, max_expand: int) -> tuple[float, int]:
-    """Bisect the frequency in ``[w_lo, w_hi]`` where the verdict at ``amplitude``
-    flips; widens by the bracket width (up to ``max_expand`` times) if both ends agree."""
-    runs = 0
-
-    def probe(w: float) -> bool:
-        nonlocal runs
-        runs += 1
-        return overturns(backend, scene, w, amplitude, settings, kind)[0]
-
-    width = w_hi - w_lo
-    v_lo, v_hi = probe(w_lo), probe(w_hi)
-    for i in range(max_expand):
-        if v_lo != v_hi:
+        if not ok or not s.robust:
             break
-        # Widen on both sides: the engine's jump may sit on either side of the model's.
-        w_lo, w_hi = max(w_lo - width, 0.5 * w_lo), w_hi + width
-        v_lo, v_hi = probe(w_lo), probe(w_hi)
-    if v_lo == v_hi:
-        return math.nan, runs
-    while w_hi - w_lo > omega_tol:
-        mid = 0.5 * (w_lo + w_hi)
-        if probe(mid) == v_lo:
-            w_lo = mid
+        checks = [r.run(hi * (1.0 + REL_NEIGHBOUR), "above"), r.run(hi, "tilt")]
+        if all(c.overturned for c in checks):
+            break
+        isolated.append(_isolated(r.nominal[hi], checks))
+        ok, lo, hi = _past_isolated(r, hi, a_ref, s, [i["amplitude"] for i in isolated])
+        ok = ok and len(isolated) <= s.max_isolated
+    if ok and s.robust:
+        nominal = r.nominal[lo]
+        for c in (r.run(lo * (1.0 - REL_NEIGHBOUR), "below"), r.run(lo, "tilt")):
+            if c.overturned:  # a perturbation flipped a survivor: isolated, not the threshold
+                isolated.append(_isolated(c, [nominal]))
+    a_eng, a_surv = (hi, lo) if ok else (math.nan, math.nan)
+    mode = r.nominal[hi].mode if ok else None
+    cpu = [p.cpu_s for p in r.probes]
+    return ThresholdPoint(omega, kind, a_ref, a_eng, a_surv, mode_reference, mode,
+                          len(r.probes),
+                          sum(p.status not in ("overturned", "survived") for p in r.probes),
+                          s.rel_tol, settings_provenance(backend, settings,
+                                                         time.perf_counter() - t0),
+                          tuple(r.probes), tuple(isolated),
+                          math.fsum(cpu) if all(math.isfinite(c) for c in cpu) else math.nan,
+                          r.spent)
+
+
+def _first_bracket(r: _Runs, a_ref: float, s: Search) -> tuple[bool, float, float]:
+    """``(found, lo, hi)``: a nominal survivor ``lo`` below a nominal overturn ``hi``."""
+    lo, hi = a_ref * (1.0 - s.rel_bracket), a_ref * (1.0 + s.rel_bracket)
+    ok, moved_down, survivor = True, False, None
+    step = s.rel_bracket
+    if s.guard > s.rel_bracket:
+        g = a_ref * (1.0 - s.guard)
+        if r.over(g):  # overturns well below the model: search downwards from there
+            hi, step, moved_down = g, 2.0 * s.guard, True
+            ok, lo = step < 0.95, a_ref * (1.0 - 2.0 * s.guard)
         else:
-            w_hi = mid
-    return 0.5 * (w_lo + w_hi), runs
+            survivor = g
+    while ok and r.over(lo):  # lo overturns: the engine's threshold is lower
+        hi, step, moved_down = lo, 2.0 * step, True
+        if survivor is not None and step >= s.guard:
+            lo = survivor  # known to survive: bisect between it and hi
+            break
+        ok = step <= max(s.rel_bracket * 2 ** s.max_expand, 2.0 * s.guard) and step < 0.95
+        lo = a_ref * (1.0 - step)
+    step = s.rel_bracket
+    while ok and not moved_down and not r.over(hi):  # hi survives: threshold is higher
+        if s.stop_on_collapse and r.probes[-1].status == "collapsed":
+            return False, math.nan, math.nan  # the frame broke above the model: no threshold
+        lo, step = hi, 2.0 * step
+        ok = step <= s.rel_bracket * 2 ** s.max_expand
+        hi = a_ref * (1.0 + step)
+    return ok, lo, hi
 
 
-def engine_jump_frequency(backend: str, scene, amplitude: float, omega_lo: float,
-                          omega_hi: float, settings=None, *, kind: str = "sine",
-                          reference_backend: str = "analytic-fast", reference_settings=None,
-                          omega_tol: float = 0.02, max_expand: int = 2) -> JumpShift:
-    """Frequency of a mode jump in ``backend`` and in the reference, at ``amplitude``.
-
-    ``[omega_lo, omega_hi]`` should bracket the model's jump (e.g. the two
-    spectrum frequencies where the overturning mode changes) and ``amplitude``
-    lie between the threshold levels on either side.  ``omega_tol`` [rad/s]: final
-    bracket width (0.02 rad/s, far below the spectra's 0.1-1 rad/s steps).
-    """
-    amplitude = _check_positive("amplitude", amplitude)
-    omega_lo = _check_positive("omega_lo", omega_lo)
-    omega_hi = _check_positive("omega_hi", omega_hi)
-    if not omega_hi > omega_lo:
-        raise ValueError(f"omega_hi must be > omega_lo={omega_lo:g}, got {omega_hi!r}")
-    omega_tol = _check_positive("omega_tol", omega_tol)
-    t0 = time.perf_counter()
-    w_ref, _ = _flip_frequency(reference_backend, scene, amplitude, omega_lo, omega_hi,
-                               reference_settings, kind, omega_tol, max_expand)
-    t1 = time.perf_counter()
-    w_eng, runs = _flip_frequency(backend, scene, amplitude, omega_lo, omega_hi, settings,
-                                  kind, omega_tol, max_expand)
-    del t0
-    return JumpShift(amplitude, kind, w_ref, w_eng, omega_tol, runs,
-                     settings_provenance(backend, settings, time.perf_counter() - t1))
+def _past_isolated(r: _Runs, a_iso: float, a_ref: float, s: Search,
+                   isolated: list) -> tuple[bool, float, float]:
+    """A new bracket above the isolated overturn ``a_iso``: up to the lowest nominal
+    overturn above it not yet isolated, else widening upwards (doubling)."""
+    above = sorted(a for a, p in r.nominal.items()
+                   if p.overturned and a > a_iso and a not in isolated)
+    lo = a_iso
+    if above:
+        return True, lo, above[0]
+    step = s.rel_bracket
+    for _ in range(s.max_expand + 1):
+        hi = lo + step * a_ref
+        if r.over(hi):
+            return True, lo, hi
+        if s.stop_on_collapse and r.probes[-1].status == "collapsed":
+            break
+        lo, step = hi, 2.0 * step
+    return False, math.nan, math.nan

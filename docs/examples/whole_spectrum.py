@@ -22,4 +22,4 @@ first = overturning_spectrum(scene, spec.omega[:2])
 for curve, points in engine_spectrum("pymunk", scene, first).curves.items():
     for p in points:
         print(f"pymunk {curve}: Omega {p.omega:g}, A {p.a_engine:.3f} vs model "
-              f"{p.a_analytic:.3f} ({100 * p.rel_error:+.2f} %, {p.cause})")
+              f"{p.a_reference:.3f} ({100 * p.rel_error:+.2f} %, {p.cause})")
