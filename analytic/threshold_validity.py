@@ -9,10 +9,13 @@ columns down (they would hop) or the column tops would have to pull the lintel
 4.1 Hz on the Fig. 5 trilith).  A threshold read there is the model's number,
 not a property of a trilith, and no engine may be blamed for missing it.
 
-Each point is checked by :func:`analytic.reactions.check_model` (one accurate
-run, the contact forces of :func:`analytic.reactions.validity_diagnostics`) at
-the curve's first-overturning amplitude: the run whose verdict the threshold
-reports.  Only the normal forces decide validity here (a pull is invalid for
+Each point is checked on one accurate run (:func:`analytic.simulate.simulate`)
+at the curve's first-overturning amplitude, the run whose verdict the threshold
+reports: its contact forces (:func:`analytic.reactions.validity_diagnostics`,
+judged by :func:`analytic.contact_forces.violations`, as
+:func:`analytic.reactions.check_model` does) and, with a pendulum, the bob's
+clearance from the columns (:func:`analytic.clearance.check_clearance`).  Only
+the normal forces and the clearance decide validity here (a pull is invalid for
 every friction coefficient); the friction demands are returned for a caller
 who knows a coefficient.
 """
@@ -24,16 +27,18 @@ from concurrent.futures import as_completed
 import numpy as np
 
 from ._workers import fork_pool
+from .clearance import check_clearance
+from .contact_forces import violations
 from .excitation import Pulse
 from .parameters import Scene
-from .reactions import check_model
 
 __all__ = ["point_validity", "curve_validity", "spectrum_validity", "invalid_spans",
            "VALIDITY_FIELDS"]
 
 # The per-point fields, in CSV column order.
 VALIDITY_FIELDS = ("model_valid", "ground_min_normal", "lintel_min_normal",
-                   "ground_max_friction", "lintel_max_friction", "model_reason")
+                   "ground_max_friction", "lintel_max_friction", "bob_min_clearance",
+                   "model_reason")
 
 
 def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "sine") -> dict:
@@ -48,16 +53,28 @@ def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "si
         overturning up to the search's ``a_max``), ``ground_min_normal``
         (fraction of the total weight), ``lintel_min_normal`` (fraction of the
         lintel and bob's weight; None without them), the two friction demands
-        ``|F_x|/F_y`` and ``model_reason`` (the first violated assumption in
-        words, "" when valid).
+        ``|F_x|/F_y``, ``bob_min_clearance`` [m] (distance of the bob from the
+        nearer inner column face, < 0 inside it; None without a pendulum) and
+        ``model_reason`` (the violated assumptions in words, "" when valid).
     """
     if amplitude is None or not math.isfinite(amplitude):
         return {k: None for k in VALIDITY_FIELDS[:-1]} | {"model_reason": ""}
-    c = check_model(scene, Pulse(float(amplitude), float(omega), kind))
-    return {"model_valid": bool(c["valid"]), "ground_min_normal": c["ground_min_normal"],
-            "lintel_min_normal": c["lintel_min_normal"],
-            "ground_max_friction": c["ground_max_friction"],
-            "lintel_max_friction": c["lintel_max_friction"], "model_reason": c["reason"]}
+    from .simulate import simulate  # simulate imports the contact checks
+
+    tr = simulate(scene, Pulse(float(amplitude), float(omega), kind))
+    d = tr.diagnostics
+    if "model_valid" not in d:  # non-finite samples: nothing to judge
+        return {k: None for k in VALIDITY_FIELDS[:-1]} | {
+            "model_reason": f"the model run ended {tr.verdict.status!r} (not checked)"}
+    reasons = violations(d)
+    clear = check_clearance(scene, tr)
+    if not clear["valid"]:
+        reasons.append(clear["reason"])
+    return {"model_valid": not reasons, "ground_min_normal": d["min_vertical_reaction"],
+            "lintel_min_normal": d["min_lintel_normal"],
+            "ground_max_friction": d["max_friction_demand"],
+            "lintel_max_friction": d["max_lintel_friction_demand"],
+            "bob_min_clearance": clear["min_clearance"], "model_reason": "; ".join(reasons)}
 
 
 _JOB: dict = {}

@@ -196,16 +196,16 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
 
 def add_model_validity(doc: dict, scene, workers: int = 1) -> dict:
     """Put the model's validity on its threshold run at every frequency of each
-    reference spectrum into ``doc["spectra"][case]["validity"]`` (aligned with
+    reference spectrum into ``doc["spectra"][case]["model_validity"]`` (aligned with
     ``omega``; :func:`analytic.threshold_validity.point_validity`), unless the
     summary already carries it.  The campaign's pulses are one-sine (Eq. 22)."""
     from analytic.threshold_validity import curve_validity
 
     scenes = {"pendulum": scene, "no_pendulum": scene.without_pendulum()}
     for case, spec in doc.get("spectra", {}).items():
-        if case in scenes and "validity" not in spec:
-            spec["validity"] = clean_nan(curve_validity(scenes[case], spec["omega"], spec["a"],
-                                                        "sine", workers))
+        if case in scenes and "model_validity" not in spec:
+            spec["model_validity"] = clean_nan(curve_validity(
+                scenes[case], spec["omega"], spec["a"], "sine", workers))
     return doc
 
 

@@ -93,7 +93,7 @@ def _spectrum_case(doc: dict, case: str) -> str:
     fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
                                    gridspec_kw={"height_ratios": [2, 1.2]})
     w, a = _arr(spec["omega"]), _arr(spec["a"])
-    validity = spec.get("validity")
+    validity = spec.get("model_validity")
     if validity:
         shade_invalid((top, bot), w, [v.get("model_valid") for v in validity])
     for jp in spec.get("jumps", []):  # no line across a jump: the curve is discontinuous

@@ -157,54 +157,60 @@ def verdict_rows(doc: dict) -> list[list]:
             for v in doc["verdicts"]]
 
 
-def _validity_at(spec: dict, omega) -> dict | None:
-    """The model's validity on its threshold run at ``omega`` (the reference
-    spectrum's ``validity`` list, aligned with its ``omega``), or None."""
-    val = spec.get("validity")
+def _validity_at(case, omega) -> dict | None:
+    """The model's validity on its own threshold run at ``omega`` (the case's
+    ``model_validity`` list, aligned with its ``omega``; written by
+    :func:`compare.report.html.add_model_validity`), or None."""
+    val = case.raw.get("model_validity")
     if not val or omega is None:
         return None
-    for w, v in zip(spec.get("omega", []), val):
+    for w, v in zip(case.omega, val):
         if w is not None and abs(w - omega) < 1e-9:
             return v
     return None
 
 
-def _valid_cell(v: dict | None, cause: str | None) -> dict:
-    if cause == "model":
-        return _cell("no (engine not blamed)", None)
-    if v is None or v.get("model_valid") is None:
-        return _cell("not checked")
-    if v["model_valid"]:
-        return _cell("yes")
-    return _cell("no (engine not blamed)", None, v.get("model_reason", ""))
+def _point_validity(case, p) -> tuple[bool | None, str]:
+    """``(valid, reason)`` of the model at an engine point: the point's own
+    checks (at the model's and the engine's thresholds and along the bracket)
+    when the campaign made them, else the model's threshold run at its Ω."""
+    if p.valid is not None or p.cause == "model":
+        bad = [v for v in p.validity if not v.valid]
+        reason = "; ".join(f"{v.where}: {v.reason}" for v in bad) or p.cause_detail
+        return (False, reason) if (p.valid is False or p.cause == "model") else (True, "")
+    v = _validity_at(case, p.omega) or {}
+    return v.get("model_valid"), v.get("model_reason", "")
 
 
 def threshold_points(doc: dict) -> list[dict]:
     """Every engine threshold point as a flat record (SI numbers, g and Hz
-    beside), for the CSV export and the table."""
-    tol = doc["config"]["tolerances"]["threshold"]
+    beside), for the CSV export and the table; read through the typed summary
+    (:class:`compare.campaign.summary.Summary`)."""
+    from compare.campaign.summary import Summary
+
+    summary = Summary.from_dict(doc)
+    tol = summary.threshold_tolerance
     out = []
-    for case, spec in doc["spectra"].items():
-        for name, pts in spec.get("engines", {}).items():
+    for case in summary.spectra.values():
+        for name, pts in case.engines.items():
             for p in pts:
-                err, w = p.get("rel_error"), p.get("omega")
-                v = _validity_at(spec, w) or {}
-                valid = False if p.get("cause") == "model" else v.get("model_valid")
+                err, w = p.rel_error, p.omega
+                valid, reason = _point_validity(case, p)
+                resolution = p.rel_resolution if p.rel_resolution is not None else p.rel_tol
                 out.append({
-                    "case": case, "engine": name, "omega_rad_s": w,
+                    "case": case.name, "engine": name, "omega_rad_s": w,
                     "f_hz": None if w is None else w / TWO_PI,
                     "pulse_period_s": None if not w else TWO_PI / w,
-                    "a_model_m_s2": p.get("a_reference"),
-                    "a_model_g": None if p.get("a_reference") is None
-                    else p["a_reference"] / units.G,
-                    "a_engine_m_s2": p.get("a_engine"), "a_survives_m_s2": p.get("a_survives"),
-                    "rel_error": err, "bracket_rel": p.get("rel_tol"), "tolerance_rel": tol,
+                    "a_model_m_s2": p.a_reference,
+                    "a_model_g": None if p.a_reference is None else p.a_reference / units.G,
+                    "a_engine_m_s2": p.a_engine, "a_survives_m_s2": p.a_survives,
+                    "rel_error": err, "rel_resolution": resolution, "tolerance_rel": tol,
                     "within_tolerance": err is not None and abs(err) <= tol,
-                    "mode_model": p.get("mode_reference"), "mode_engine": p.get("mode_engine"),
-                    "model_valid": valid, "model_reason": v.get("model_reason", ""),
-                    "cause": p.get("cause"), "cause_detail": p.get("cause_detail"),
-                    "n_runs": p.get("n_runs"),
-                    "wall_s": p.get("provenance", {}).get("wall_time")})
+                    "mode_model": p.mode_reference, "mode_engine": p.mode_engine,
+                    "model_valid": valid, "model_reason": reason,
+                    "cause": p.cause, "cause_detail": p.cause_detail, "n_runs": p.n_runs,
+                    "cpu_s": p.cpu_s,
+                    "wall_s": (p.raw.get("provenance") or {}).get("wall_time")})
     return out
 
 
@@ -225,6 +231,12 @@ def threshold_csv(doc: dict) -> str:
     return buf.getvalue()
 
 
+def _valid_cell(valid: bool | None, reason: str) -> dict:
+    if valid is None:
+        return _cell("not checked")
+    return _cell("yes") if valid else _cell("no (engine not blamed)", None, reason)
+
+
 def threshold_rows(doc: dict) -> list[list]:
     rows = []
     for p in threshold_points(doc):
@@ -235,10 +247,9 @@ def threshold_rows(doc: dict) -> list[list]:
         rows.append([p["case"].replace("_", " "), label(p["engine"]),
                      "n/a" if w is None else f"{w:g} ({p['f_hz']:.2g} Hz)",
                      units.accel(p["a_model_m_s2"]), units.accel(p["a_engine_m_s2"]),
-                     _cell(units.rel_error(p["rel_error"], p["bracket_rel"]), ok),
+                     _cell(units.rel_error(p["rel_error"], p["rel_resolution"]), ok),
                      f"{p['mode_model']} / {p['mode_engine']}",
-                     _valid_cell({"model_valid": p["model_valid"],
-                                  "model_reason": p["model_reason"]}, p["cause"]),
+                     _valid_cell(p["model_valid"], p["model_reason"]),
                      str(p["n_runs"]),
                      _cell(cause_phrase(p["cause"]), None,
                            "" if p["cause"] == "agrees" else (p["cause_detail"] or "")),
