@@ -96,8 +96,8 @@ th{background:#eee}td.pass{background:#d4edda}td.fail{background:#f8d7da}
 td:first-child{min-width:9em}
 summary{cursor:pointer}.nb{white-space:nowrap}
 .banner{background:#fff3cd;border:2px solid #d39e00;padding:0.6em;font-weight:bold}
-.reco{background:#eef5ff;border-left:4px solid #3b73c4;padding:0.4em 0.8em}
-.reco li{margin:0.2em 0}
+.reco{background:#eef5ff;border-left:4px solid #3b73c4;padding:0.3em 0.8em}
+.reco ul{margin:0.2em 0;padding-left:1.2em}.reco li{margin:0.1em 0}
 .headline{font-size:1.1em}.small{font-size:0.85em;color:#444}.conclusion{margin:0.4em 0 0.8em 0}
 code{overflow-wrap:anywhere}
 @media (max-width:600px){body{padding:0.4em}table{font-size:11px}td,th{padding:2px 3px}
@@ -137,11 +137,11 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              "model (accurate path for time histories, compiled path for spectra).</p>",
              "<div class='reco'><b>Recommendation</b><ul>",
              *(f"<li>{esc(line)}</li>" for line in recommendations(doc)), "</ul></div>",
+             "<h2>Trust table</h2>", tables.table(header, rows),
              f"<p class='small'>{esc(prov.get('date', 'date unknown'))}, commit "
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
              "end. Download: " + _download("trust.csv", tables.csv_text(header, rows)) + ", "
              + _download("thresholds.csv", tables.threshold_csv(doc)) + ".</p>",
-             "<h2>Trust table</h2>", tables.table(header, rows),
              *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> {esc(r['conclusion'])}</p>"
                for r in doc["trust"].values()),
              "<h2>Verdicts</h2>", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc)),
