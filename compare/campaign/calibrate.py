@@ -1,0 +1,290 @@
+"""The cheapest settings of an engine that agree with the model (``trilith calibrate``).
+
+An engine's accuracy and its cost both follow from a few numerical settings: the
+step ``dt`` above all, then the engine's own (solver iterations, contact
+parameters).  What a step must be depends on what is measured: overturning
+thresholds tolerate much coarser steps than impact restitution.  So the search is
+per engine and per *metric*, on a stated validation set:
+
+``restitution``
+    free rocking from ``alpha/2``: the worst relative error of the first impacts'
+    velocity ratios against Eq. 20 (no pendulum) and Eq. 19 (with it), over
+    slenderness ``lam`` and lintel mass ratio ``mu`` (:func:`measure_restitution`).
+``thresholds``
+    the first-overturning amplitude under one-sine pulses (Eq. 22) at a few
+    frequencies, both curves: the worst relative error against the analytic
+    threshold, through the one engine threshold search
+    (:func:`compare.measure.engine_spectrum.engine_spectrum`).  Points where the
+    model itself is invalid (cause ``model``) are not counted against the engine.
+``histories``
+    theta(t) before the first impact at the paper's points A-D (both curves): the
+    worst RMS error in units of ``alpha``, and a verdict that differs counts as an
+    error of 1 (:func:`compare.measure.trajectories.compare_trajectories`).
+
+Every candidate (the product of the values in the search space) is evaluated on
+the whole set, its CPU time measured around the evaluation (this process and the
+worker processes it started and reaped), with the store bypassed so that the cost
+is what the runs cost on this machine now.  The result is the Pareto front of
+cost against worst error and the cheapest candidate within the tolerance.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import resource
+from dataclasses import dataclass, field
+
+__all__ = ["METRICS", "ValidationSet", "Evaluation", "Calibration", "calibrate",
+           "default_space", "default_tolerance", "pareto_front", "cpu_seconds"]
+
+METRICS = ("restitution", "thresholds", "histories")
+# Multiples of an engine's calibrated step tried by default: thresholds were seen
+# to tolerate 10x (Pymunk's Fig. 5 spectrum at 1e-3 s kept 53 of 56 thresholds).
+DT_FACTORS = (1.0, 2.0, 5.0, 10.0)
+
+
+@dataclass(frozen=True)
+class ValidationSet:
+    """What a candidate must reproduce.
+
+    Parameters
+    ----------
+    scene : str
+        Scene name or file (default ``fig5``, the paper's Fig. 5 trilith).
+    releases : tuple of (lam, mu)
+        Free-rocking cases for ``restitution`` (default lam 3 and 7 x mu 0.5 and
+        2: the corners of the paper's range, where engines differ most), each
+        without the pendulum, plus the scene itself with its pendulum (Eq. 19).
+    n_impacts : int
+        Impacts measured per release (default 3).
+    omegas : tuple of float
+        Pulse frequencies [rad/s] for ``thresholds`` (default 6, 12, 18: the
+        rising, middle and upper part of the Fig. 5 curves, away from its jumps).
+    points : tuple of str
+        The paper's points for ``histories`` (default A-D).
+    """
+
+    scene: str = "fig5"
+    releases: tuple = ((3.0, 0.5), (3.0, 2.0), (7.0, 0.5), (7.0, 2.0))
+    n_impacts: int = 3
+    omegas: tuple = (6.0, 12.0, 18.0)
+    points: tuple = ("A", "B", "C", "D")
+
+    def describe(self) -> dict:
+        return {"scene": self.scene, "releases": [list(r) for r in self.releases],
+                "n_impacts": self.n_impacts, "omegas": list(self.omegas),
+                "points": list(self.points)}
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """One candidate on the whole validation set."""
+
+    options: dict
+    worst_error: float
+    errors: tuple  # (case label, error) pairs; nan where the engine gave no answer
+    cpu_s: float
+    simulated_s: float  # 0 when the metric does not sum simulated time (thresholds)
+    runs: int
+
+    @property
+    def real_time_factor(self) -> float:
+        """CPU seconds per simulated second (nan when not measured)."""
+        return self.cpu_s / self.simulated_s if self.simulated_s > 0 else math.nan
+
+    def to_dict(self) -> dict:
+        return {"options": dict(self.options), "worst_error": self.worst_error,
+                "errors": [list(e) for e in self.errors], "cpu_s": self.cpu_s,
+                "simulated_s": self.simulated_s, "real_time_factor": self.real_time_factor,
+                "runs": self.runs}
+
+
+@dataclass
+class Calibration:
+    """All candidates of one engine and metric, their front and the recommendation."""
+
+    engine: str
+    version: str
+    metric: str
+    tolerance: float
+    validation: ValidationSet
+    evaluations: list = field(default_factory=list)
+    load_average: tuple = ()
+
+    @property
+    def front(self) -> list:
+        return pareto_front(self.evaluations)
+
+    @property
+    def recommended(self) -> Evaluation | None:
+        """The cheapest candidate whose worst error is within the tolerance."""
+        ok = [e for e in self.evaluations if e.worst_error <= self.tolerance]
+        return min(ok, key=lambda e: e.cpu_s) if ok else None
+
+    def to_dict(self) -> dict:
+        rec = self.recommended
+        return {"engine": self.engine, "version": self.version, "metric": self.metric,
+                "tolerance": self.tolerance, "validation": self.validation.describe(),
+                "load_average": list(self.load_average),
+                "recommended": rec.to_dict() if rec else None,
+                "front": [e.to_dict() for e in self.front],
+                "evaluations": [e.to_dict() for e in self.evaluations]}
+
+
+def default_tolerance(metric: str) -> float:
+    """The validation campaign's tolerance for ``metric`` (one source for both)."""
+    from compare.campaign.validation import Tolerances
+    t = Tolerances()
+    return {"restitution": t.restitution, "thresholds": t.threshold,
+            "histories": t.theta_rms_first}[metric]
+
+
+def cpu_seconds() -> float:
+    """User + system CPU time of this process and its reaped children [s]."""
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
+        resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def pareto_front(evaluations) -> list:
+    """Candidates no other beats in both cost and worst error, cheapest first."""
+    pts = sorted(evaluations, key=lambda e: (e.cpu_s, e.worst_error))
+    front, best = [], math.inf
+    for e in pts:
+        if e.worst_error < best:
+            front.append(e)
+            best = e.worst_error
+    return front
+
+
+def default_space(engine: str) -> dict:
+    """``{'dt': [...]}``: the engine's calibrated step times :data:`DT_FACTORS`, plus
+    the engine's own declared search ranges (``calibration_space`` on its class)."""
+    import engines
+    base = engines.configure(engine)
+    space = {"dt": [base.dt * f for f in DT_FACTORS]}
+    space.update(getattr(engines.get_backend(engine), "calibration_space", {}) or {})
+    return space
+
+
+def _candidates(space: dict) -> list[dict]:
+    names = list(space)
+    return [dict(zip(names, values)) for values in itertools.product(*(space[n] for n in names))]
+
+
+# ------------------------------------------------------------------ the three metrics
+def _restitution(engine, scene, vs: ValidationSet, options):
+    from compare.measure.restitution import measure_restitution
+    cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
+             for lam, mu in vs.releases]
+    if scene.has_pendulum:
+        cases.append((f"lam {scene.lam:g} mu {scene.mu:g} gamma {scene.gamma:g}", scene))
+    errors, simulated, runs = [], 0.0, 0
+    for label, sc in cases:
+        r = measure_restitution(engine, sc, n_impacts=vs.n_impacts, **options)
+        errors.append((label, r.max_rel_error if r.complete else math.nan))
+        simulated += r.diagnostics.get("steps", 0) * r.settings["dt"]
+        runs += 1
+    return errors, simulated, runs
+
+
+def _thresholds(engine, scene, vs: ValidationSet, options, workers):
+    from analytic.spectrum import overturning_spectrum
+    from compare.measure.engine_spectrum import engine_spectrum
+    reference = overturning_spectrum(scene, list(vs.omegas))
+    es = engine_spectrum(engine, scene, reference, workers=workers, **options)
+    errors, runs = [], 0
+    for curve, points in es.curves.items():
+        for p in points:
+            runs += p.runs
+            if p.cause == "model":  # the model cannot judge the engine there
+                continue
+            errors.append((f"{curve} Omega {p.omega:g}", abs(p.rel_error)))
+    return errors, 0.0, runs
+
+
+def _histories(engine, scene, vs: ValidationSet, options):
+    import engines
+    from compare.measure.trajectories import compare_trajectories
+    from scenes import point_pulse
+    errors, simulated, runs = [], 0.0, 0
+    for sc in (scene, scene.without_pendulum()) if scene.has_pendulum else (scene,):
+        for point in vs.points:
+            pulse = point_pulse(point)
+            ref = engines.simulate("analytic", sc, pulse)
+            test = engines.simulate(engine, sc, pulse, **options)
+            c = compare_trajectories(ref, test)
+            err = c.theta_rms_first if c.verdict_agrees else 1.0
+            label = f"{point} {'pendulum' if sc.has_pendulum else 'no pendulum'}"
+            errors.append((label, err))
+            simulated += float(test.t[-1]) if len(test.t) else 0.0
+            runs += 1
+    return errors, simulated, runs
+
+
+def calibrate(engine: str, metric: str = "thresholds", *, validation: ValidationSet | None = None,
+              space: dict | None = None, tolerance: float | None = None, workers: int = 1,
+              progress=None, scene=None) -> Calibration:
+    """Evaluate every candidate of ``space`` on ``validation`` for ``metric``.
+
+    Parameters
+    ----------
+    engine : str
+        A registered engine.
+    metric : {'restitution', 'thresholds', 'histories'}
+    validation : ValidationSet, optional
+        Default :class:`ValidationSet()`.
+    space : dict, optional
+        Setting name -> values to try (every combination is evaluated); default
+        :func:`default_space`.  Values are checked by the engine's ``Settings``
+        before any run.
+    tolerance : float, optional
+        Largest acceptable worst error, in (0, 1]; default the validation
+        campaign's own (:class:`compare.campaign.validation.Tolerances`): 0.5 %
+        for restitution, 2 % for thresholds, 1e-3 alpha for histories.
+    workers : int
+        Processes for the threshold search.
+    progress : callable, optional
+        ``progress(done, total, evaluation)`` after each candidate.
+    scene : Scene, optional
+        The scene itself (e.g. with overrides); default ``load_scene(validation.scene)``.
+
+    Returns
+    -------
+    Calibration
+    """
+    import engines
+    from compare.run import runs
+    from scenes import load_scene
+    if metric not in METRICS:
+        raise ValueError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
+    if tolerance is None:
+        tolerance = default_tolerance(metric)
+    if isinstance(tolerance, bool) or not (isinstance(tolerance, (int, float))
+                                            and 0.0 < tolerance <= 1.0):
+        raise ValueError(f"tolerance must be in (0, 1], got {tolerance!r}")
+    vs = validation or ValidationSet()
+    scene = load_scene(vs.scene) if scene is None else scene
+    space = default_space(engine) if space is None else dict(space)
+    candidates = _candidates(space)
+    for cand in candidates:  # every value checked before any run
+        engines.configure(engine, **cand)
+    cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
+                      load_average=os.getloadavg())
+    with runs.using(None):  # measured costs: nothing served from a store
+        for i, cand in enumerate(candidates):
+            cpu0 = cpu_seconds()
+            if metric == "restitution":
+                errors, simulated, n = _restitution(engine, scene, vs, cand)
+            elif metric == "thresholds":
+                errors, simulated, n = _thresholds(engine, scene, vs, cand, workers)
+            else:
+                errors, simulated, n = _histories(engine, scene, vs, cand)
+            values = [e for _, e in errors]
+            worst = max(values) if values and all(math.isfinite(v) for v in values) else math.inf
+            ev = Evaluation(dict(cand), worst, tuple(errors), cpu_seconds() - cpu0, simulated, n)
+            cal.evaluations.append(ev)
+            if progress is not None:
+                progress(i + 1, len(candidates), ev)
+    return cal

@@ -1,0 +1,86 @@
+"""Engine settings files: one TOML table per engine, as ``trilith calibrate`` writes them.
+
+::
+
+    # trilith calibrate --engine pymunk --metric thresholds
+    [pymunk]
+    dt = 0.0005
+
+Every key is a field of that engine's ``Settings`` and is validated by it
+(:func:`engines.configure`), so a file is refused as a whole, before any run, with
+the file, the table and the key named.  Data only: nothing in the file is
+evaluated.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+__all__ = ["load_settings_file", "settings_toml"]
+
+# Larger files are not settings files (a handful of keys per engine).
+MAX_BYTES = 64 * 1024
+
+
+def load_settings_file(path) -> dict[str, dict]:
+    """``{engine: {field: value}}`` from a settings TOML file, each table checked by
+    the engine's ``Settings``.
+
+    Raises
+    ------
+    ValueError
+        Unreadable, not TOML, too large, an unknown engine (naming the known
+        ones), a field the engine does not have (naming its fields) or a value it
+        refuses; the message starts with the file's name.
+    """
+    import engines
+    p = Path(path)
+    where = f"settings file {str(p)!r}"
+    if not p.is_file():
+        raise ValueError(f"{where}: not a readable file")
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot be read ({exc.strerror})") from None
+    if len(data) > MAX_BYTES:
+        raise ValueError(f"{where}: {len(data)} bytes, more than a settings file's "
+                         f"{MAX_BYTES} bytes")
+    try:
+        doc = tomllib.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
+        raise ValueError(f"{where}: not TOML ({str(exc).splitlines()[0]})") from None
+    known = engines.ENGINES
+    out = {}
+    for name, table in doc.items():
+        if name not in known:
+            raise ValueError(f"{where}: unknown engine table [{name}]; allowed: "
+                             f"{', '.join(known)}")
+        if not isinstance(table, dict):
+            raise ValueError(f"{where}: [{name}] must be a table of settings")
+        for key, value in table.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                raise ValueError(f"{where}: [{name}] {key} must be finite, got {value!r}")
+        try:
+            engines.configure(name, **table)
+        except (TypeError, ValueError, OverflowError) as exc:
+            raise ValueError(f"{where}: [{name}] {exc}") from None
+        out[name] = dict(table)
+    return out
+
+
+def settings_toml(engine: str, options: dict, comment: str = "") -> str:
+    """A settings file holding ``options`` for ``engine`` (floats written with
+    ``repr``: they read back bit-identical)."""
+    lines = [f"# {line}" for line in comment.splitlines()] + [f"[{engine}]"]
+    for key, value in options.items():
+        if isinstance(value, bool):
+            text = "true" if value else "false"
+        elif isinstance(value, (int, float)):
+            text = repr(value)
+        elif isinstance(value, str):
+            text = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        else:
+            raise TypeError(f"setting {key!r}: cannot write a {type(value).__name__}")
+        lines.append(f"{key} = {text}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,180 @@
+"""``trilith calibrate``: the cheapest settings of an engine that agree with the model."""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from compare.cli import options as _common
+from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg,
+                                 check_output_path, clean_nan, envelope, info, print_json,
+                                 resolve_workers, sig)
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    from compare.campaign.calibrate import DT_FACTORS, METRICS
+    from engines import ENGINES
+    parser = subparsers.add_parser(
+        "calibrate",
+        help="the cheapest engine settings meeting a tolerance on a validation set: "
+             "Pareto front of CPU cost against worst error",
+        description="Evaluate every combination of the varied settings on a validation set "
+                    "(restitution: free rocking vs Eq. 19/20; thresholds: first-overturning "
+                    "amplitudes vs the model; histories: theta(t) at the paper's points A-D), "
+                    "measure each one's CPU time with the run store bypassed, and recommend "
+                    "the cheapest within the tolerance.")
+    parser.add_argument("--engine", required=True, metavar="NAME",
+                        help=f"the engine to calibrate: {', '.join(ENGINES)}")
+    add_scene_args(parser)
+    parser.add_argument("--metric", choices=METRICS, default="thresholds",
+                        help="what must agree (default: thresholds)")
+    parser.add_argument("--tolerance", type=float, default=None, metavar="X",
+                        help="largest acceptable worst error, in (0, 1] (default: the report's "
+                             "own: 0.005 restitution, 0.02 thresholds, 1e-3 alpha histories)")
+    parser.add_argument("--dt", default=None, metavar="S[,S...]",
+                        help="time steps [s] to try (default: the engine's calibrated step x "
+                             + ", ".join(f"{f:g}" for f in DT_FACTORS) + ")")
+    parser.add_argument("--vary", action="append", default=[], metavar="NAME=V1,V2,...",
+                        help="another setting of the engine to try at these values (repeat "
+                             "for several; every combination is evaluated)")
+    parser.add_argument("--omega", default=None, metavar="W1,W2,...",
+                        help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18)")
+    add_workers_arg(parser)
+    parser.add_argument("--json", metavar="FILE", help="write every evaluation as JSON")
+    parser.add_argument("--csv", metavar="FILE", help="write every evaluation as CSV")
+    parser.add_argument("--plot", metavar="FILE.png", help="write the Pareto front plot")
+    parser.add_argument("--settings-out", metavar="FILE.toml",
+                        help="write the recommended settings as a settings file")
+    return parser
+
+
+def _number(text: str, option: str) -> float | int:
+    try:
+        value = int(text)
+    except ValueError:
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"{option}: {text!r} is not a number") from None
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"{option}: {text!r} is not finite")
+    return value
+
+
+def _space(args, engine: str) -> dict:
+    from compare.campaign.calibrate import default_space
+    space = default_space(engine)
+    if args.dt is not None:
+        space["dt"] = [float(_number(v.strip(), "--dt")) for v in args.dt.split(",") if v.strip()]
+    for item in args.vary:
+        name, sep, values = item.partition("=")
+        name = name.strip()
+        if not sep or not name or not values.strip():
+            raise ValueError(f"--vary must be NAME=V1,V2,..., got {item!r}")
+        if name == "dt":
+            raise ValueError("--vary: give the steps with --dt")
+        space[name] = [_number(v.strip(), f"--vary {name}") for v in values.split(",")
+                       if v.strip()]
+    if any(not v for v in space.values()):
+        raise ValueError("--dt/--vary: give at least one value")
+    n = math.prod(len(v) for v in space.values())
+    if n > 64:
+        raise ValueError(f"--dt/--vary: {n} combinations; at most 64 per calibration")
+    return space
+
+
+def run(args: argparse.Namespace) -> int:
+    import engines
+    from compare.campaign.calibrate import ValidationSet, calibrate
+    from compare.campaign.settings_file import settings_toml
+    from compare.run import atomic
+
+    engine = engines.engine_list(args.engine)
+    if len(engine) != 1:
+        raise ValueError("--engine: calibrate one engine at a time")
+    engine = engine[0]
+    scene = _common.scene_from_args(args)
+    space = _space(args, engine)
+    vs = ValidationSet(scene=scene.name) if args.omega is None else ValidationSet(
+        scene=scene.name, omegas=tuple(float(_number(v.strip(), "--omega"))
+                                       for v in args.omega.split(",") if v.strip()))
+    workers = resolve_workers(args.workers)
+    outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
+    for option, path in outputs.items():
+        if path is not None:
+            check_output_path(path, option)
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    bar = None
+    if sys.stderr.isatty() and _common.VERBOSITY >= 0:
+        from tqdm import tqdm
+        bar = tqdm(total=math.prod(len(v) for v in space.values()), unit="candidate",
+                   file=sys.stderr)
+
+    def progress(done, total, ev):
+        if bar is not None:
+            bar.update(1)
+
+    cal = calibrate(engine, args.metric, validation=vs, space=space, tolerance=args.tolerance,
+                    workers=workers, progress=progress, scene=scene)
+    if bar is not None:
+        bar.close()
+    _print(cal)
+    body = clean_nan(cal.to_dict())
+    if args.json is not None:
+        import json
+        atomic.write_text(args.json, json.dumps(envelope("calibrate", {
+            "engine": engine, "metric": args.metric, "scene": scene.to_dict()}, body, {}),
+            indent=1) + "\n")
+        info(f"wrote {args.json}")
+    if args.csv is not None:
+        atomic.write_text(args.csv, _csv(cal))
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        from compare.report.calibration_plot import pareto_plot
+        pareto_plot(cal, args.plot)
+        info(f"wrote {args.plot}")
+    rec = cal.recommended
+    if args.settings_out is not None:
+        if rec is None:
+            info(f"no candidate met the tolerance: {args.settings_out} not written")
+        else:
+            atomic.write_text(args.settings_out, settings_toml(engine, rec.options, (
+                f"trilith calibrate --engine {engine} --metric {args.metric} "
+                f"--scene {scene.name}\nworst error {rec.worst_error:.3g} "
+                f"(tolerance {cal.tolerance:g}), {rec.cpu_s:.3g} CPU s on the validation set")))
+            info(f"wrote {args.settings_out}")
+    return 0 if rec is not None else 1
+
+
+def _label(options: dict) -> str:
+    return ", ".join(f"{k} {sig(v)}" for k, v in options.items())
+
+
+def _print(cal) -> None:
+    rec, front = cal.recommended, {id(e) for e in cal.front}
+    load = ", ".join(f"{x:.2f}" for x in cal.load_average)
+    print(f"{cal.engine} ({cal.version}), metric {cal.metric}, tolerance {cal.tolerance:g}, "
+          f"load average {load}")
+    print(f"{'settings':<34} {'worst error':>11} {'CPU [s]':>8} {'CPU/sim':>8} {'runs':>5}")
+    for e in sorted(cal.evaluations, key=lambda e: e.cpu_s):
+        mark = ("<- recommended" if e is rec else "front" if id(e) in front else "")
+        rtf = e.real_time_factor
+        print(f"{_label(e.options):<34} {e.worst_error:11.3g} {e.cpu_s:8.3g} "
+              f"{(f'{rtf:.3g}' if math.isfinite(rtf) else '-'):>8} {e.runs:5d}  {mark}")
+    if rec is None:
+        print(f"no candidate meets {cal.tolerance:g}: widen the search (--dt, --vary) "
+              f"or the tolerance")
+
+
+def _csv(cal) -> str:
+    names = list(cal.evaluations[0].options) if cal.evaluations else []
+    front = {id(e) for e in cal.front}
+    lines = [",".join([*names, "worst_error", "cpu_s", "simulated_s", "cpu_per_simulated_s",
+                       "runs", "on_front", "recommended"])]
+    for e in cal.evaluations:
+        lines.append(",".join([*(repr(e.options[n]) for n in names), repr(e.worst_error),
+                               repr(e.cpu_s), repr(e.simulated_s), repr(e.real_time_factor),
+                               str(e.runs), str(id(e) in front).lower(),
+                               str(e is cal.recommended).lower()]))
+    return "\n".join(lines) + "\n"

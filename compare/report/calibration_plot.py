@@ -1,0 +1,51 @@
+"""The Pareto front of a calibration: CPU cost against worst error, one point per
+candidate, the front joined, the tolerance drawn and the recommendation marked."""
+from __future__ import annotations
+
+import math
+
+__all__ = ["pareto_plot"]
+
+
+def pareto_plot(cal, path) -> None:
+    """Write the plot of :class:`compare.campaign.calibrate.Calibration` ``cal`` to
+    ``path`` (PNG, PDF or SVG by suffix), atomically."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from compare.run import atomic
+
+    pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.cpu_s > 0]
+    front = [e for e in cal.front if e in pts]
+    fig, ax = plt.subplots(figsize=(7.0, 4.6), dpi=150, layout="constrained")
+    ax.scatter([e.cpu_s for e in pts], [max(e.worst_error, 1e-6) for e in pts], s=28,
+               color="0.55", label="candidate", zorder=2)
+    if front:
+        ax.plot([e.cpu_s for e in front], [max(e.worst_error, 1e-6) for e in front], "-o",
+                color="C0", ms=5, lw=1.5, label="Pareto front", zorder=3)
+    for e in pts:
+        ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()), (e.cpu_s,
+                    max(e.worst_error, 1e-6)), textcoords="offset points", xytext=(5, 4),
+                    fontsize=8, color="0.25")
+    ax.axhline(cal.tolerance, color="C3", ls="--", lw=1.2,
+               label=f"tolerance {cal.tolerance:g}")
+    rec = cal.recommended
+    if rec is not None:
+        ax.scatter([rec.cpu_s], [max(rec.worst_error, 1e-6)], s=140, facecolors="none",
+                   edgecolors="C2", linewidths=2, label="recommended (cheapest within)",
+                   zorder=4)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    unit = {"restitution": "relative error vs Eq. 19/20",
+            "thresholds": "relative threshold error",
+            "histories": "theta RMS / alpha before the first impact"}[cal.metric]
+    ax.set_xlabel("CPU time on the validation set [s]")
+    ax.set_ylabel(f"worst error ({unit})")
+    load = ", ".join(f"{x:.2f}" for x in cal.load_average)
+    ax.set_title(f"{cal.engine}: {cal.metric}, {cal.validation.scene} (load {load})",
+                 fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    atomic.savefig(fig, path)
+    plt.close(fig)
