@@ -29,15 +29,17 @@ def _shifted(traj, name: str):
     dt = SHIFT[name]
     theta = np.interp(traj.t - dt, traj.t, traj.theta)
     psi = np.interp(traj.t - dt, traj.t, traj.psi)
+    cpu = 0.4 if name == "pymunk" else 1.1
     return dataclasses.replace(traj, backend=name, theta=theta, psi=psi,
-                               settings={"dt": 1e-4}, wall_time=0.4 if name == "pymunk" else 1.1)
+                               settings={"dt": 1e-4}, wall_time=cpu,
+                               diagnostics={**(traj.diagnostics or {}), "cpu_time": cpu})
 
 
 def _threshold(omega, a_ref, err, mode="after-impact", **extra):
     return {"omega": omega, "kind": "sine", "a_reference": a_ref, "a_engine": a_ref * (1 + err),
-            "a_low": a_ref * (1 + err - 0.002), "mode_reference": mode, "mode_engine": mode,
+            "a_survives": a_ref * (1 + err - 0.002), "mode_reference": mode, "mode_engine": mode,
             "n_runs": 7, "irregular_runs": 0, "rel_tol": 0.002, "rel_error": err,
-            "bracketed": True,
+            "bracketed": True, "cpu_s": 3.0,
             "provenance": {"backend": "x", "version": "x", "dt": 1e-4, "settings": {},
                            "wall_time": 3.0}, **extra}
 

@@ -9,12 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from compare.report.findings import BEGIN, END, render
+from compare.campaign.summary import SCHEMA_VERSION
+from compare.report.findings import BEGIN, END, TRUST_BEGIN, TRUST_END, render, render_trust
 from compare.report.trust import trust_table
 from compare.campaign.verdicts import VERDICT_IDS
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+TRUST_DOC = ROOT / "docs" / "engine-trust.md"
 SUMMARY = ROOT / "docs" / "validation" / "summary.json"
 
 
@@ -32,8 +34,17 @@ def test_readme_block_is_generated_from_the_summary(doc):
                                   "README.md")
 
 
+def test_trust_doc_table_is_generated_from_the_same_summary(doc):
+    text = TRUST_DOC.read_text(encoding="utf-8")
+    assert text.count(TRUST_BEGIN) == 1 and text.count(TRUST_END) == 1
+    block = text.split(TRUST_BEGIN, 1)[1].split(TRUST_END, 1)[0].strip("\n")
+    assert block == render_trust(doc), (
+        "docs/engine-trust.md differs from docs/validation/summary.json; run: python -m "
+        "compare.report.findings docs/validation/summary.json README.md docs/engine-trust.md")
+
+
 def test_stored_summary_is_a_full_campaign_with_a_consistent_trust_table(doc):
-    assert doc["schema_version"] == 2 and doc["quick"] is False
+    assert doc["schema_version"] == SCHEMA_VERSION and doc["quick"] is False
     assert "--quick" not in doc["provenance"]["command"]
     assert {v["id"] for v in doc["verdicts"]} == set(VERDICT_IDS)
     # The stored trust table is what compare.report.trust computes from the stored

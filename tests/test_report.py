@@ -13,6 +13,7 @@ import json
 
 import pytest
 
+from compare.campaign.summary import SCHEMA_VERSION
 from compare.campaign.validation import CampaignConfig, run_campaign
 from compare.cli.main import main
 from compare.report.html import write_report
@@ -22,7 +23,7 @@ from compare.campaign.verdicts import VERDICT_IDS
 # (17.5-18 rad/s), so the one threshold point is away from jumps.
 TINY = dict(engines=("pymunk",), points=("B",), restitution_lams=(5.0,), restitution_mus=(1.0,),
             pendulum_lams=(5.0,), spectrum_cases=("no_pendulum",), n_frequencies=1,
-            omega_range=(6.0, 8.0), jump_cases=(), rel_tol=4e-3, workers=2)
+            omega_range=(6.0, 8.0), jump_cases=(), rel_tol=4e-3, workers=2, long_runs=False)
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +48,7 @@ def test_report_files_and_keys(tiny_report):
     assert html.count("data:image/png;base64,") >= 3
     assert "http://" not in html and "https://" not in html
     assert "| id | engine | value |" in (out / "summary.md").read_text()
-    assert summary["schema_version"] == 2 and summary["quick"] is False
+    assert summary["schema_version"] == SCHEMA_VERSION and summary["quick"] is False
     assert {v["id"] for v in summary["verdicts"]} <= set(VERDICT_IDS)
     assert set(summary["trust"]) == {"pymunk"}
     # Provenance travels with every number.
@@ -139,8 +140,9 @@ def test_trust_table_is_computed_from_the_measurements(synthetic):
     first = thr["first_disagreement"]
     assert first["rel_error"] == pytest.approx(-0.066) and first["cause"] == "contact"
     assert doc["trust"]["pymunk"]["thresholds"]["agree_up_to"] == pytest.approx(60.0)
-    # Cost: median of the A-D run walls.
-    assert pb["cost"]["run_s"] == pytest.approx(1.1)
+    # Cost: median of the A-D runs' CPU seconds, measured inside each run.
+    assert pb["cost"]["run_cpu_s"] == pytest.approx(1.1)
+    assert pb["cost"]["threshold_point_cpu_s"] == pytest.approx(3.0)
     assert pb["settings"] == {"dt": 1e-4, "solver_iterations": 50}
 
 
@@ -162,7 +164,7 @@ def test_missing_cause_reads_not_measured():
     assert out["agree_up_to"] is None and out["failing"][0]["cause"] is None
     from compare.report.trust import conclusion
     row = {"version": "v", "settings": {}, "thresholds": out,
-           "cost": {"run_s": None, "spectrum_s": None}}
+           "cost": {"run_cpu_s": None, "threshold_point_cpu_s": None, "spectrum_cpu_s": None}}
     assert "cause: not measured" in conclusion("pymunk", row)
 
 

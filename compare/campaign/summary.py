@@ -299,13 +299,18 @@ class LongRun:
     cpu_s: float | None
     passed: bool | None
     detail: str = ""
+    scene: str = ""
+    model_status: str = ""
+    t_end: float | None = None
+    cpu_per_sim_s: float | None = None
 
     @classmethod
     def from_dict(cls, d) -> "LongRun":
         return cls(d.get("backend", ""), d.get("case", ""), num(d.get("t_max")),
                    d.get("status", ""), num(d.get("pivot_sliding")), num(d.get("theta_final")),
                    num(d.get("psi_final")), num(d.get("cpu_s")), d.get("passed"),
-                   d.get("detail", ""))
+                   d.get("detail", ""), d.get("scene", ""), d.get("model_status", ""),
+                   num(d.get("t_end")), num(d.get("cpu_per_sim_s")))
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ Progress bar on a terminal only.
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -94,6 +95,8 @@ class CampaignConfig:
     rel_bracket: float = 0.03  # frequencies are chosen where the model is monotone 2x this above
     rel_tol: float = 5e-3  # robust bracket width (the one search's, compare.measure.thresholds)
     engine_dt: float | None = None  # override every engine's time step (None: calibrated)
+    long_run_t_max: float = 20.0  # s, fixed window of the long runs (compare/measure/long_runs.py)
+    long_runs: bool = True  # the trust table's long-run line (rest, after a pulse)
     workers: int = 2  # the target machine has 2 cores
     tolerances: Tolerances = Tolerances()
 
@@ -125,7 +128,7 @@ class CampaignConfig:
     def quick(cls, **changes) -> "CampaignConfig":
         """Smaller grids for ``--quick`` (< 2 min on 2 cores)."""
         base = dict(restitution_lams=(3.0, 7.0), restitution_mus=(1.0,), pendulum_lams=(5.0,),
-                    n_impacts=3, n_frequencies=1, jump_cases=())
+                    n_impacts=3, n_frequencies=1, jump_cases=(), long_runs=False)
         base.update(changes)
         return cls(**base)
 
@@ -180,21 +183,34 @@ def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
                                  reference_backend=config.spectrum_backend)
 
 
+def _job_long_run(name, label, scene_name, amplitude, omega, config):
+    from compare.measure.long_runs import long_run
+    return long_run(name, label, scene_name, amplitude, omega, config.long_run_t_max,
+                    backend_settings(name, config))
+
+
 _JOBS = {"history": _job_history, "restitution": free_rocking_restitution,
-         "threshold": _job_threshold, "jump": _job_jump}
+         "threshold": _job_threshold, "jump": _job_jump, "long_run": _job_long_run}
 
 
 def _run_one(item):
-    """Run one job; an exception becomes an error record (one bad engine run must
-    not sink a 10-minute campaign; the verdict table then reports it unmeasured)."""
+    """Run one job: ``(result, cpu_s when computed, cpu_s spent now, from_store)``.
+    An exception becomes an error record (one bad engine run must not sink a
+    10-minute campaign; the verdict table then reports it unmeasured)."""
     kind, args = item
-    t0 = time.perf_counter()
+    c0 = time.process_time()
+
+    def compute():  # stored with its CPU cost, so a store hit can say what it cost
+        t0 = time.process_time()
+        value = _JOBS[kind](*args)
+        return {"value": value, "cpu_s": time.process_time() - t0}
     try:  # through the store: a finished job is not redone (compare/ code in its key)
-        out = runs.memo("campaign-job", _job_description(item), lambda: _JOBS[kind](*args),
-                        code=runs.ALL_CODE)
+        hits = runs.STATS["hits"]
+        out = runs.memo("campaign-job", _job_description(item), compute, code=runs.ALL_CODE)
+        stored = runs.STATS["hits"] > hits
+        return out["value"], out["cpu_s"], time.process_time() - c0, stored
     except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
-        out = _JobError(f"{type(exc).__name__}: {exc}")
-    return out, time.perf_counter() - t0
+        return _JobError(f"{type(exc).__name__}: {exc}"), 0.0, time.process_time() - c0, False
 
 
 def _job_description(item) -> dict:
@@ -206,9 +222,9 @@ def _job_description(item) -> dict:
 
 
 def _lookup(item):
-    """A finished job from the store (its wall time here: 0), or None."""
+    """A finished job from the store (nothing spent now), or None."""
     out = runs.lookup("campaign-job", _job_description(item), code=runs.ALL_CODE)
-    return None if out is None else (out, 0.0)
+    return None if out is None else (out["value"], out["cpu_s"], 0.0, True)
 
 
 @dataclass(frozen=True)
@@ -276,13 +292,14 @@ class CampaignResult:
     verdicts: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     errors: list = field(default_factory=list)  # jobs that raised, with the message
+    long_runs: list = field(default_factory=list)  # compare.measure.long_runs rows
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
                 "settings": self.settings, "versions": self.versions,
                 "comparisons": self.comparisons, "restitution": self.restitution,
                 "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
-                "errors": self.errors}
+                "errors": self.errors, "long_runs": self.long_runs}
 
 
 def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
@@ -291,6 +308,7 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
 
     config = config or CampaignConfig()
     t_start = time.perf_counter()
+    load_start = os.getloadavg()[0]
     scene = load_scene(config.scene)
     scenes = {True: scene, False: scene.without_pendulum()}
     if not scene.has_pendulum:
@@ -343,13 +361,23 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
                 jobs.append(("restitution", (name, scene.replace(lam=lam), config)))
                 labels.append(("restitution", True, name))
 
+    if config.long_runs:
+        from compare.measure.long_runs import LONG_RUNS
+        for name in config.engines:
+            for label, scene_name, amplitude, omega in LONG_RUNS:
+                jobs.append(("long_run", (name, label, scene_name, amplitude, omega, config)))
+                labels.append(("long_run", False, name))
     t0 = time.perf_counter()
     outputs = _execute(jobs, config.workers)
     result.timings["engine_runs_wall"] = time.perf_counter() - t0
     cpu: dict[str, float] = {}
-    for label, job, (out, wall) in zip(labels, jobs, outputs):
+    spent: dict[str, float] = {}
+    n_stored = 0
+    for label, job, (out, cpu_s, spent_s, stored) in zip(labels, jobs, outputs):
         kind, pend, name = label[:3]
-        cpu[f"{kind}:{name}"] = cpu.get(f"{kind}:{name}", 0.0) + wall
+        cpu[f"{kind}:{name}"] = cpu.get(f"{kind}:{name}", 0.0) + cpu_s
+        spent[f"{kind}:{name}"] = spent.get(f"{kind}:{name}", 0.0) + spent_s
+        n_stored += bool(stored)
         if isinstance(out, _JobError):
             result.errors.append({"job": kind, "backend": name, "pendulum": pend,
                                   "label": [str(x) for x in label[3:]],
@@ -360,7 +388,10 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
         elif kind == "restitution":
             result.restitution.append({"backend": name, "pendulum": pend, **out.to_dict()})
         elif kind == "threshold":
-            ref_spectra[pend].setdefault("engines", {}).setdefault(name, []).append(out.to_dict())
+            ref_spectra[pend].setdefault("engines", {}).setdefault(name, []).append(
+                {**out.to_dict(), "from_store": bool(stored)})
+        elif kind == "long_run":
+            result.long_runs.append(out)
         elif kind == "jump":
             ref_spectra[pend].setdefault("jump_shifts", {})[name] = out.to_dict()
     # Sorted by the key's text (str of the whole item would print every array).
@@ -374,6 +405,7 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
                                    **comp.to_dict()})
     result.spectra = {_case(p): s for p, s in ref_spectra.items()}
     result.verdicts = build_verdicts(result)
-    result.timings["cpu_by_job"] = cpu
-    result.timings["total"] = time.perf_counter() - t_start
+    result.timings.update(cpu_by_job=cpu, spent_by_job=spent, from_store=n_stored,
+                          n_jobs=len(jobs), total=time.perf_counter() - t_start,
+                          load_average=[load_start, os.getloadavg()[0]])
     return result

@@ -13,7 +13,7 @@ __all__ = ["build_verdicts", "VERDICT_IDS"]
 # Stable ids of the verdict rows (summary.json ``verdicts[*].id``): scripts key on
 # these, never on the human-readable ``metric`` text, which may be reworded.
 VERDICT_IDS = ("restitution_eq20", "restitution_eq19", "threshold_pendulum",
-               "threshold_no_pendulum", "verdicts_AD", "theta_first_impact")
+               "threshold_no_pendulum", "verdicts_AD", "theta_first_impact", "long_run")
 
 
 def _finite(values) -> list[float]:
@@ -92,4 +92,17 @@ def build_verdicts(result) -> list[dict]:
                              "theta RMS error / alpha before the first impact (A-D)", name,
                              [c["theta_rms_first"] for c in comps], tol.theta_rms_first,
                              why["theta_rms_first"], "fraction of alpha", n_cases))
+        longs = [r for r in getattr(result, "long_runs", []) if r["backend"] == name]
+        if longs:
+            from compare.measure.long_runs import MAX_CREEP
+            bad = [r for r in longs if not r["passed"]]
+            rows.append({
+                "id": "long_run", "metric": "long runs (fixed window, no early stop): verdict "
+                "as the model's, pivot creep (max, m)", "backend": name,
+                "value": max(r["pivot_sliding"] for r in longs), "tolerance": MAX_CREEP,
+                "passed": not bad, "unit": "m",
+                "reason": "the model's verdict over the same window; pivots slide < 1 mm, a "
+                          "tenth of the monitor's collapse limit",
+                "detail": "; ".join(f"{r['case']} ({r['scene']}): {r['detail']}"
+                                    for r in longs)})
     return rows

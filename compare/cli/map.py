@@ -33,6 +33,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help=f"engine frequencies (default: {ENGINE_POINTS} of --omega)")
     parser.add_argument("--engine-amplitude", default=None, metavar="A0:A1:dA",
                         help=f"engine amplitudes (default: {ENGINE_POINTS} of --amplitude)")
+    parser.add_argument("--t-max", type=float, default=None, metavar="S",
+                        help="fixed window of every engine run [s], no early stop (default: "
+                             "each run stops when its verdict is certain)")
     parser.add_argument("--max-engine-runs", type=int, default=100, metavar="N",
                         help="refuse engine grids with more runs than this in all")
     add_workers_arg(parser)
@@ -62,15 +65,23 @@ def _engine_grid(args, omegas, amps, n_engines: int):
 
 
 class _EngineRun:
-    """``(A, Omega) -> Verdict`` of one backend with its default settings."""
+    """``(A, Omega) -> Verdict`` of one backend: its calibrated settings with the
+    friction the pulse needs (as every threshold search,
+    :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
+    no early stop when given, through the run store."""
 
-    def __init__(self, name: str, scene, pulse: str):
-        from engines import get_backend
-        self.backend, self.scene, self.pulse = get_backend(name), scene, pulse
+    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None):
+        self.name, self.scene, self.pulse = name, scene, pulse
+        self.options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
 
     def __call__(self, amplitude: float, omega: float):
         from analytic.excitation import Pulse
-        return self.backend.simulate(self.scene, Pulse(amplitude, omega, self.pulse)).verdict
+        from compare.measure.engine_spectrum import pulse_settings
+        from compare.run import runs
+        settings = pulse_settings(self.name, self.scene, amplitude, omega, self.pulse,
+                                  verdict_only=True, **self.options)
+        return runs.simulate(self.name, self.scene, Pulse(amplitude, omega, self.pulse),
+                             settings).verdict
 
 
 def _hatch_invalid(ax, first, validity) -> None:
@@ -145,6 +156,8 @@ def run(args: argparse.Namespace) -> int:
     omegas = parse_omega_range(args.omega, "--omega")
     amps = parse_range(args.amplitude, "--amplitude", "m/s^2")
     workers = resolve_workers(args.workers)
+    if args.t_max is not None and not (math.isfinite(args.t_max) and 0 < args.t_max <= 1e5):
+        raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {args.t_max!r}")
     if not (1 <= args.max_engine_runs <= 100_000):
         raise ValueError(f"--max-engine-runs must be in [1, 100000], got {args.max_engine_runs}")
     if args.csv:
@@ -164,7 +177,8 @@ def run(args: argparse.Namespace) -> int:
     maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
                          workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, args.pulse), scene, *eng_grid,
+        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
+                                *eng_grid,
                                 backend=name, pulse=args.pulse, workers=workers))
     from analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)

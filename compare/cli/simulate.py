@@ -39,15 +39,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _settings(name: str, criterion: str | None, t_max: float | None):
-    """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied."""
+    """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied
+    (``--t-max`` fixes the run's window: no early stop, in every backend)."""
     from engines import configure
     if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
     options = {}
     if criterion is not None:  # configure keeps the backend's topple angle
         options["criterion"] = criterion
-    if t_max is not None:
+    if t_max is not None:  # the same fixed window in every backend: no early stop
         options["t_max"] = t_max
+        if name != "analytic-fast":  # the compiled model stops only when its verdict is exact
+            options["early_stop"] = False
     return configure(name, **options)
 
 

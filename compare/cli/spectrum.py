@@ -259,6 +259,8 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
     import time
 
     options = {} if args.dt is None else {"dt": args.dt}
+    if args.t_max is not None:  # the model's window, fixed, in every engine run
+        options.update(t_max=args.t_max, early_stop=False)
     results, walls = [], {}
     for name in names:
         t0 = time.perf_counter()

@@ -12,6 +12,10 @@ Candidates (all evaluated; ``causes`` lists every one that applies):
     the bob meeting a column (:func:`analytic.clearance.check_clearance`).
     Validity is also checked at both ends of the engine's bracket; a failure
     only above the decisive amplitude is reported in ``validity``, not blamed.
+``collapse``
+    the engine's frame collapsed (columns out of step, a pivot slid, the lintel
+    turned: no longer the model's mechanism) below its first overturn, where
+    the model holds; the diagnostic farthest beyond its noise level is named.
 ``no-bracket``
     no robust first overturn within the widened bracket.
 ``window``
@@ -26,7 +30,6 @@ Candidates (all evaluated; ``causes`` lists every one that applies):
 ``iterations``
     the robust threshold with doubled solver iterations at the same step meets it.
 ``contact``
-    the engine's frame collapsed below its threshold where the model holds, or
     the error shrinks neither with the step nor with the iterations (the
     diagnostic farthest beyond its noise level is named).
 ``sensitivity``
@@ -34,7 +37,8 @@ Candidates (all evaluated; ``causes`` lists every one that applies):
     verdict at the bracket's ends (the point has ``isolated`` overturns).
 
 Primary rule: the first applying cause in :data:`PRIMARY_ORDER`: the model before
-any engine (no engine is blamed where the model is invalid), then what makes the
+any engine (no engine is blamed where the model is invalid), then a collapse of
+the engine's frame (it explains a missing bracket), then what makes the
 comparison itself ill-posed (no bracket, window, jump), then the engine's
 numerics from the cheapest remedy (step, iterations) to none (contact), then
 sensitivity; ``unknown`` when none applies.
@@ -54,8 +58,8 @@ from compare.measure.thresholds import SEARCH, Search, ThresholdPoint, engine_th
 __all__ = ["Classification", "classify", "model_validity", "model_jump", "model_island",
            "explain_isolated", "PRIMARY_ORDER", "JUMP_REL"]
 
-PRIMARY_ORDER = ("model", "no-bracket", "window", "jump", "discretisation", "iterations",
-                 "contact", "sensitivity")
+PRIMARY_ORDER = ("model", "collapse", "no-bracket", "window", "jump", "discretisation",
+                 "iterations", "contact", "sensitivity")
 # Frequency neighbourhood searched for a jump of the model, relative: 2.5 % is
 # 0.25 rad/s at Omega 10, eight times PyBullet's measured shift of Fig. 5's
 # Omega_1 jump (-0.03 rad/s) and far below the model's jump spacing (~7 rad/s).
@@ -130,7 +134,7 @@ def model_jump(scene, omega: float, kind: str, a_engine: float, tol: float) -> s
             else:
                 w1 = mid
         return (f"the model's overturning mode changes from {m0} to {m1} at Omega = "
-                f"{0.5 * (w0 + w1):.3g} rad/s (+/- {0.5 * (w1 - w0):.2g}; located on the model), "
+                f"{0.5 * (w0 + w1):.4g} rad/s (+/- {0.5 * (w1 - w0):.2g}; located on the model), "
                 f"within {100 * JUMP_REL:g} % of {omega:g}; its thresholds there span "
                 f"{min(levels):.4g}-{max(levels):.4g} m/s^2")
     return None
@@ -271,9 +275,9 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
                  and not p.perturbation and p.amplitude < (point.a_engine if point.bracketed
                                                            else math.inf)]
     if collapsed and valid:
-        causes["contact"] = ("the engine's frame collapsed (not overturned) where the model "
-                             "holds; " + contact_detail(engine, scene, omega, min(collapsed),
-                                                        settings, kind))
+        causes["collapse"] = ("the engine's frame collapsed (not overturned) where the model "
+                              "holds; " + contact_detail(engine, scene, omega, min(collapsed),
+                                                         settings, kind))
     rows: tuple = ()
     if convergence and point.bracketed and abs(point.rel_error) > tol:
         rows = tuple(convergence_rows(engine, scene, omega, point, settings, kind, search))
@@ -289,8 +293,7 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
             causes["iterations"] = (f"{more[0]['iterations']} solver iterations at dt: "
                                     f"{100 * more[0]['rel_error']:+.2g} %, meets "
                                     f"{100 * tol:g} %")
-        if finer is None and not (more and abs(more[0]["rel_error"]) <= tol) \
-                and "contact" not in causes:
+        if finer is None and not (more and abs(more[0]["rel_error"]) <= tol):
             causes["contact"] = (f"robust error {steps} at dt, dt/2, dt/4 does not meet "
                                  f"{100 * tol:g} %; " + contact_detail(
                                      engine, scene, omega, point.a_engine, settings, kind))

@@ -54,26 +54,31 @@ def backend_version(name: str) -> str:
 
 @dataclass(frozen=True)
 class Provenance:
-    """What produced a number: backend, its version, time step, settings, wall time."""
+    """What produced a number: backend, its version, time step, settings, wall time
+    and CPU time [s] (the run's own, when computed; NaN when not reported)."""
 
     backend: str
     version: str
     dt: float | None
     settings: dict = field(default_factory=dict)
     wall_time: float = math.nan
+    cpu_time: float = math.nan
 
     def to_dict(self) -> dict:
         return {"backend": self.backend, "version": self.version, "dt": self.dt,
-                "settings": _plain(self.settings), "wall_time": self.wall_time}
+                "settings": _plain(self.settings), "wall_time": self.wall_time,
+                "cpu_time": self.cpu_time}
 
 
 def provenance_of(traj: Trajectory, wall_time: float | None = None) -> Provenance:
     """The provenance of a trajectory (``dt`` is None for adaptive backends)."""
     settings = _plain(traj.settings or {})
     dt = settings.get("dt") if isinstance(settings, dict) else None
+    cpu = (traj.diagnostics or {}).get("cpu_time")
     return Provenance(traj.backend, backend_version(traj.backend),
                       float(dt) if dt is not None else None, settings,
-                      float(traj.wall_time if wall_time is None else wall_time))
+                      float(traj.wall_time if wall_time is None else wall_time),
+                      float(cpu) if cpu is not None else math.nan)
 
 
 def settings_provenance(backend: str, settings, wall_time: float) -> Provenance:

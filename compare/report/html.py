@@ -33,8 +33,8 @@ from compare.report.trust import trust_table
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict", "add_model_validity",
            "SCHEMA_VERSION"]
 
-# 2: schema_version, quick, provenance, trust, verdict ids (1 had none of them).
-SCHEMA_VERSION = 2
+# The schema (and its version) lives in one place, compare/campaign/summary.py.
+from compare.campaign.summary import SCHEMA_VERSION  # noqa: E402
 
 
 def summary_dict(result, provenance: dict | None = None) -> dict:

@@ -18,7 +18,8 @@ __all__ = ["HEADERS", "table", "csv_text", "error_rows", "history_rows", "jump_r
            "key_value_rows", "cause_phrase"]
 
 _JOBS = {"threshold": "overturning thresholds (bisections)", "history": "time histories A-D",
-         "restitution": "free-rocking restitution", "jump": "mode-jump frequency"}
+         "restitution": "free-rocking restitution", "jump": "mode-jump frequency",
+         "long_run": "long runs (fixed window)"}
 _TIMINGS = {"reference_spectra": "reference spectra (analytic model, both curves)",
             "engine_runs_wall": "all jobs, wall time (parallel)",
             "total": "whole campaign, wall time"}
@@ -111,12 +112,12 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     def cost(row, key):
         c = row["cost"]
         if key == "run":
-            return _cell(fmt_seconds(c["run_s"]))
-        if c["threshold_point_s"] is None:
+            return _cell(fmt_seconds(c["run_cpu_s"]) + " CPU")
+        if c["threshold_point_cpu_s"] is None:
             return _cell("not measured")
-        return _cell(f"{fmt_seconds(c['threshold_point_s'])} per point "
-                     f"({c['runs_per_point']:.2g} runs); ≈ {fmt_seconds(c['spectrum_s'])} for "
-                     f"{c['spectrum_frequencies']} frequencies")
+        return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per point "
+                     f"({c['runs_per_point']:.2g} runs); ≈ {fmt_seconds(c['spectrum_cpu_s'])} "
+                     f"for {c['spectrum_frequencies']} frequencies")
 
     def settings(row):
         dt = row["settings"].get("dt")
@@ -209,8 +210,7 @@ def threshold_points(doc: dict) -> list[dict]:
                     "mode_model": p.mode_reference, "mode_engine": p.mode_engine,
                     "model_valid": valid, "model_reason": reason,
                     "cause": p.cause, "cause_detail": p.cause_detail, "n_runs": p.n_runs,
-                    "cpu_s": p.cpu_s,
-                    "wall_s": (p.raw.get("provenance") or {}).get("wall_time")})
+                    "cpu_s": p.cpu_s, "from_store": p.from_store})
     return out
 
 
@@ -253,7 +253,7 @@ def threshold_rows(doc: dict) -> list[list]:
                      str(p["n_runs"]),
                      _cell(cause_phrase(p["cause"]), None,
                            "" if p["cause"] == "agrees" else (p["cause_detail"] or "")),
-                     fmt_seconds(p["wall_s"])])
+                     fmt_seconds(p["cpu_s"]) + (" (store)" if p["from_store"] else "")])
     return rows
 
 
@@ -353,12 +353,20 @@ def restitution_rows(doc: dict) -> list[list]:
 
 def timing_rows(doc: dict) -> list[list]:
     t = doc["timings"]
-    rows = [[_TIMINGS.get(k, k.replace("_", " ")), fmt_seconds(v)] for k, v in t.items()
-            if not isinstance(v, dict)]
+    counts = ("from_store", "n_jobs", "load_average")
+    rows = [[_TIMINGS.get(k, k.replace("_", " ")) + " (wall)", fmt_seconds(v)]
+            for k, v in t.items() if not isinstance(v, (dict, list)) and k not in counts]
+    if "n_jobs" in t:
+        rows.append(["jobs served by the run store", f"{t.get('from_store', 0)} of {t['n_jobs']}"])
+    if t.get("load_average"):
+        rows.append(["load average (1 min) at start, end",
+                     ", ".join(f"{x:.2g}" for x in t["load_average"])])
+    spent = t.get("spent_by_job", {})
     for key, v in t.get("cpu_by_job", {}).items():
         kind, _, name = key.partition(":")
-        rows.append([f"{_JOBS.get(kind, kind)}, {label(name)} (summed over runs)",
-                     fmt_seconds(v)])
+        now = f"; {fmt_seconds(spent[key])} spent now" if key in spent else ""
+        rows.append([f"{_JOBS.get(kind, kind)}, {label(name)} (CPU when computed)",
+                     fmt_seconds(v) + now])
     return rows
 
 
@@ -375,7 +383,7 @@ HEADERS = {"verdicts": ["id", "engine", "value", "tolerance", "result",
                         "metric (detail and the tolerance's reason folded)"],
       "thresholds": ["case", "engine", "Ω [rad/s]", "A model", "A engine",
                      "error (bracket)", "mode (model / engine)", "model valid", "runs", "cause",
-                     "wall"],
+                     "CPU"],
       "jumps": ["case", "engine", "probe A [m/s²]", "Ω jump model", "Ω jump engine",
                 "shift [rad/s]", "runs"],
       "histories": ["point", "pendulum", "engine", "verdict (model)", "verdict (engine)",

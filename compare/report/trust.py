@@ -13,7 +13,7 @@ import math
 import statistics
 
 __all__ = ["trust_table", "threshold_agreement", "engine_cost", "key_settings", "conclusion",
-           "LABELS", "label", "fmt_sci", "fmt_seconds", "fmt_pct"]
+           "LABELS", "label", "fmt_sci", "fmt_seconds", "fmt_pct", "AGREEMENT_RULE", "EXCUSED"]
 
 # Human names of backends (run-time tables, conclusions).
 LABELS = {"pybullet": "PyBullet", "pymunk": "Pymunk", "mujoco": "MuJoCo",
@@ -51,65 +51,97 @@ def _points(doc: dict, engine: str) -> list[dict]:
     return out
 
 
-def threshold_agreement(points: list[dict], tolerance: float) -> dict:
-    """How far up in amplitude an engine's thresholds agree with the model.
+# Causes that do not blame the engine: where the model is invalid, or its own
+# threshold curve is discontinuous or has a window, the comparison is ill-posed.
+EXCUSED = ("model", "jump", "window")
+AGREEMENT_RULE = ("An engine agrees up to the highest model threshold A* such that every "
+                  "point with A_model <= A* agrees within the tolerance (robust bracket) or "
+                  "disagrees for a cause that does not blame the engine (" + ", ".join(EXCUSED)
+                  + "); those exceptions are listed by cause.  The first point that "
+                  "disagrees for an engine cause ends the region; every point beyond is "
+                  "listed too.")
 
-    Points are taken in order of the model's threshold ``a_reference``; the
-    engine *agrees up to* the highest one reached before the first point whose
-    ``|rel_error|`` exceeds ``tolerance`` (or was not bracketed).  Returns
-    ``n_points``, ``n_agree``, ``agree_up_to`` [m/s^2] (None when the lowest
-    point already disagrees), ``omega_range`` of the agreeing points below it,
-    ``first_disagreement`` (that point) and ``failing`` (every disagreeing point,
-    with its measured ``cause``/``cause_detail``/``convergence`` when present).
+
+def threshold_agreement(points: list[dict], tolerance: float) -> dict:
+    """How far up in amplitude an engine's thresholds agree with the model
+    (:data:`AGREEMENT_RULE`).
+
+    Returns ``n_points``, ``n_agree``, ``agree_up_to`` [m/s^2] (None when the
+    lowest point already disagrees for an engine cause), ``omega_range`` of the
+    agreeing points up to it, ``exceptions`` (excused points inside the region,
+    by cause), ``first_disagreement`` (the point that ends it), ``failing``
+    (every disagreeing point with its causes), ``isolated`` (points with
+    isolated overturns) and ``rule``.
     """
-    pts = sorted(points, key=lambda p: (_num(p.get("a_reference")) or math.inf))
+    from compare.campaign.summary import ThresholdResult
+    pts = sorted((ThresholdResult.from_dict(p) for p in points),
+                 key=lambda p: p.a_reference if p.a_reference is not None else math.inf)
 
     def ok(p):
-        err = _num(p.get("rel_error")) if p.get("bracketed", True) else None
-        return err is not None and abs(err) <= tolerance
+        if p.cause is not None:
+            return p.cause == "agrees"
+        return p.rel_error is not None and p.bracketed and abs(p.rel_error) <= tolerance
 
-    below, first = [], None
+    inside, first = [], None
     for p in pts:
-        if not ok(p):
+        if not ok(p) and p.cause not in EXCUSED:
             first = p
             break
-        below.append(p)
-    failing = [p for p in pts if not ok(p)]
+        inside.append(p)
 
     def brief(p):
-        return {"case": p.get("case"), "omega": _num(p.get("omega")),
-                "a_reference": _num(p.get("a_reference")), "a_engine": _num(p.get("a_engine")),
-                "rel_error": _num(p.get("rel_error")),
-                "cause": p.get("cause"), "cause_detail": p.get("cause_detail"),
-                "convergence": p.get("convergence")}
+        return {"case": p.case, "omega": p.omega, "a_reference": p.a_reference,
+                "a_engine": p.a_engine, "a_survives": p.a_survives, "rel_error": p.rel_error,
+                "rel_resolution": p.rel_resolution, "cause": p.cause,
+                "cause_detail": p.cause_detail, "causes": [c.name for c in p.causes],
+                "valid": p.valid, "n_isolated": len(p.isolated),
+                "convergence": list(p.convergence)}
 
-    omegas = [_num(p.get("omega")) for p in below]
-    return {"tolerance": tolerance, "n_points": len(pts), "n_agree": len(pts) - len(failing),
-            "agree_up_to": _num(below[-1].get("a_reference")) if below else None,
+    agreeing = [p for p in inside if ok(p)]
+    omegas = [p.omega for p in agreeing if p.omega is not None]
+    exceptions: dict[str, list] = {}
+    for p in inside:
+        if not ok(p):
+            exceptions.setdefault(p.cause, []).append(brief(p))
+    return {"tolerance": tolerance, "n_points": len(pts), "n_agree": sum(map(ok, pts)),
+            "agree_up_to": agreeing[-1].a_reference if agreeing else None,
             "omega_range": [min(omegas), max(omegas)] if omegas else None,
+            "exceptions": exceptions,
             "first_disagreement": brief(first) if first else None,
-            "failing": [brief(p) for p in failing]}
+            "failing": [brief(p) for p in pts if not ok(p)],
+            "isolated": [brief(p) for p in pts if p.isolated],
+            "rule": AGREEMENT_RULE}
+
+
+def _median(values):
+    values = [v for v in values if v is not None]
+    return statistics.median(values) if values else None
 
 
 def engine_cost(doc: dict, engine: str) -> dict:
-    """Wall time per engine run (median over the A-D time histories), per
-    threshold point (mean bisection), runs per point, and an estimated spectrum:
-    one threshold point per frequency of the reference grids (both curves)."""
-    runs = [_num(c.get("test", {}).get("wall_time")) for c in doc.get("comparisons", [])
+    """CPU seconds (measured inside each run, when it was computed): per run
+    (median over the A-D time histories), per threshold point (mean, with its
+    runs), per simulated second (median over the points' searches), and an
+    estimated spectrum (one point per frequency of the reference grids, both
+    curves); ``points_from_store`` says how many points the run store served
+    (they cost nothing now).  None where the summary holds no CPU time (a
+    schema-2 summary held wall time only)."""
+    from compare.campaign.summary import ThresholdResult
+    runs = [_num(c.get("test", {}).get("cpu_time")) for c in doc.get("comparisons", [])
             if c.get("backend") == engine]
-    runs = [r for r in runs if r is not None]
-    pts = _points(doc, engine)
-    walls = [_num(p.get("provenance", {}).get("wall_time")) for p in pts]
-    walls = [w for w in walls if w is not None]
-    n_runs = [p.get("n_runs") for p in pts if p.get("n_runs")]
+    pts = [ThresholdResult.from_dict(p) for p in _points(doc, engine)]
+    cpus = [p.cpu_s for p in pts if p.cpu_s is not None]
+    n_runs = [p.n_runs for p in pts if p.n_runs]
     n_grid = sum(sum(a is not None for a in spec.get("a", []))
                  for spec in doc.get("spectra", {}).values())
-    point = statistics.fmean(walls) if walls else None
-    return {"run_s": statistics.median(runs) if runs else None, "n_runs_timed": len(runs),
-            "threshold_point_s": point,
+    point = statistics.fmean(cpus) if cpus else None
+    return {"run_cpu_s": _median(runs), "n_runs_timed": sum(r is not None for r in runs),
+            "threshold_point_cpu_s": point,
             "runs_per_point": statistics.fmean(n_runs) if n_runs else None,
+            "cpu_per_sim_s": _median([p.cpu_per_sim_s for p in pts]),
+            "points_from_store": sum(p.from_store for p in pts), "n_points": len(pts),
             "spectrum_frequencies": n_grid,
-            "spectrum_s": point * n_grid if (point is not None and n_grid) else None}
+            "spectrum_cpu_s": point * n_grid if (point is not None and n_grid) else None}
 
 
 def key_settings(doc: dict, engine: str) -> dict:
@@ -136,7 +168,7 @@ def fmt_sci(x: float | None, digits: int = 2) -> str:
 
 
 def fmt_seconds(x: float | None) -> str:
-    """Wall time in the unit a reader expects: ms, s or min."""
+    """Seconds in the unit a reader expects: ms, s or min."""
     if x is None:
         return "not measured"
     if x < 1.0:
@@ -169,6 +201,10 @@ def conclusion(engine: str, row: dict) -> str:
                 if n_cases else "the paper's verdicts at A-D")
         (good if ad["passed"] else bad).append(
             text if ad["passed"] else f"the paper's verdicts at A-D: {ad['value']} disagree")
+    lr = row.get("long_run")
+    if lr is not None and lr["value"] is not None:
+        (good if lr["passed"] else bad).append(
+            f"long runs (rest, and after a pulse, fixed window): {lr['detail']}")
     th = row.get("theta_first_impact")
     if th is not None and th["value"] is not None:
         (good if th["passed"] else bad).append(
@@ -180,9 +216,13 @@ def conclusion(engine: str, row: dict) -> str:
         tol = fmt_pct(thr["tolerance"])
         if thr["agree_up_to"] is not None:
             lo, hi = thr["omega_range"]
-            good.append(f"overturning thresholds within {tol} up to A = "
-                        f"{thr['agree_up_to']:.3g} m/s² (Ω {lo:g}-{hi:g} rad/s, "
-                        f"{thr['n_agree']} of {thr['n_points']} points agree)")
+            text = (f"overturning thresholds within {tol} up to A = {thr['agree_up_to']:.3g} "
+                    f"m/s² (Ω {lo:g}-{hi:g} rad/s, {thr['n_agree']} of {thr['n_points']} "
+                    f"points agree")
+            exc = "; ".join(f"{cause}: Ω " + ", ".join(f"{p['omega']:g}" for p in pts)
+                            for cause, pts in thr.get("exceptions", {}).items())
+            good.append(text + (f"; exceptions where the model is no fair reference: {exc}"
+                                if exc else "") + ")")
         first = thr["first_disagreement"]
         if first is not None:
             err = first["rel_error"]
@@ -196,14 +236,19 @@ def conclusion(engine: str, row: dict) -> str:
     if bad:
         parts.append("It does not reproduce " + "; ".join(bad) + ".")
     cost = row["cost"]
-    if cost["run_s"] is not None:
-        text = f"One run costs {fmt_seconds(cost['run_s'])}"
-        if cost["spectrum_s"] is not None:
-            text += (f", a threshold point {fmt_seconds(cost['threshold_point_s'])} "
-                     f"({cost['runs_per_point']:.2g} runs) and a spectrum of "
-                     f"{cost['spectrum_frequencies']} frequencies about "
-                     f"{fmt_seconds(cost['spectrum_s'])}")
-        parts.append(text + " (wall time on the measuring machine).")
+    if cost["run_cpu_s"] is not None or cost["threshold_point_cpu_s"] is not None:
+        bits = []
+        if cost["run_cpu_s"] is not None:
+            bits.append(f"one run {fmt_seconds(cost['run_cpu_s'])}")
+        if cost["threshold_point_cpu_s"] is not None:
+            bits.append(f"a threshold point {fmt_seconds(cost['threshold_point_cpu_s'])} "
+                        f"({cost['runs_per_point']:.2g} runs)")
+        if cost["spectrum_cpu_s"] is not None:
+            bits.append(f"a spectrum of {cost['spectrum_frequencies']} frequencies about "
+                        f"{fmt_seconds(cost['spectrum_cpu_s'])}")
+        store = (f"; {cost['points_from_store']} of {cost['n_points']} points were served "
+                 "by the run store" if cost["points_from_store"] else "")
+        parts.append("CPU time when computed: " + ", ".join(bits) + store + ".")
     return " ".join(parts)
 
 
@@ -217,7 +262,8 @@ def trust_table(doc: dict) -> dict[str, dict]:
     for engine in doc.get("config", {}).get("engines", []):
         row = {"version": doc.get("versions", {}).get(engine, "unknown"),
                "label": label(engine)}
-        for vid in ("restitution_eq20", "restitution_eq19", "verdicts_AD", "theta_first_impact"):
+        for vid in ("restitution_eq20", "restitution_eq19", "verdicts_AD", "theta_first_impact",
+                    "long_run"):
             row[vid] = _verdict(doc, vid, engine)
         if row["verdicts_AD"] is not None:
             row["verdicts_AD"]["n_cases"] = n_points_ad * (2 if has_pend else 1)

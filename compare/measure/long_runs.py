@@ -1,0 +1,58 @@
+"""Long runs: every backend over the same fixed window, no early stop.
+
+A threshold probe stops as soon as its verdict is certain, and a time history at
+the end of the pulse plus a rest hold; neither shows what an engine does to a
+frame left standing for tens of seconds: pivots that creep, a frame that drifts
+after a pulse.  A long run fixes ``t_max`` and turns ``early_stop`` off, so every
+backend covers the same window and the monitor still calls a collapse.
+
+Pass rule: the run ends with the model's verdict (its status over the same
+window) and its pivots slid less than :data:`MAX_CREEP` [m].
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["LONG_RUNS", "LONG_T_MAX", "MAX_CREEP", "long_run"]
+
+# (label, scene, amplitude [m/s^2], omega [rad/s]): the trilith at rest, and the
+# README's Fig. 8 record (lam 3, gamma 0.1) after a 19 m/s^2, 15 rad/s pulse.
+LONG_RUNS = (("rest", "fig5", 0.0, 0.0),
+             ("after pulse", "fig8_lam3_gamma0.1", 19.0, 15.0))
+LONG_T_MAX = 20.0  # s: ~30 rocking periods of the Fig. 8 frame's small swings after the pulse
+# 1 mm: a tenth of the monitor's collapse limit (pivot sliding 0.01 b = 6 mm at b = 0.6 m).
+MAX_CREEP = 1e-3
+
+
+def long_run(backend: str, label: str, scene_name: str, amplitude: float, omega: float,
+             t_max: float = LONG_T_MAX, settings=None) -> dict:
+    """One fixed-window run of ``backend`` and of the model; the row of the trust
+    table's long-run line (:class:`compare.campaign.summary.LongRun`)."""
+    from analytic.excitation import Pulse, Still
+    from engines import configure
+    from scenes import load_scene
+    from compare.run import runs
+    scene = load_scene(scene_name)
+    exc = Pulse(amplitude, omega) if amplitude > 0.0 else Still()
+    s = configure(backend, settings, t_max=t_max, early_stop=False)
+    tr = runs.simulate(backend, scene, exc, s)
+    model = runs.simulate("analytic-fast", scene, exc,
+                          configure("analytic-fast", t_max=t_max, early_stop=False))
+    slide = tr.diagnostics.get("pivot_sliding_max")
+    slide = float(slide) if slide is not None else math.nan
+    passed = tr.verdict.status == model.verdict.status and slide < MAX_CREEP
+    detail = (f"{tr.verdict.status} at {tr.t[-1]:.3g} s of {t_max:g} s (model: "
+              f"{model.verdict.status}); pivots slid {slide:.3g} m")
+    if tr.verdict.status == "collapsed":
+        detail += f" ({tr.verdict.reason})"
+    cpu = tr.diagnostics.get("cpu_time")
+    return {"backend": backend, "case": label, "scene": scene_name, "amplitude": amplitude,
+            "omega": omega, "t_max": t_max, "t_end": float(tr.t[-1]) if len(tr.t) else 0.0,
+            "status": tr.verdict.status, "model_status": model.verdict.status,
+            "pivot_sliding": slide,
+            "theta_final": float(tr.theta[-1]) if len(tr.theta) else None,
+            "psi_final": float(tr.psi[-1]) if len(tr.psi) else None,
+            "cpu_s": float(cpu) if cpu is not None else None,
+            "cpu_per_sim_s": (float(cpu) / float(tr.t[-1])
+                              if cpu is not None and len(tr.t) and tr.t[-1] > 0 else None),
+            "passed": bool(passed), "detail": detail}
