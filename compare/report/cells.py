@@ -5,7 +5,7 @@ from __future__ import annotations
 import html
 import re
 
-__all__ = ["table", "csv_text", "cause_phrase"]
+__all__ = ["table", "csv_text", "cause_phrase", "unbroken"]
 
 
 def _cell(text: str, ok: bool | None = None, details: str = "") -> dict:
@@ -32,7 +32,9 @@ _UNIT = re.compile(r"(\d) (%|α|ms|s|g|Hz|m/s²|rad/s|min)(?=[\s),;.]|$)")
 _HYPHENATED = re.compile(r"[^\s<>]*\w-\w[^\s<>]*")
 
 
-def _unbroken(escaped: str) -> str:
+def unbroken(escaped: str) -> str:
+    """Already-escaped text with numbers kept on their unit's line and hyphenated
+    tokens unsplittable (HTML)."""
     text = _UNIT.sub("\\1\u00a0\\2", escaped)
     return _HYPHENATED.sub(lambda m: f"<span class='nb'>{m.group(0)}</span>", text)
 
@@ -53,10 +55,10 @@ def table(header: list[str], rows: list[list], md: bool = False) -> str:
         ok = c.get("ok") if isinstance(c, dict) else None
         cls = "" if ok is None else (" class='pass'" if ok else " class='fail'")
         more = c.get("details") if isinstance(c, dict) else ""
-        inner = _unbroken(html.escape(_text(c)))
+        inner = unbroken(html.escape(_text(c)))
         if more:
             inner = (f"<details><summary>{inner}</summary>"
-                     f"<span class='small'>{_unbroken(html.escape(more))}</span></details>")
+                     f"<span class='small'>{unbroken(html.escape(more))}</span></details>")
         return f"<td{cls}>{inner}</td>"
 
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)

@@ -23,6 +23,7 @@ from compare.run import atomic
 from compare.report import plots
 from compare.report import tables
 from compare.report import units
+from compare.report.cells import unbroken
 from compare.report.recommend import recommendations
 from scenes import POINTS
 
@@ -136,14 +137,15 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
     body += [f"<p class='headline'><b>{esc(_headline(doc))}.</b> Reference: the analytic "
              "model (accurate path for time histories, compiled path for spectra).</p>",
              "<div class='reco'><b>Recommendation</b><ul>",
-             *(f"<li>{esc(line)}</li>" for line in recommendations(doc)), "</ul></div>",
+             *(f"<li>{unbroken(esc(line))}</li>" for line in recommendations(doc)),
+             "</ul></div>",
              "<h2>Trust table</h2>", tables.table(header, rows),
              f"<p class='small'>{esc(prov.get('date', 'date unknown'))}, commit "
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
              "end. Download: " + _download("trust.csv", tables.csv_text(header, rows)) + ", "
              + _download("thresholds.csv", tables.threshold_csv(doc)) + ".</p>",
-             *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> {esc(r['conclusion'])}</p>"
-               for r in doc["trust"].values()),
+             *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> "
+               f"{unbroken(esc(r['conclusion']))}</p>" for r in doc["trust"].values()),
              "<h2>Verdicts</h2>", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc)),
              "<h2>Overturning thresholds</h2>",
              "<p>Engine thresholds (bisection around the model's) on the model's spectra; "

@@ -112,7 +112,8 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     def cost(row, key):
         c = row["cost"]
         if key == "run":
-            return _cell(fmt_seconds(c["run_cpu_s"]) + " CPU")
+            return _cell("not measured" if c["run_cpu_s"] is None
+                         else fmt_seconds(c["run_cpu_s"]) + " CPU")
         if c["threshold_point_cpu_s"] is None:
             return _cell("not measured")
         return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per point "
