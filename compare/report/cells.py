@@ -43,12 +43,21 @@ def _text(c) -> str:
     return c["text"] if isinstance(c, dict) else c
 
 
+def _flat(c, sep: str = " -- ") -> str:
+    """A cell as plain text, its details (if any) after ``sep``."""
+    if isinstance(c, dict) and c.get("details"):
+        return f"{c['text']}{sep}{c['details']}"
+    return _text(c)
+
+
 def table(header: list[str], rows: list[list], md: bool = False) -> str:
     """HTML (in a horizontally scrolling wrapper) or Markdown table.  A cell is a
-    string or :func:`_cell` (coloured pass/fail, details on demand)."""
+    string or :func:`_cell` (coloured pass/fail, details on demand in HTML,
+    written out after the text in Markdown)."""
     if md:
         lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-        lines += ["| " + " | ".join(_text(c).replace("|", "/") for c in r) + " |" for r in rows]
+        lines += ["| " + " | ".join(_flat(c, ": ").replace("|", "/") for c in r) + " |"
+                  for r in rows]
         return "\n".join(lines)
 
     def td(c):
@@ -72,13 +81,8 @@ def csv_text(header: list[str], rows: list[list]) -> str:
     import csv
     import io
 
-    def flat(c):
-        if isinstance(c, dict) and c.get("details"):
-            return f"{c['text']} -- {c['details']}"
-        return _text(c)
-
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
-    w.writerows([[flat(c) for c in r] for r in rows])
+    w.writerows([[_flat(c) for c in r] for r in rows])
     return buf.getvalue()

@@ -102,7 +102,7 @@ summary{cursor:pointer}.nb{white-space:nowrap}
 .headline{font-size:1.1em}.small{font-size:0.85em;color:#444}.conclusion{margin:0.4em 0 0.8em 0}
 code{overflow-wrap:anywhere}
 @media (max-width:600px){body{padding:0.4em}table{font-size:11px}td,th{padding:2px 3px}
-td:first-child{min-width:7em}}
+td:first-child{min-width:7em}td:last-child{min-width:9em}}
 @media print{body{max-width:none;padding:0}.scroll{overflow:visible}
 td.pass,td.fail,th,.banner{-webkit-print-color-adjust:exact;print-color-adjust:exact}
 img,table{break-inside:avoid}h2{break-after:avoid}}"""
