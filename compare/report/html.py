@@ -1,16 +1,20 @@
 """Writing the validation report: ``index.html`` (self-contained), ``summary.json``,
-``summary.md``.
+``summary.md``, ``trust.csv`` and ``thresholds.csv``.
 
 The first screen answers "which engine can I trust, for what, up to where, at
-what cost": the trust table (:mod:`compare.report.trust`, computed from the summary
+what cost": one recommendation line per use (:mod:`compare.report.recommend`),
+the trust table (:mod:`compare.report.trust`, computed from the summary
 document) and a conclusion per engine.  The evidence follows (plots with error
-panels, :mod:`compare.report.plots`, and tables), then provenance and, folded
-away, the raw settings.  Plots are PNGs embedded as base64 data URIs: the HTML
-opens offline with no server and no side files.
+panels, :mod:`compare.report.plots`, and tables), then the engines' settings as
+a table, provenance and, folded away, scene and configuration.  Plots are PNGs
+and the CSV exports data URIs: the HTML opens offline with no server and no
+side files.
 
 ``summary.json`` carries ``schema_version``, ``quick``, ``provenance``, the
-``trust`` table and verdict rows with stable ``id`` s
-(:data:`compare.campaign.verdicts.VERDICT_IDS`).
+``trust`` table, verdict rows with stable ``id`` s
+(:data:`compare.campaign.verdicts.VERDICT_IDS`) and, beside each reference
+spectrum, ``model_validity``: the model's own validity on its threshold run at
+every frequency (:func:`add_model_validity`).
 """
 from __future__ import annotations
 
