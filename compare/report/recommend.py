@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import re
 
+from compare.report.cells import cause_phrase
 from compare.report.trust import fmt_pct, fmt_sci, label
 
 __all__ = ["recommendations"]
@@ -52,7 +53,7 @@ def _thresholds(trust: dict) -> str | None:
             err = ("not bracketed" if worst["rel_error"] is None
                    else f"{100 * worst['rel_error']:+.1f} %")
             bad.append(f"{label(e)} ({err} at Ω = {worst['omega']:g} rad/s, "
-                       f"{worst.get('cause') or 'cause not measured'})")
+                       f"{cause_phrase(worst.get('cause'))})")
     return _line("Overturning thresholds", good + finer, bad)
 
 

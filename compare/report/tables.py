@@ -82,8 +82,9 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
             text = "none agree"
         else:
             lo, hi = t["omega_range"]
-            text = (f"A ≤ {units.accel(t['agree_up_to'])}, Ω {lo:g} to {hi:g} rad/s "
-                    f"({lo / TWO_PI:.2g} to {hi / TWO_PI:.2g} Hz)")
+            span = (f"Ω {lo:g} rad/s ({lo / TWO_PI:.2g} Hz)" if lo == hi else
+                    f"Ω {lo:g} to {hi:g} rad/s ({lo / TWO_PI:.2g} to {hi / TWO_PI:.2g} Hz)")
+            text = f"A ≤ {units.accel(t['agree_up_to'])}, {span}"
         return _cell(f"{text}; {t['n_agree']} of {t['n_points']} points",
                      t["n_agree"] == t["n_points"])
 
