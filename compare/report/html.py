@@ -157,8 +157,9 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              "where the threshold is discontinuous in Ω (engines are tested away from them). "
              "Hatched grey: the model itself is invalid on its threshold run (a contact would "
              "have to pull: the columns hop or the lintel is thrown off); no engine is blamed "
-             "there. An error no larger than the bracket (both thresholds are bisected to "
-             "0.2 % of A) prints as |e| ≤ 0.2 %.</p>",
+             "there. An error no larger than the engine's bracket (the relative width between "
+             "its highest surviving and lowest overturning amplitude) is no number: it "
+             "prints as |e| ≤ that width.</p>",
              figs((d, f"thresholds on the spectrum {case}, with error panel")
                   for case, d in plots.spectra_figures(doc)),
              tables.table(tables.HEADERS["thresholds"], tables.threshold_rows(doc))]

@@ -250,7 +250,7 @@ def threshold_rows(doc: dict) -> list[list]:
                      "n/a" if w is None else f"{w:g} ({p['f_hz']:.2g} Hz)",
                      units.accel(p["a_model_m_s2"]), units.accel(p["a_engine_m_s2"]),
                      _cell(units.rel_error(p["rel_error"], p["rel_resolution"]), ok),
-                     f"{p['mode_model']} / {p['mode_engine']}",
+                     f"{p['mode_model'] or '—'} / {p['mode_engine'] or '—'}",
                      _valid_cell(p["model_valid"], p["model_reason"]),
                      str(p["n_runs"]),
                      _cell(cause_phrase(p["cause"]), None,
