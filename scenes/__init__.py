@@ -11,6 +11,8 @@ they are.
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from pathlib import Path
 
@@ -19,10 +21,50 @@ from analytic.parameters import Scene
 from .ground_motion import load_record
 from .points import PAPER_OUTCOMES, POINTS, point_pulse
 
-__all__ = ["load_scene", "load_record", "scene_names", "scene_path", "SCENE_DIR", "POINTS",
-           "PAPER_OUTCOMES", "point_pulse"]
+__all__ = ["load_scene", "load_record", "read_toml", "scene_names", "scene_path", "SCENE_DIR",
+           "POINTS", "PAPER_OUTCOMES", "point_pulse"]
 
 SCENE_DIR = Path(__file__).resolve().parent / "data"
+# Largest input file read: a scene or campaign file is a few hundred bytes; a
+# megabyte is a mistake (or a device), refused before parsing.
+MAX_FILE_BYTES = 1 << 20
+
+
+def read_toml(path: Path, what: str) -> dict:
+    """The TOML table of the regular file ``path``; ``ValueError`` naming the file
+    (``what``: 'scene file', 'campaign file') when it is not a regular file, cannot
+    be read, is over :data:`MAX_FILE_BYTES`, is not UTF-8 or not TOML (nesting too
+    deep included)."""
+    where = f"{what} {str(path)!r}"
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # before open: a FIFO would block
+            raise ValueError(f"{where} is not a regular file (a directory, FIFO or "
+                             "device)")
+        with open(path, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                raise ValueError(f"{where} is not a regular file (a directory, FIFO or "
+                                 "device)")
+            data = fh.read(MAX_FILE_BYTES + 1)
+    except FileNotFoundError:
+        raise ValueError(f"{where} does not exist") from None
+    except IsADirectoryError:
+        raise ValueError(f"{where} is a directory, not a TOML file") from None
+    except OSError as exc:
+        raise ValueError(f"{where} cannot be read ({exc.strerror or exc})") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ValueError(f"{where} is larger than {MAX_FILE_BYTES} bytes")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"{where} is not a UTF-8 text file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{where} is not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ValueError(f"{where} is not valid TOML (nesting too deep)") from None
+    except ValueError as exc:  # e.g. an integer over Python's digit limit
+        raise ValueError(f"{where} is not valid TOML ({exc})") from None
 
 
 def scene_names() -> tuple[str, ...]:
@@ -30,7 +72,7 @@ def scene_names() -> tuple[str, ...]:
     return tuple(sorted(p.stem for p in SCENE_DIR.glob("*.toml")))
 
 
-def _resolve(name_or_path: str | Path) -> Path:
+def _find(name_or_path: str | Path) -> Path:
     if not isinstance(name_or_path, (str, Path)):
         raise TypeError(f"scene must be a name (str) or a path (str or Path), got "
                         f"{name_or_path!r} ({type(name_or_path).__name__})")
@@ -56,6 +98,13 @@ def scene_path(name_or_path: str | Path) -> Path:
     return _resolve(name_or_path)
 
 
+def _resolve(name_or_path: str | Path) -> Path:
+    try:
+        return _find(name_or_path)
+    except OSError as exc:  # a name too long for the filesystem, a loop of links
+        raise ValueError(f"scene {_short(str(name_or_path))}: {exc.strerror or exc}") from None
+
+
 def _check_value(where: str, key: str, value) -> None:
     """Reject values that ``float()`` would silently accept but a scene file
     should not contain (booleans, strings), naming the file and the key."""
@@ -65,9 +114,17 @@ def _check_value(where: str, key: str, value) -> None:
         return
     # bool is an int subclass: float(True) == 1.0 would pass unnoticed.
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{where}: key {key!r} must be a number, got {value!r}")
+        raise ValueError(f"{where}: key {key!r} must be a number, got {_short(value)}")
+    if isinstance(value, int) and abs(value) > 1e300:  # float() would overflow
+        raise ValueError(f"{where}: key {key!r} must be a finite number, got an integer "
+                         f"of {len(str(abs(value)))} digits")
     if not math.isfinite(float(value)):
         raise ValueError(f"{where}: key {key!r} must be finite, got {value!r}")
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:57]}... ({type(value).__name__})"
 
 
 def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
@@ -79,21 +136,16 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
     or naming the override when the file is valid but an override is not.
     """
     path = _resolve(name_or_path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{path}: not valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"{path}: not a UTF-8 text file") from None
+    data = read_toml(path, "scene file")
     table = data.get("scene")
     if not isinstance(table, dict) or set(data) - {"scene"}:
         raise ValueError(f"{path}: expected exactly one [scene] table, found "
-                         f"{', '.join(data) or 'none'}")
+                         f"{_short(', '.join(data)) or 'none'}")
     fields = set(Scene.field_names())
     allowed = ", ".join(sorted(fields))
     for key in table:
         if key not in fields:
-            raise ValueError(f"{path}: unknown key {key!r}; allowed: {allowed}")
+            raise ValueError(f"{path}: unknown key {_short(key)}; allowed: {allowed}")
     for key in overrides:
         if key not in fields:
             raise ValueError(f"override: unknown key {key!r}; allowed: {allowed}")

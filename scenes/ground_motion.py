@@ -45,7 +45,7 @@ def _open_text(path: Path, where: str) -> list[str]:
     if path.stat().st_size > MAX_FILE_BYTES:
         raise ValueError(f"{where}: {str(path)!r} is larger than {MAX_FILE_BYTES >> 20} MB")
     try:
-        return path.read_text().splitlines()
+        return path.read_text(encoding="utf-8-sig").splitlines()  # a BOM is not data
     except UnicodeDecodeError:
         raise ValueError(f"{where}: {str(path)!r} is not a UTF-8 text file") from None
     except OSError as exc:

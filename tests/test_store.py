@@ -15,7 +15,8 @@ import pytest
 from analytic.excitation import Pulse, SampledRecord, Still
 from compare.run import atomic
 from compare.run import runs
-from compare.run.store import RunStore, default_cache_dir, run_key
+from compare.run.keys import run_key
+from compare.run.store import RunStore, default_cache_dir
 from engines import get_backend
 
 # Short pymunk run (0.3 s of simulated time at 5e-4 s steps): milliseconds.
@@ -128,7 +129,7 @@ def test_default_cache_dir(tmp_path):
 
 def test_not_a_store_is_a_clear_error(tmp_path):
     (tmp_path / "runs.sqlite").write_bytes(b"not sqlite" * 100)
-    with pytest.raises(ValueError, match="not a usable run store"):
+    with pytest.raises(ValueError, match="is not usable.*trilith cache clear"):
         RunStore(tmp_path)
     (tmp_path / "file").write_text("")
     with pytest.raises(ValueError, match="cannot create"):
@@ -192,12 +193,12 @@ def test_report_dir_is_swapped_whole(tmp_path):
         with atomic.report_dir(out) as d:
             (d / "index.html").write_text("new")
             raise RuntimeError
-    assert sorted(os.listdir(out)) == ["index.html", "stale.md"]
+    assert sorted(os.listdir(out)) == [atomic.MARKER, "index.html", "stale.md"]
     assert (out / "index.html").read_text() == "old"
     with atomic.report_dir(out) as d:
         (d / "index.html").write_text("new")
         (d / "summary.json").write_text("{}")
-    assert sorted(os.listdir(out)) == ["index.html", "summary.json"]  # nothing old mixed in
+    assert sorted(os.listdir(out)) == [atomic.MARKER, "index.html", "summary.json"]  # nothing old mixed in
     leftovers = [n for n in os.listdir(tmp_path) if n.startswith(".report.")]
     assert leftovers == []
 
@@ -224,3 +225,98 @@ def test_run_many_lookup_sends_only_missing_items(store):
     out = list(runs.run_many(fn, [1, 2, 3], workers=1, on_done=lambda i, r: seen.append(i),
                              lookup=lambda x: runs.lookup("demo", {"x": x})))
     assert out == [10, 20, 30] and calls == [3] and sorted(seen) == [0, 1, 2]
+
+
+# ------------------------------------------------------ the data-only value format
+def test_every_trajectory_field_round_trips_through_the_format(fig5):
+    """A record-driven pymunk run (events, verdict, settings, diagnostics, scene and a
+    SampledRecord excitation) comes back field for field, bit for bit."""
+    from compare.run.codec import decode, encode
+
+    rec = SampledRecord(tuple(np.linspace(0.0, 1.0, 11)), (0.0, 30.0, -30.0, 30.0, -1e-300,
+                                                           -0.0, 5e-324, 2.0, 1.0, 0.5, 0.0))
+    traj = get_backend("pymunk").simulate(fig5, rec, _pymunk_settings(t_max=1.0))
+    assert traj.events and traj.diagnostics and traj.settings
+    back = decode(encode(traj))
+    assert_same_trajectory(traj, back)
+    assert back.theta.flags.writeable and back.excitation == rec
+
+
+def test_format_keeps_types_and_special_floats():
+    from compare.measure.thresholds import ThresholdPoint
+    from compare.measure.trajectories import Provenance
+    from compare.run.codec import decode, encode
+
+    prov_fields = {f.name: 0.5 if f.type in ("float", float) else None
+                   for f in dataclasses.fields(Provenance)}
+    prov = Provenance(**{**prov_fields, **{f.name: "x" for f in dataclasses.fields(Provenance)
+                                           if f.type in ("str", str)}})
+    value = {"nan": float("nan"), "inf": -float("inf"), "zero": -0.0, "tiny": 5e-324,
+             "tuple": (1, "a", None, True), "list": [np.float64(2.5), np.int32(-3)],
+             (1.5, "k"): np.arange(6, dtype=np.int16).reshape(2, 3)[:, ::2],
+             "complex": np.array([1 + 2j]), "big": 10 ** 40,
+             "point": ThresholdPoint(9.0, "sine", 8.0, float("nan"), 7.5, "no-impact", None,
+                                     6, 0, 4e-3, prov, ((7.5, "survived", None),))}
+    back = decode(encode(value))
+    assert same(value, back)
+    assert type(back["list"][1]) is np.int32 and back[(1.5, "k")].dtype == np.int16
+
+
+@pytest.mark.parametrize("value", [object(), {1, 2}, np.array(["a"], dtype=object),
+                                   b"bytes"])
+def test_format_refuses_what_is_not_data(value):
+    from compare.run.codec import encode
+    with pytest.raises(TypeError, match="store"):
+        encode(value)
+
+
+def test_format_reads_nothing_foreign():
+    """Decoding refuses (never runs, never imports outside the project) a pickle,
+    a class of another package, a non-dataclass of the project, a truncated value."""
+    import json
+    import struct
+
+    from compare.run.codec import MAGIC, ForeignValue, decode, encode
+
+    def blob(tree) -> bytes:
+        header = json.dumps(tree).encode()
+        return MAGIC + struct.pack("<Q", len(header)) + header
+
+    good = encode({"a": np.ones(3)})
+    for bad in (b"\x80\x05K\x01.",  # pickle.dumps(1)
+                blob({"~": "class", "cls": "os:system", "v": {}}),
+                blob({"~": "class", "cls": "compare.run.store:RunStore", "v": {}}),
+                blob({"~": "class", "cls": "analytic.nothing_here:X", "v": {}}),
+                blob({"~": "array", "dtype": "|O", "shape": [1], "at": 0, "n": 8}),
+                blob({"~": "array", "dtype": "<f8", "shape": [10], "at": 0, "n": 80}),
+                blob({"~": "eval", "v": "1"}),
+                good[:len(good) - 5], good[:10]):
+        with pytest.raises(ForeignValue):
+            decode(bad)
+
+
+def test_a_value_the_format_cannot_hold_is_not_stored_but_not_lost(tmp_path, capsys):
+    s = RunStore(tmp_path / "c")
+    s.put("k", {1, 2}, kind="demo", label="demo", cost=0.0)
+    assert s.get("k") is None and "'demo' result is not stored" in capsys.readouterr().err
+    s.close()
+
+
+def test_a_store_of_pickles_is_read_as_empty_and_pruned(tmp_path):
+    """A store written before the data-only format (no code column, pickled values)
+    opens, is never unpickled, and ``prune`` removes its rows."""
+    import pickle
+    import sqlite3
+
+    d = tmp_path / "old"
+    d.mkdir(mode=0o700)
+    con = sqlite3.connect(d / "runs.sqlite")
+    con.execute("CREATE TABLE runs (key TEXT PRIMARY KEY, kind TEXT NOT NULL, label TEXT NOT "
+                "NULL, cost REAL NOT NULL, created REAL NOT NULL, value BLOB NOT NULL)")
+    con.execute("INSERT INTO runs VALUES ('k', 'demo', 'demo', 0, 0, ?)", (pickle.dumps(1.5),))
+    con.commit()
+    con.close()
+    s = RunStore(d)
+    assert s.get("k") is None and s.by_code() == [("foreign", 1, len(pickle.dumps(1.5)))]
+    assert s.prune(set()) == 1 and s.count() == 0
+    s.close()

@@ -24,14 +24,14 @@ from __future__ import annotations
 
 import fnmatch
 import math
-import tomllib
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from engines import ENGINES
-from scenes import load_scene, scene_names
+from scenes import load_scene, read_toml, scene_names
 
 __all__ = ["Study", "load_study", "reference_jobs", "threshold_jobs", "run_reference",
            "run_threshold", "JOB_RUNS"]
@@ -40,6 +40,8 @@ __all__ = ["Study", "load_study", "reference_jobs", "threshold_jobs", "run_refer
 # rel_tol) bisection runs and 4 robustness runs (compare/measure/thresholds.py); 10 at the
 # defaults.
 JOB_RUNS = 10
+# A campaign name: it becomes the folder campaign-<name>, so no separators or '..'.
+_NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}")
 _KEYS = {"name", "scenes", "engines", "pulses", "omega", "steps", "cases", "rel_bracket",
          "rel_tol", "workers"}
 
@@ -72,24 +74,44 @@ def _list(table: dict, key: str, where: str) -> list:
     return value
 
 
+def _number(value, where: str, key: str) -> float:
+    """A TOML number as float; ``ValueError`` naming the file and key otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        shown = repr(value) if len(repr(value)) <= 40 else f"a {type(value).__name__}"
+        raise ValueError(f"{where}: campaign.{key} must be a number, got {shown}")
+    if isinstance(value, int) and abs(value) > 1e300:  # float() would overflow
+        raise ValueError(f"{where}: campaign.{key} must be a finite number, got an "
+                         f"integer of {len(str(abs(value)))} digits")
+    return float(value)
+
+
 def load_study(path) -> Study:
-    """Read and validate a campaign file; ``ValueError`` naming the key."""
+    """Read and validate a campaign file; ``ValueError`` naming the file and key.
+
+    ``name`` must be a plain name (letters, digits, ``.``, ``_``, ``-``; no path):
+    it picks the default output folder ``campaign-<name>`` in the working
+    directory, which a file must not be able to point elsewhere.
+    """
     from analytic.excitation import PULSE_KINDS
     from compare.campaign.grids import parse_omega_range
 
     path = Path(path)
     where = str(path)
-    try:
-        table = tomllib.loads(path.read_text())["campaign"]
-    except FileNotFoundError:
-        raise ValueError(f"campaign file {where!r} does not exist") from None
-    except (tomllib.TOMLDecodeError, KeyError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{where}: not a campaign file (a [campaign] table is needed: "
-                         f"{exc})") from None
+    data = read_toml(path, "campaign file")
+    table = data.get("campaign")
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: not a campaign file (a [campaign] table is needed)")
     unknown = set(table) - _KEYS
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}; allowed: "
+        shown = ", ".join(sorted(unknown))
+        shown = shown if len(shown) <= 80 else shown[:77] + "..."
+        raise ValueError(f"{where}: unknown key(s) {shown}; allowed: "
                          f"{', '.join(sorted(_KEYS))}")
+    name = table.get("name", path.stem)  # a file's stem holds no path separator
+    if "name" in table and not (isinstance(name, str) and _NAME.fullmatch(name)):
+        raise ValueError(f"{where}: campaign.name must be a plain name of 1-100 letters, "
+                         f"digits, '.', '_' or '-', not starting with '.' (it names the "
+                         f"output folder), got {str(name)[:60]!r}")
     names = []
     for pattern in _list(table, "scenes", where):
         hits = [n for n in scene_names() if fnmatch.fnmatchcase(n, str(pattern))]
@@ -108,9 +130,16 @@ def load_study(path) -> Study:
         if p not in PULSE_KINDS:
             raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_KINDS)}")
     omega = table.get("omega")
-    text = ",".join(str(float(w)) for w in omega) if isinstance(omega, list) else omega
-    omegas = parse_omega_range(str(text), f"{where}: campaign.omega")
-    steps = [float(s) for s in _list(table, "steps", where)] if "steps" in table else [0.0]
+    if isinstance(omega, list):
+        text = ",".join(repr(_number(w, where, "omega")) for w in omega)
+    elif isinstance(omega, str):
+        text = omega
+    else:
+        raise ValueError(f"{where}: campaign.omega must be 'START:STOP:STEP' or a list of "
+                         f"frequencies [rad/s], got {str(omega)[:40]!r}")
+    omegas = parse_omega_range(text, f"{where}: campaign.omega")
+    steps = ([_number(s, where, "steps") for s in _list(table, "steps", where)]
+             if "steps" in table else [0.0])
     for s in steps:
         if not (math.isfinite(s) and 0.0 <= s <= 0.01):
             raise ValueError(f"{where}: steps: each time step must be in [0, 0.01] s "
@@ -120,15 +149,17 @@ def load_study(path) -> Study:
     for c in cases:
         if c not in ("pendulum", "no_pendulum"):
             raise ValueError(f"{where}: cases: {c!r} is not pendulum or no_pendulum")
-    rel_bracket = float(table.get("rel_bracket", Study.rel_bracket))
-    rel_tol = float(table.get("rel_tol", Study.rel_tol))
+    rel_bracket = _number(table.get("rel_bracket", Study.rel_bracket), where, "rel_bracket")
+    rel_tol = _number(table.get("rel_tol", Study.rel_tol), where, "rel_tol")
     if not (0.0 < rel_tol < rel_bracket < 0.5):
         raise ValueError(f"{where}: need 0 < rel_tol < rel_bracket < 0.5, got "
                          f"{rel_tol!r}, {rel_bracket!r}")
     workers = table.get("workers", Study.workers)
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"{where}: workers must be an integer >= 1, got {workers!r}")
-    return Study(name=str(table.get("name", path.stem)), scenes=tuple(names),
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= 256:
+        shown = repr(workers) if len(repr(workers)) <= 40 else f"a {type(workers).__name__}"
+        raise ValueError(f"{where}: campaign.workers must be an integer in [1, 256] (as "
+                         f"--workers), got {shown}")
+    return Study(name=name, scenes=tuple(names),
                  engines=tuple(engines), pulses=tuple(pulses),
                  omegas=tuple(float(w) for w in np.asarray(omegas)), steps=tuple(steps),
                  cases=tuple(cases), rel_bracket=rel_bracket, rel_tol=rel_tol,
@@ -152,7 +183,7 @@ def run_reference(job: tuple) -> tuple[float, str | None]:
     from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
     from compare.run import runs
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
 
     name, case, pulse, omega = job
     scene, ss = _scene(name, case), SpectrumSettings(pulse=pulse)
@@ -186,7 +217,7 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float):
 
 def threshold_description(job: tuple) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
-    from compare.run.store import _engine_version, scene_dict, settings_dict
+    from compare.run.keys import _engine_version, scene_dict, settings_dict
 
     n, c, p, w, a_ref, mode, e, dt, rb, rt = job
     scene = _scene(n, c)

@@ -256,7 +256,7 @@ def _memo(kind: str, scene, config: CampaignConfig, compute):
     """A model-side result (reference spectrum, chosen frequencies) through the run
     store, keyed by the scene and the config (but its worker count: no number
     depends on it)."""
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
     described = {k: v for k, v in config.to_dict().items() if k != "workers"}
     return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute,
                      code=runs.ALL_CODE)

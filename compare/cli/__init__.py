@@ -4,4 +4,4 @@
 each subcommand can land on its own.
 """
 COMMANDS = ("simulate", "restitution", "spectrum", "figures", "report", "bench", "view",
-            "record", "map", "scenes", "campaign", "calibrate")
+            "record", "map", "scenes", "campaign", "calibrate", "cache")

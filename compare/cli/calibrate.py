@@ -83,6 +83,22 @@ def _space(args, engine: str) -> dict:
     return space
 
 
+def _check_budget(engine: str, space: dict, vs) -> None:
+    """Refuse before any work a step that is not positive or whose longest run
+    (the lowest validation frequency's pulse) is over the run budget."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+
+    settings = get_backend(engine).Settings()
+    for dt in space.get("dt", [settings.dt]):
+        if not dt > 0:
+            raise ValueError(f"--dt: each step must be > 0 s, got {dt!r}")
+        _common.check_run_budget(engine, dataclasses.replace(settings, dt=dt),
+                                 Pulse(1.0, min(vs.omegas)), option="--dt")
+
+
 def run(args: argparse.Namespace) -> int:
     import engines
     from compare.campaign.calibrate import ValidationSet, calibrate
@@ -98,6 +114,7 @@ def run(args: argparse.Namespace) -> int:
     vs = ValidationSet(scene=scene.name) if args.omega is None else ValidationSet(
         scene=scene.name, omegas=tuple(float(_number(v.strip(), "--omega"))
                                        for v in args.omega.split(",") if v.strip()))
+    _check_budget(engine, space, vs)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
     for option, path in outputs.items():

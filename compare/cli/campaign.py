@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from compare.cli.options import add_store_args, use_store
+from compare.cli.options import add_store_args, check_output_path, check_run_budget, use_store
 
 # Cost of one engine run [s] before the store has measured any (median of the
 # Fig. 5 threshold runs at the calibrated step on the 2-core target machine).
@@ -30,12 +30,30 @@ def add_parser(subparsers) -> None:
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", metavar="FILE.toml", help="campaign file (see campaigns/paper.toml)")
     p.add_argument("--out", default=None, metavar="DIR",
-                   help="output directory [campaign-<name>]")
+                   help="output directory, replaced whole at the end; refused when it "
+                        "holds files this tool did not write [campaign-<name>]")
     p.add_argument("--workers", type=int, default=None,
                    help="local processes, >= 1 [the file's, else 2]")
     p.add_argument("--estimate", action="store_true",
                    help="print the number of jobs and the expected time; run nothing")
     add_store_args(p, scheduler=True)
+
+
+def check_budget(study, file) -> None:
+    """Refuse a file whose engine runs would exceed the run budget: the longest
+    run of each (engine, step) is at the lowest Omega (the longest pulse)."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+
+    pulse = Pulse(1.0, min(study.omegas))
+    for engine in study.engines:
+        settings = get_backend(engine).Settings()
+        for dt in study.steps:
+            if dt:
+                check_run_budget(engine, dataclasses.replace(settings, dt=dt), pulse,
+                                 option=f"{file}: campaign.steps")
 
 
 def _run_cost(engine: str, dt: float, costs: dict) -> float:
@@ -77,8 +95,9 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     workers = args.workers or study.workers
     out = Path(args.out or f"campaign-{study.name}")
-    if out.is_file():
-        raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
+    if not args.estimate:  # --estimate writes nothing: it leaves the output alone
+        check_output_path(out, "--out", directory=True, replace=True)
+    check_budget(study, args.file)
     store = use_store(args)
     t0 = time.perf_counter()
     # --estimate writes nothing: it leaves the output location (and its lock) alone.
@@ -117,7 +136,7 @@ def distinct(jobs: list) -> tuple[list, list[int]]:
     """The jobs with distinct store keys, and for each job the index of its
     distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
     the scene name is a label)."""
-    from compare.run.store import digest
+    from compare.run.keys import digest
     from compare.campaign.study import threshold_description
 
     seen: dict[str, int] = {}
@@ -147,7 +166,7 @@ def _bar(total: float):
 
 
 def _versions(study) -> dict:
-    from compare.run.store import _engine_version, project_version
+    from compare.run.keys import _engine_version, project_version
     return {"project": project_version(), "analytic-fast": _engine_version("analytic-fast"),
             **{e: _engine_version(e) for e in study.engines}}
 

@@ -1,18 +1,25 @@
 """``trilith``: the command-line front door.
 
 Bad input ends with a one-line ``error: ...`` on stderr naming the option and
-its allowed range, exit code 2 (argparse's convention), never a traceback.
-A closed pipe (``trilith ... --json | head``) ends quietly.
+its allowed range, exit code 2 (argparse's convention), never a traceback; so
+does an output that cannot be written (a full disk, a read-only filesystem, a
+full or closed stdout).  A pipe whose reader went away
+(``trilith ... --json | head``) ends quietly with exit code 1.
 """
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import re
 import sys
 
 from compare.cli import COMMANDS
+
+
+# Errors of a write that found no room or no device.
+_WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 
 
 class UsageError(ValueError):
@@ -54,7 +61,14 @@ def _plain(text: str) -> str:
     return re.sub(r"``([^`]+)``", r"'\1'", text) if text else text
 
 
-class _Parser(argparse.ArgumentParser):
+class _OneLineErrors:
+    """argparse's errors as one ``error:`` line (not the usage block), exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"error: {self.prog}: {message} (see '{self.prog} --help')\n")
+
+
+class _Parser(_OneLineErrors, argparse.ArgumentParser):
     """Subcommand parser: the help formatter above and the -q/-v switches."""
 
     def __init__(self, *args, **kwargs):
@@ -69,8 +83,12 @@ class _Parser(argparse.ArgumentParser):
                            help="also print timings, engine versions and settings")
 
 
+class _TopParser(_OneLineErrors, argparse.ArgumentParser):
+    """The ``trilith`` parser itself."""
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, dict]:
-    parser = argparse.ArgumentParser(
+    parser = _TopParser(
         prog="trilith", formatter_class=HelpFormatter,
         description="Cross-validate PyBullet and Pymunk against the analytic rocking "
                     "model of a trilith with a pendulum mass absorber.")
@@ -89,7 +107,38 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     return parser, modules
 
 
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
+    try:
+        fd = sys.stdout.fileno()
+    except (OSError, ValueError):  # an in-memory stream: nothing to flush at exit
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
+
+
+def _stdout_open() -> bool:
+    """stdout is an open descriptor (``trilith ... >&-`` closes it: then a file the
+    command opens could take descriptor 1 and receive its printout)."""
+    if sys.stdout is None:
+        return False
+    try:
+        fd = sys.stdout.fileno()
+    except (OSError, ValueError):  # an in-memory stream (tests, notebooks)
+        return True
+    try:
+        os.fstat(fd)
+    except OSError:
+        return False
+    return True
+
+
 def main(argv: list[str] | None = None) -> int:
+    if not _stdout_open():
+        print("error: standard output is closed; redirect it to a file or /dev/null",
+              file=sys.stderr)
+        return 2
     parser, modules = build_parser()
     args = parser.parse_args(argv)
     if not args.command:
@@ -107,12 +156,19 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:
-        # The reader went away (| head): stop quietly, as cat and grep do.  Point
-        # stdout at /dev/null so the interpreter's final flush cannot fail again.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
+        # The reader went away (| head): stop quietly, as cat and grep do.
+        _quiet_stdout()
         return 1  # what Python itself does on EPIPE
+    except OSError as exc:  # an output that cannot be written: full disk, read-only
+        where = f"{exc.filename}: " if exc.filename else ""
+        if exc.filename is None and exc.errno in _WRITE_ERRORS:
+            # Every file output names itself (compare.run.atomic): a nameless write
+            # failure is stdout's (e.g. > /dev/full).
+            where = "standard output: "
+            _quiet_stdout()
+        print(f"error: {where}{exc.strerror or exc}; nothing was left half-written",
+              file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         runs = sys.modules.get("compare.run.runs")
         kept = "; finished runs are kept in the run store" if runs and runs.active() else ""
@@ -122,7 +178,9 @@ def main(argv: list[str] | None = None) -> int:
         # A command's run store and scheduler end with it (main() is also called
         # in-process, by tests and scripts).
         if "compare.run.runs" in sys.modules:
-            sys.modules["compare.run.runs"].activate(None)
+            store = sys.modules["compare.run.runs"].activate(None)
+            if store is not None:
+                store.close()
             sys.modules["compare.run.runs"].set_scheduler(None)
 
 

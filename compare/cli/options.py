@@ -20,6 +20,7 @@ from analytic.parameters import Scene
 from scenes import load_scene
 
 from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
+from compare.run.atomic import check_name_length, check_replaceable
 from compare.run.jsonable import plain
 
 SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel_height",
@@ -211,23 +212,52 @@ def resolve_workers(n: int, option: str = "--workers") -> int:
 
 
 def check_output_path(path: str | os.PathLike, option: str, *, directory: bool = False,
-                      suffixes: tuple[str, ...] | None = None) -> Path:
+                      replace: bool = False, suffixes: tuple[str, ...] | None = None) -> Path:
     """Check an output path before any work; returns it as a Path.
 
     A file (``directory=False``): not an existing directory nor a special file,
     its suffix in ``suffixes`` when given, and its parent directory must exist
     (refused otherwise: a typo should not create directories) and be writable.
     A directory (``directory=True``): not an existing file; created with its
-    parents when missing, then checked writable.  Writability is probed by
-    creating a temporary file, which also holds for root on read-only mounts.
+    parents when missing, then checked writable.  Files are written into it and
+    nothing else there is touched, unless ``replace``: then the directory is
+    replaced whole at the end, and refused now unless it is new, empty or one
+    this tool wrote (:func:`compare.run.atomic.check_replaceable`); nothing is
+    created now, its nearest existing ancestor is checked writable.
+    Writability is probed by creating a temporary file, which also holds for
+    root on read-only mounts; names too long for the temporary name beside
+    them are refused.
     """
     text = os.fspath(path)
     if not text.strip():
         raise ValueError(f"{option}: empty path")
+    if "\0" in text:
+        raise ValueError(f"{option}: the path contains a NUL character")
     p = Path(text)
+    try:
+        return _check_output_path(p, text, option, directory, replace, suffixes)
+    except OSError as exc:  # a name too long, a loop of links, a permission
+        raise ValueError(f"{option} {text[:60]!r}: {exc.strerror or exc}") from None
+
+
+def _check_output_path(p: Path, text: str, option: str, directory: bool, replace: bool,
+                       suffixes: tuple[str, ...] | None) -> Path:
     if directory:
         if p.exists() and not p.is_dir():
             raise ValueError(f"{option} must be a directory, but {text!r} is a file")
+        if replace:  # built beside it and swapped in: create nothing now
+            check_replaceable(p, option)
+            ancestor = next(a for a in (p.absolute(), *p.absolute().parents) if a.exists())
+            try:
+                if not ancestor.is_dir():
+                    raise NotADirectoryError(20, f"{str(ancestor)!r} is not a directory")
+                fd, probe = tempfile.mkstemp(prefix=".trilith-probe-", dir=ancestor)
+                os.close(fd)
+                os.unlink(probe)
+            except OSError as exc:
+                raise ValueError(f"{option}: cannot create directory {text!r} "
+                                 f"({exc.strerror or exc})") from None
+            return p
         try:
             p.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -241,6 +271,7 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
         raise ValueError(f"{option}: {text!r} is not a regular file (a FIFO or device)")
     if suffixes is not None and p.suffix.lower() not in suffixes:
         raise ValueError(f"{option} must end in {', '.join(suffixes)}, got {text!r}")
+    check_name_length(p, option, p.suffix)
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         what = "is not a directory" if parent.exists() else "does not exist"
@@ -289,7 +320,8 @@ def check_run_budget(engine: str, settings, excitation, option: str = "--t-max",
         unit = "steps" if getattr(settings, "dt", None) else "samples"
         raise ValueError(f"{option}: a {engine} run of {length:.4g} s at {dt:g} s is "
                          f"{steps:.3g} {unit}, over the budget of {MAX_RUN_STEPS:.0e} "
-                         f"(excitation {excitation.end_time:.4g} s); shorten the run")
+                         f"(excitation {excitation.end_time:.4g} s); shorten the run or use a "
+                         "larger step")
     return steps
 
 
@@ -360,6 +392,8 @@ def use_store(args: argparse.Namespace):
     if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
                                                         "ucx://")) and "://" in address):
         raise ValueError(f"--scheduler must be an address like tcp://host:8786, got {address!r}")
+    if address is not None:
+        runs.check_scheduler(address)  # an address with no scheduler: refused now
     runs.set_scheduler(address)
     runs.STATS.clear()
     store = None if getattr(args, "no_cache", False) else RunStore(

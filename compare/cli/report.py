@@ -2,7 +2,8 @@
 
 ``trilith report [--scene fig5] [--engine pybullet,pymunk] [--quick] [--out DIR]
 [--strict]`` writes ``DIR/index.html`` (self-contained), ``DIR/summary.json``,
-``DIR/summary.md``, ``DIR/trust.csv`` and ``DIR/thresholds.csv``.  ``DIR`` is created (with its parents) when missing.
+``DIR/summary.md``, ``DIR/trust.csv`` and ``DIR/thresholds.csv``.  ``DIR`` is
+created (with its parents) when missing.
 Exit code 0 when the report was written, whatever the verdicts say (they are
 the report's content), unless ``--strict``: then 1 when a verdict fails (for
 CI jobs); 2 on bad input.
@@ -36,7 +37,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--quick", action="store_true",
                    help="smaller grids (< 2 min on 2 cores) instead of the full campaign")
     p.add_argument("--out", default="report", metavar="DIR",
-                   help="output directory, created if missing")
+                   help="output directory, created if missing and replaced whole at the "
+                        "end; refused when it holds files this tool did not write")
     add_workers_arg(p)
     p.add_argument("--dt", type=float, default=None, metavar="S",
                    help=f"override every engine's time step [s], in [{DT_RANGE[0]:g}, "
@@ -50,6 +52,25 @@ def parse_engines(text: str) -> tuple[str, ...]:
     return parse_engine_list(text, ENGINES)
 
 
+def _check_budget(config) -> None:
+    """Refuse before any work an engine run over the run budget: the longest pulse
+    of the campaign (its lowest threshold frequency, or a labelled point's)."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+    from scenes import POINTS
+
+    from compare.cli.options import check_run_budget
+
+    omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
+    for name in config.engines:
+        settings = get_backend(name).Settings()
+        if config.engine_dt is not None:
+            settings = dataclasses.replace(settings, dt=config.engine_dt)
+        check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
+
+
 def run(args: argparse.Namespace) -> int:
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
@@ -59,7 +80,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dt is not None and not (math.isfinite(args.dt)
                                     and DT_RANGE[0] <= args.dt <= DT_RANGE[1]):
         raise ValueError(f"--dt must be in [{DT_RANGE[0]:g}, {DT_RANGE[1]:g}] s, got {args.dt!r}")
-    out = check_output_path(args.out, "--out", directory=True)
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
 
     from compare.run import atomic
 
@@ -70,8 +91,7 @@ def run(args: argparse.Namespace) -> int:
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
-    if Path(args.out).is_file():
-        raise ValueError(f"--out must be a directory, got the file {args.out!r}")
+    _check_budget(config)
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started

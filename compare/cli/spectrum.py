@@ -76,7 +76,7 @@ def _map_fn(scene, settings, workers: int):
     """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
     through the store, on local processes or the ``--scheduler`` cluster."""
     from compare.run import runs
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
 
     description = {"scene": scene_dict(scene), "settings": settings.describe()}
 
@@ -176,6 +176,7 @@ def run(args: argparse.Namespace) -> int:
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
+    _check_engine_budget(args, engines_wanted, omegas)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
                                 map_fn=_map_fn(scene, settings, workers))
@@ -246,6 +247,25 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= 0.01):
         raise ValueError(f"--dt must be in (0, 0.01] s, got {args.dt!r}")
     return names
+
+
+def _check_engine_budget(args, names, omegas) -> None:
+    """Refuse before any work an engine run over the run budget: the longest is at
+    the lowest Omega, at the finest step (``--convergence`` reruns at dt/4)."""
+    import dataclasses
+
+    from analytic.excitation import Pulse
+    from engines import get_backend
+
+    from compare.cli.options import check_run_budget
+
+    for name in names:
+        settings = get_backend(name).Settings()
+        dt = args.dt if args.dt is not None else settings.dt
+        finest = dt / 4 if args.convergence else dt
+        option = "--dt" + (" (with --convergence: dt/4)" if args.convergence else "")
+        check_run_budget(name, dataclasses.replace(settings, dt=finest),
+                         Pulse(1.0, float(min(omegas)), args.pulse), option=option)
 
 
 def _run_engines(args, scene, spec, names, workers: int) -> int:

@@ -38,7 +38,7 @@ def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
     from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
     from compare.run import runs
-    from compare.run.store import scene_dict
+    from compare.run.keys import scene_dict
 
     ss = SpectrumSettings()
     # One stored threshold point per frequency (the run store, issue 12).

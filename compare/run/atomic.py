@@ -12,6 +12,13 @@ syscalls, microseconds) ``<out>`` does not exist; a reader never sees old and
 new files mixed.  A kill in that window leaves the complete old report in
 ``.<name>.old-*`` and the complete new one in ``.<name>.tmp-*``.
 
+Only a directory this tool wrote is ever replaced: each one holds the marker
+file :data:`MARKER`.  An existing ``<out>`` that is neither empty nor marked
+(a user's folder) is refused with one line before any work
+(:func:`check_replaceable`), and checked again just before the swap.  The next
+build of ``<out>`` removes the ``.<name>.tmp-*`` and ``.<name>.old-*`` that
+killed builds left (marked, or empty; never anything else).
+
 :func:`output_lock` takes ``fcntl.flock`` on ``<out>.lock``: a second process
 writing the same output fails at once with a one-line ``ValueError`` instead of
 racing.  The kernel drops the lock when its holder dies, even by SIGKILL.
@@ -25,7 +32,75 @@ import tempfile
 from pathlib import Path
 
 __all__ = ["write_text", "write_bytes", "savefig", "savetxt", "atomic_path",
-           "output_lock", "report_dir"]
+           "output_lock", "report_dir", "check_replaceable", "check_name_length", "MARKER"]
+
+# The file that marks a directory as written (and replaceable) by this tool.
+MARKER = ".trilith-output"
+# Bytes a temporary name adds to an output's name: '.' + '.tmp-' + 8 random ones
+# (tempfile), and a file's suffix on top; the lock file's '.lock' adds fewer.
+_TMP_EXTRA = len(".") + len(".tmp-") + 8
+
+# The exact file sets of report and campaign directories written before the
+# marker existed: replaced like marked ones (a folder of a user's holds other files).
+_UNMARKED_OUTPUTS = ({"index.html", "summary.json", "summary.md"},
+                     {"index.html", "campaign.json"})
+
+
+def check_name_length(path, option: str, suffix: str = "") -> None:
+    """``ValueError`` when the temporary name next to ``path``
+    (``.<name>.tmp-XXXXXXXX<suffix>``) is longer than the filesystem allows."""
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        limit = os.pathconf(parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    need = len(os.fsencode(path.name)) + _TMP_EXTRA + len(os.fsencode(suffix))
+    if need > limit:
+        room = limit - _TMP_EXTRA - len(os.fsencode(suffix))
+        raise ValueError(f"{option}: the name {path.name[:40]!r}... is "
+                         f"{len(os.fsencode(path.name))} bytes; at most {room} here (the "
+                         f"temporary name adds {need - len(os.fsencode(path.name))})")
+
+
+def check_replaceable(out, option: str = "--out") -> None:
+    """``ValueError`` unless ``out`` may be replaced whole: missing, an empty
+    directory, a directory holding :data:`MARKER`, or one holding exactly the
+    files an earlier report or campaign wrote before the marker existed; never
+    the working directory or one of its ancestors, never a file."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"{option} must be a directory, got the file {str(out)!r}")
+    here, target = Path.cwd().resolve(), out.resolve()
+    if target == here or target in here.parents:
+        raise ValueError(f"{option} {str(out)!r} is the working directory or one of its "
+                         "parents; name a directory for the output, e.g. --out report")
+    check_name_length(target, option)
+    if out.is_dir() and not (out / MARKER).is_file():
+        try:
+            names = {p.name for p in out.iterdir() if p.is_file() and not p.is_symlink()}
+            entries = sum(1 for _ in out.iterdir())
+        except OSError as exc:
+            raise ValueError(f"{option} {str(out)!r}: {exc.strerror or exc}") from None
+        if entries and not any(names == set(files) for files in _UNMARKED_OUTPUTS):
+            raise ValueError(f"{option} {str(out)!r} holds files this tool did not write "
+                             f"(no {MARKER} inside) and is not replaced; choose a new or "
+                             "empty directory")
+
+
+def _remove_stale(out: Path) -> None:
+    """Remove the ``.<name>.tmp-*``/``.<name>.old-*`` directories of killed builds
+    of ``out`` (the caller holds its lock, so none is in use): marked or empty."""
+    parent = out.parent
+    for pattern in (f".{out.name}.tmp-*", f".{out.name}.old-*"):
+        for stale in parent.glob(pattern):
+            if stale.is_symlink() or not stale.is_dir():
+                continue
+            if (stale / MARKER).is_file():
+                shutil.rmtree(stale, ignore_errors=True)
+            else:
+                with contextlib.suppress(OSError):
+                    stale.rmdir()  # only when empty
 
 
 @contextlib.contextmanager
@@ -43,9 +118,12 @@ def atomic_path(path, suffix: str = ""):
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs are ordinary files
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.errno is not None:
+            # A writer's failure (a full disk) names the output, not its temporary name.
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
 
 
@@ -107,18 +185,22 @@ def report_dir(out, lock: bool = True):
 
     Takes :func:`output_lock` on ``out`` for the whole build (``lock=False``: the
     caller holds it already, e.g. for a long computation before).  ``ValueError``
-    if ``out`` is an existing file.  On an exception the temporary directory is
-    removed and ``out`` is left as it was.
+    unless :func:`check_replaceable`.  The temporary directory holds
+    :data:`MARKER` from the start.  On an exception it is removed and ``out`` is
+    left as it was.
     """
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out must be a directory, got the file {str(out)!r}")
+    check_replaceable(out)
     parent = out.parent if str(out.parent) else Path(".")
     parent.mkdir(parents=True, exist_ok=True)
     with output_lock(out) if lock else contextlib.nullcontext():
+        _remove_stale(Path(parent) / out.name)
         tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=parent))
         try:
+            (tmp / MARKER).write_text("written by trilith-xval: this directory is replaced "
+                                      "whole by the next run with the same --out\n")
             yield tmp
+            check_replaceable(out)  # a user's files may have appeared meanwhile
             os.chmod(tmp, 0o777 & ~_umask())
             old = None
             if out.exists():

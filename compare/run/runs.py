@@ -24,10 +24,12 @@ import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from compare.run.store import RunStore, digest, project_version, run_key, source_digest
+from compare.run.keys import (CODE_SETS, code_version, digest, project_version, run_code, run_key,
+                              source_digest)
+from compare.run.store import RunStore
 
 __all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
-           "STATS", "stats_line"]
+           "check_scheduler", "STATS", "stats_line"]
 
 _ACTIVE: RunStore | None = None
 # Default Dask scheduler of run_many (the CLI's --scheduler); None: local processes.
@@ -40,6 +42,13 @@ STATS: Counter = Counter()
 UNSTORED = frozenset({"analytic-fast"})
 # Polling period of the parent's wait: Ctrl-C is acted on within it.
 _POLL_S = 0.2
+# A Dask scheduler answers a handshake in milliseconds; 15 s covers a loaded
+# network.  Past it the address is reported as not being a scheduler.
+CONNECT_TIMEOUT_S = 15.0
+# How long a cluster may have no worker (none yet, or all gone) before the run is
+# stopped with an error: a worker starts in ~2-5 s, a batch system queue may
+# take longer, so a minute.
+NO_WORKERS_TIMEOUT_S = 60.0
 
 
 def activate(store: RunStore | None) -> RunStore | None:
@@ -94,14 +103,14 @@ def simulate(name: str, scene, excitation, settings=None):
     t0 = time.perf_counter()
     traj = backend.simulate(scene, excitation, settings)
     store.put(key, traj, kind="run", label=_label(name, resolved),
-              cost=time.perf_counter() - t0)
+              cost=time.perf_counter() - t0, code=run_code(name))
     STATS["computed"] += 1
     return traj
 
 
-MODEL_CODE = ("analytic", "engines")
+MODEL_CODE = CODE_SETS[1]
 # Results computed by compare/ itself (campaign jobs, chosen frequencies).
-ALL_CODE = ("analytic", "engines", "compare")
+ALL_CODE = CODE_SETS[2]
 
 
 def memo_key(kind: str, description: dict, code: tuple = MODEL_CODE) -> str:
@@ -134,7 +143,8 @@ def memo(kind: str, description: dict, compute, label: str = "",
         return value
     t0 = time.perf_counter()
     value = compute()
-    store.put(key, value, kind=kind, label=label or kind, cost=time.perf_counter() - t0)
+    store.put(key, value, kind=kind, label=label or kind, cost=time.perf_counter() - t0,
+              code=code_version(code))
     STATS["computed"] += 1
     return value
 
@@ -215,6 +225,8 @@ def run_many(fn, items, *, workers: int = 1, scheduler: str | None = None,
         return
     scheduler = _SCHEDULER if scheduler is None else scheduler
     store_dir = str(_ACTIVE.directory) if _ACTIVE is not None else None
+    if _ACTIVE is not None and (scheduler is not None or (workers > 1 and len(items) > 1)):
+        _ACTIVE.create()  # workers will store results: none of them creates the store
     payloads = [(fn, item, store_dir) for item in items]
     if scheduler is not None:
         yield from _run_dask(payloads, scheduler, on_done)
@@ -255,17 +267,64 @@ def _run_local(payloads, workers: int, on_done):
                                                  return_when=FIRST_COMPLETED))
 
 
+def _connect(address: str):
+    """A Dask client of ``address``; ``ValueError`` when no scheduler answers within
+    :data:`CONNECT_TIMEOUT_S` (something else listening there can hold a
+    connection open without ever answering, so the wait is bounded here)."""
+    import threading
+
+    from distributed import Client
+
+    box: dict = {}
+
+    def connect():
+        try:
+            box["client"] = Client(address, timeout=f"{CONNECT_TIMEOUT_S:g}s")
+        except Exception as exc:  # noqa: BLE001 - reported below as one line
+            box["error"] = exc
+
+    thread = threading.Thread(target=connect, daemon=True)
+    thread.start()
+    thread.join(CONNECT_TIMEOUT_S + 5.0)
+    if "client" in box:
+        return box["client"]
+    why = (f"{type(box['error']).__name__}: {box['error']}" if "error" in box
+           else f"no answer within {CONNECT_TIMEOUT_S:g} s")
+    raise ValueError(f"--scheduler: no Dask scheduler at {address!r} ({why})")
+
+
+def check_scheduler(address: str) -> None:
+    """``ValueError`` unless a Dask scheduler answers at ``address`` (see :func:`_connect`)."""
+    _connect(address).close()
+
+
+class NoWorkers(ValueError):
+    """The cluster had no worker for :data:`NO_WORKERS_TIMEOUT_S`."""
+
+
 def _run_dask(payloads, address: str, on_done):
     try:
-        from distributed import Client, wait as dwait
+        from distributed import wait as dwait
     except ImportError:  # pragma: no cover - dask[distributed] is a dependency
         raise ValueError("--scheduler needs dask[distributed] installed") from None
-    try:
-        client = Client(address, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise ValueError(f"--scheduler: cannot reach a Dask scheduler at {address!r} "
-                         f"({exc})") from None
+    client = _connect(address)
     futures = []
+    # Since when the cluster has had no worker (None: it has some).
+    idle = {"since": None, "checked": 0.0}
+
+    def check_workers():
+        now = time.monotonic()
+        if now - idle["checked"] < 1.0:
+            return
+        idle["checked"] = now
+        if client.nthreads():
+            idle["since"] = None
+        elif idle["since"] is None:
+            idle["since"] = now
+        elif now - idle["since"] > NO_WORKERS_TIMEOUT_S:
+            raise NoWorkers(f"--scheduler {address!r}: the cluster has had no worker for "
+                            f"{NO_WORKERS_TIMEOUT_S:g} s; start some (dask worker "
+                            f"{address}) and rerun: finished runs are in the store")
     try:
         # pure=False: every payload is a task of its own (no deduplication by hash).
         futures = [client.submit(_call, p, pure=False, priority=-i)
@@ -280,9 +339,12 @@ def _run_dask(payloads, address: str, on_done):
 
         def poll_safe(pending):
             try:
-                return poll(pending)
+                done, pending = poll(pending)
             except TimeoutError:  # nothing finished within the poll period
-                return set(), pending
+                done = set()
+            if not done:
+                check_workers()
+            return done, pending
         yield from _ordered(futures, lambda f: f.result(), on_done, poll_safe)
     finally:
         if futures:

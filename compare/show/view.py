@@ -50,9 +50,14 @@ def _configured_backend() -> str | None:
     return value if isinstance(value, str) else None
 
 
-def record_hint(scene_name: str, engine: str, amplitude: float, omega: float) -> str:
-    return (f"trilith record --scene {scene_name} --engine {engine} --amplitude {amplitude:g} "
-            f"--omega {omega:g} --out run.gif")
+def record_hint(scene_name: str, engine: str, excitation) -> str:
+    """The ``trilith record`` command that shows the same run in a file (a record
+    is named by its file name: its path is the user's own)."""
+    if hasattr(excitation, "amplitude"):
+        what = f"--amplitude {excitation.amplitude:g} --omega {excitation.omega:g}"
+    else:
+        what = f"--record {getattr(excitation, 'label', 'FILE')}"
+    return f"trilith record --scene {scene_name} --engine {engine} {what} --out run.gif"
 
 
 def _pybullet_gui(scene: Scene, excitation, duration: float) -> bool:
@@ -94,10 +99,8 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
         if backend.lower() in NON_INTERACTIVE_BACKENDS:
             problem = f"matplotlib found no GUI toolkit (backend {backend!r})"
     if problem is not None:
-        amplitude = getattr(excitation, "amplitude", 0.0)
-        omega = getattr(excitation, "omega", 0.0)
         raise ValueError(f"cannot open a window: {problem}. Record the run to a file "
-                         f"instead: {record_hint(scene_arg or scene.name, engine, amplitude, omega)}")
+                         f"instead: {record_hint(scene_arg or scene.name, engine, excitation)}")
     for name in names:
         load_backend(name)
     span = settings.duration if settings.duration is not None else default_duration(excitation)
