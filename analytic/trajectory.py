@@ -187,14 +187,16 @@ class Trajectory:
         """The result part of ``trilith simulate --json``.
 
         ``engine`` names the backend (the key every JSON document uses); wall
-        times (``wall_time``, and the engines' ``diagnostics['wall_time']``) sit
-        in the last key, ``timings``, so that everything before it is identical
-        between reruns.
+        and CPU times (``wall_time``, and the engines' ``diagnostics['wall_time']``
+        and ``['cpu_time']``) sit in the last key, ``timings``, so that
+        everything before it is identical between reruns.
         """
         diagnostics = dict(self.diagnostics)
         timings = {"wall_time": self.wall_time}
         if "wall_time" in diagnostics:
             timings["engine_wall_time"] = diagnostics.pop("wall_time")
+        if "cpu_time" in diagnostics:
+            timings["engine_cpu_time"] = diagnostics.pop("cpu_time")
         return {
             "engine": self.backend,
             "status": self.verdict.status,

@@ -39,8 +39,8 @@ def _jobs(fig5):
 
 def test_dask_results_equal_local_results(cluster, fig5):
     jobs = _jobs(fig5)
-    local = [out for out, _ in runs.run_many(_run_one, jobs, workers=2)]
-    remote = [out for out, _ in runs.run_many(_run_one, jobs,
+    local = [out for out, *_ in runs.run_many(_run_one, jobs, workers=2)]
+    remote = [out for out, *_ in runs.run_many(_run_one, jobs,
                                                scheduler=cluster.scheduler_address)]
     assert len(remote) == len(jobs)
     for a, b in zip(local, remote):
@@ -51,11 +51,11 @@ def test_dask_workers_fill_the_callers_store(cluster, fig5, tmp_path):
     jobs = _jobs(fig5)
     store = RunStore(tmp_path)
     with runs.using(store):
-        remote = [out for out, _ in runs.run_many(_run_one, jobs,
+        remote = [out for out, *_ in runs.run_many(_run_one, jobs,
                                                    scheduler=cluster.scheduler_address)]
         assert store.count("run") == len(jobs)  # stored by the workers
         runs.STATS.clear()
-        again = [out for out, _ in runs.run_many(_run_one, jobs, workers=1)]
+        again = [out for out, *_ in runs.run_many(_run_one, jobs, workers=1)]
         assert runs.STATS["hits"] == len(jobs) and runs.STATS["computed"] == 0
     for a, b in zip(remote, again):
         assert_same_trajectory(a, b)  # what the cluster computed, bit for bit

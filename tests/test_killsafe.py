@@ -100,9 +100,11 @@ def _cleanup(proc: subprocess.Popen) -> None:
 
 
 def _strip(obj):
-    """campaign.json without its timings (the only numbers a rerun may change)."""
+    """campaign.json without its costs (the only numbers a rerun may change: wall and
+    CPU seconds, and whether the run store served a row)."""
     if isinstance(obj, dict):
-        return {k: _strip(v) for k, v in obj.items() if k != "wall_time"}
+        return {k: _strip(v) for k, v in obj.items()
+                if k not in ("wall_time", "cpu_s", "cpu_s_spent", "from_store")}
     if isinstance(obj, list):
         return [_strip(v) for v in obj]
     return obj

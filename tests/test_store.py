@@ -46,7 +46,7 @@ def same(x, y) -> bool:
 
 
 # Timings of a run (its cost, not its result): the only things a new run changes.
-TIMINGS = ("wall_time",)
+TIMINGS = ("wall_time", "cpu_time")
 
 
 def assert_same_trajectory(a, b, timings: bool = True) -> None:

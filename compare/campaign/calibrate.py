@@ -197,7 +197,7 @@ def _thresholds(engine, scene, vs: ValidationSet, options, workers):
     errors, runs = [], 0
     for curve, points in es.curves.items():
         for p in points:
-            runs += p.runs
+            runs += p.n_runs
             if p.cause == "model":  # the model cannot judge the engine there
                 continue
             errors.append((f"{curve} Omega {p.omega:g}", abs(p.rel_error)))

@@ -167,6 +167,7 @@ class ThresholdResult:
     rel_tol: float | None = None
     probes: tuple = ()  # Probe
     cpu_per_sim_s: float | None = None
+    flips: tuple = ()  # Probe: perturbed runs that flipped an end's verdict
     raw: Mapping = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -189,7 +190,8 @@ class ThresholdResult:
                    _tuple(d.get("validity"), Validity), tuple(d.get("convergence") or ()),
                    int(d.get("n_runs") or 0), num(d.get("cpu_s")), num(d.get("cpu_s_spent")),
                    bool(d.get("from_store")), num(d.get("rel_tol")),
-                   _tuple(d.get("probes"), Probe), num(d.get("cpu_per_sim_s")), d)
+                   _tuple(d.get("probes"), Probe), num(d.get("cpu_per_sim_s")),
+                   _tuple(d.get("flips"), Probe), d)
 
 
 @dataclass(frozen=True)

@@ -203,7 +203,7 @@ def _run_one(item):
     def compute():  # stored with its CPU cost, so a store hit can say what it cost
         t0 = time.process_time()
         value = _JOBS[kind](*args)
-        return {"value": value, "cpu_s": time.process_time() - t0}
+        return {"value": value, "cpu_s": _own_cost(value, time.process_time() - t0)}
     try:  # through the store: a finished job is not redone (compare/ code in its key)
         hits = runs.STATS["hits"]
         out = runs.memo("campaign-job", _job_description(item), compute, code=runs.ALL_CODE)
@@ -211,6 +211,19 @@ def _run_one(item):
         return out["value"], out["cpu_s"], time.process_time() - c0, stored
     except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
         return _JobError(f"{type(exc).__name__}: {exc}"), 0.0, time.process_time() - c0, False
+
+
+def _own_cost(value, spent: float) -> float:
+    """CPU seconds a job's result cost when its engine runs were computed: the
+    result's own record (a threshold point's probes, a run's ``cpu_time``, a long
+    run's row) where it has one, since runs served by the store cost nothing now;
+    else ``spent``."""
+    own = getattr(value, "cpu_s", None)
+    if own is None and hasattr(value, "diagnostics"):
+        own = (value.diagnostics or {}).get("cpu_time")
+    if own is None and isinstance(value, dict):
+        own = value.get("cpu_s")
+    return float(own) if own is not None and math.isfinite(float(own)) else spent
 
 
 def _job_description(item) -> dict:

@@ -207,7 +207,8 @@ def write_campaign(doc: dict, out: Path) -> None:
                                          for c in cols) + "</tr>" for r in rows)
         return f"<table><tr>{head}</tr>{body}</table>"
     cols = ["scene", "case", "pulse", "omega", "engine", "dt", "a_reference", "a_engine",
-            "rel_error", "mode_reference", "mode_engine", "n_runs", "error"]
+            "rel_error", "rel_resolution", "cause", "valid", "mode_reference", "mode_engine",
+            "n_runs", "cpu_s", "from_store", "error"]
     study = doc["study"]
     page = ("<!DOCTYPE html><html><head><meta charset='utf-8'><title>campaign "
             f"{html.escape(study['name'])}</title><style>body{{font-family:sans-serif}}"

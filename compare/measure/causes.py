@@ -34,7 +34,8 @@ Candidates (all evaluated; ``causes`` lists every one that applies):
     diagnostic farthest beyond its noise level is named).
 ``sensitivity``
     a perturbation of :data:`compare.measure.thresholds.PERTURBATIONS` flipped a
-    verdict at the bracket's ends (the point has ``isolated`` overturns).
+    verdict at the bracket's ends (``isolated`` overturns, or ``flips``: e.g. a
+    tilted twin that collapsed).
 
 Primary rule: the first applying cause in :data:`PRIMARY_ORDER`: the model before
 any engine (no engine is blamed where the model is invalid), then a collapse of
@@ -56,7 +57,7 @@ from engines import configure, supports
 from compare.measure.thresholds import SEARCH, Search, ThresholdPoint, engine_threshold
 
 __all__ = ["Classification", "classify", "model_validity", "model_jump", "model_island",
-           "explain_isolated", "PRIMARY_ORDER", "JUMP_REL"]
+           "explain_isolated", "sensitivity_detail", "PRIMARY_ORDER", "JUMP_REL"]
 
 PRIMARY_ORDER = ("model", "collapse", "no-bracket", "window", "jump", "discretisation",
                  "iterations", "contact", "sensitivity")
@@ -233,6 +234,18 @@ def explain_isolated(engine, scene, omega, iso: dict, settings, kind) -> str:
             f"{100 * worst.rel_error:+.2g} % off {eq} (worst of {len(rows)})")
 
 
+def sensitivity_detail(point: ThresholdPoint) -> str:
+    """The isolated overturns and the perturbed runs that flipped an end's verdict."""
+    parts = []
+    if point.isolated:
+        parts.append(f"{len(point.isolated)} isolated overturn(s) at A = "
+                     + ", ".join(f"{i['amplitude']:.6g}" for i in point.isolated))
+    if point.flips:
+        parts.append("perturbed runs at the ends: " + ", ".join(
+            f"{p.perturbation} at {p.amplitude:.6g} {p.status}" for p in point.flips))
+    return "; ".join(parts)
+
+
 def _depart(point: ThresholdPoint) -> float:
     """Where the engine leaves the model: its first overturn or first collapse."""
     collapsed = [p.amplitude for p in point.probes
@@ -268,9 +281,8 @@ def classify(engine: str, scene, omega: float, point: ThresholdPoint, settings, 
         jump = model_jump(scene, omega, kind, point.a_engine, tol)
         if jump:
             causes["jump"] = jump
-    if point.isolated:
-        causes["sensitivity"] = (f"{len(point.isolated)} isolated overturn(s) at A = "
-                                 + ", ".join(f"{i['amplitude']:.6g}" for i in point.isolated))
+    if point.isolated or point.flips:
+        causes["sensitivity"] = sensitivity_detail(point)
     collapsed = [p.amplitude for p in point.probes if p.status == "collapsed"
                  and not p.perturbation and p.amplitude < (point.a_engine if point.bracketed
                                                            else math.inf)]

@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 
 from engines import configure
 
-from compare.measure.causes import PRIMARY_ORDER, classify, explain_isolated, model_validity
+from compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
+                                    sensitivity_detail)
 from compare.measure.thresholds import SEARCH, ThresholdPoint, engine_threshold
 
 __all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "measure_point",
@@ -131,8 +132,8 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
                                   {"model threshold": a_reference, "engine survives":
                                    p.a_survives, "engine overturns": p.a_engine},
                                   settings.friction)
-        causes = ((({"name": "sensitivity", "detail": f"{len(p.isolated)} isolated "
-                     "overturn(s), not the threshold"},) if p.isolated else ()))
+        causes = (({"name": "sensitivity", "detail": sensitivity_detail(p)},)
+                  if p.isolated or p.flips else ())
         return EnginePoint(case, p, "agrees", f"within {100 * tol:g} %", causes,
                            validity[0]["valid"], tuple(validity), (), isolated)
     c = classify(engine, scene, omega, p, settings, kind=kind, tol=tol, search=search,

@@ -103,7 +103,8 @@ def render_trust(doc: dict) -> str:
             f"{'pend.' if p['case'] == 'pendulum' else 'no pend.'} Ω {p['omega']:g}: "
             f"{_pct(p['rel_error'])}, {p['cause']} [{', '.join(p['causes'])}]"
             for p in thr["failing"]) or "none"
-        iso = "; ".join(f"Ω {p['omega']:g}: {p['n_isolated']}" for p in thr["isolated"]) or "none"
+        iso = "; ".join(f"{'pend.' if p['case'] == 'pendulum' else 'no pend.'} Ω {p['omega']:g}: "
+                        f"{p['n_isolated']}" for p in thr["isolated"]) or "none"
         lr = row.get("long_run")
         longs = "not measured" if lr is None else (
             f"{'pass' if lr['passed'] else 'FAIL'}: {lr['detail']}")

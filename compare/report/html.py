@@ -33,7 +33,7 @@ from scenes import POINTS
 
 from compare.run.jsonable import plain as clean_nan
 from compare.measure.trajectories import _plain
-from compare.report.trust import trust_table
+from compare.report.trust import AGREEMENT_RULE, trust_table
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict", "add_model_validity",
            "SCHEMA_VERSION"]
@@ -72,6 +72,7 @@ def render_markdown(doc: dict) -> str:
     parts += [f"{_headline(doc)}.", "## Recommendation",
               "\n".join(f"- {r}" for r in recommendations(doc)),
               "## Which engine to trust", tables.table(header, rows, md=True),
+              AGREEMENT_RULE,
               *(f"- {r['conclusion']}" for r in doc["trust"].values()),
               "## Verdicts", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc), md=True),
               "## Overturning thresholds (away from mode jumps)",
@@ -148,6 +149,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
              "end. Download: " + _download("trust.csv", tables.csv_text(header, rows)) + ", "
              + _download("thresholds.csv", tables.threshold_csv(doc)) + ".</p>",
+             f"<p class='small'>{esc(AGREEMENT_RULE)}</p>",
              *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> "
                f"{unbroken(esc(r['conclusion']))}</p>" for r in doc["trust"].values()),
              "<h2>Verdicts</h2>", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc)),
