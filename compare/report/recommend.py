@@ -12,7 +12,9 @@ what a user computes:
 * **restitution without the pendulum** (Eq. 20) and **with it** (Eq. 19 at the
   measured psi);
 * **time histories** (the paper's verdicts at A-D and theta(t) before the first
-  impact).
+  impact);
+* **long runs** (tens of seconds at rest and after a pulse: the pivots must not
+  creep).
 
 Engines not recommended are named with the number that excludes them, so the
 line is checked against the tables below it, never typed.
@@ -113,7 +115,10 @@ def recommendations(doc: dict) -> list[str]:
                           "restitution_eq20", off),
              _verdict_use(trust, "Restitution with the pendulum (Eq. 19)",
                           "restitution_eq19", lambda v, row: off(v, row) + _worst_lam(doc, row)),
-             _histories(trust)]
+             _histories(trust),
+             _verdict_use(trust, "Long runs (rest, and rocking after a pulse)", "long_run",
+                          lambda v, row: f"pivots slid {1e3 * v['value']:.2g} mm, tolerance "
+                                         f"{1e3 * v['tolerance']:.2g} mm")]
     return [line for line in lines if line]
 
 
