@@ -107,14 +107,28 @@ class Spectrum:
             "wall_time": self.wall_time,
         }
 
-    def to_csv(self, path) -> None:
-        with open(path, "w") as fh:
-            fh.write("omega,a_no_pendulum,a_pendulum,gain_percent,mode_no_pendulum,"
-                     "mode_pendulum\n")
-            for i, w in enumerate(self.omega):
-                fh.write(f"{w:.12g},{self.a_no_pendulum[i]:.12g},{self.a_pendulum[i]:.12g},"
-                         f"{self.gain_percent[i]:.12g},{self.mode_no_pendulum[i] or ''},"
-                         f"{self.mode_pendulum[i] or ''}\n")
+    def to_csv(self, path, validity: dict | None = None) -> None:
+        """One row per frequency; with ``validity``
+        (:func:`analytic.threshold_validity.spectrum_validity`) also each curve's
+        ``model_valid`` (empty: not checked) and the reason when it is not."""
+        import csv
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh, lineterminator="\n")
+            head = ["omega", "a_no_pendulum", "a_pendulum", "gain_percent", "mode_no_pendulum",
+                    "mode_pendulum"]
+            if validity:
+                head += ["model_valid_no_pendulum", "model_valid_pendulum",
+                         "model_reason_no_pendulum", "model_reason_pendulum"]
+            w.writerow(head)
+            for i, om in enumerate(self.omega):
+                row = [f"{om:.12g}", f"{self.a_no_pendulum[i]:.12g}",
+                       f"{self.a_pendulum[i]:.12g}", f"{self.gain_percent[i]:.12g}",
+                       self.mode_no_pendulum[i] or "", self.mode_pendulum[i] or ""]
+                if validity:
+                    vs = [validity[c][i] for c in ("no_pendulum", "pendulum")]
+                    row += ["" if v["model_valid"] is None else v["model_valid"] for v in vs]
+                    row += [v["model_reason"] for v in vs]
+                w.writerow(row)
 
 
 # --- worker side: module globals set before the fork --------------------------------

@@ -182,3 +182,70 @@ def test_real_quick_report_in_the_browser(tmp_path):
         assert_not_blank(screenshot(out / "index.html", size, tmp_path), size)
     w = widths(out / "index.html", PHONE, tmp_path)
     assert w["inner"] == PHONE[0] and w["scroll"] <= w["client"], w
+
+
+# Words split across lines inside table cells ("PyBulle|t", "4.4e-|4"): each word
+# of each text node in a table is a DOM Range; a word laid out on one line has one
+# client rectangle.  The count is drawn as a red bar (4 px per split word, plus 2 px
+# that show the script ran) and read back from a screenshot, as for BARS (only a
+# screenshot lays the page out at 390 px).
+SPLIT_WORDS = """<div id='probe-split' style='position:fixed;top:0;left:0;z-index:2147483647'></div>
+<script>
+(function () {
+  function count() {
+    var n = 0, walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+    while (walker.nextNode()) {
+      var node = walker.currentNode;
+      if (!node.parentElement.closest('td,th')) continue;
+      var re = /\\S+/g, m;
+      while ((m = re.exec(node.data)) !== null) {
+        var r = document.createRange();
+        r.setStart(node, m.index); r.setEnd(node, m.index + m[0].length);
+        var tops = {};
+        Array.prototype.forEach.call(r.getClientRects(), function (q) {
+          if (q.width > 0) tops[Math.round(q.top)] = 1; });
+        if (Object.keys(tops).length > 1) n += 1;
+      }
+    }
+    return n;
+  }
+  function draw() {
+    document.getElementById('probe-split').innerHTML =
+      "<div style='height:6px;width:" + (2 + 4 * count()) + "px;background:#ff0000'></div>";
+  }
+  addEventListener('load', draw); setTimeout(draw, 500);
+})();
+</script>"""
+
+
+def split_words(html_path: Path, size: tuple[int, int], tmp_path: Path) -> int:
+    """How many words in table cells are broken across lines at ``size``."""
+    page = tmp_path / f"split-{size[0]}.html"
+    page.write_text(html_path.read_text(encoding="utf-8").replace("</body>",
+                                                                  SPLIT_WORDS + "</body>"),
+                    encoding="utf-8")
+    png = tmp_path / f"split-{size[0]}.png"
+    chromium(page.as_uri(), size, tmp_path, "--force-device-scale-factor=1",
+             "--virtual-time-budget=3000", f"--screenshot={png}")
+    with Image.open(png) as im:
+        line = np.asarray(im.convert("RGB"), dtype=int)[3]
+    red = int(((line[:, 0] > 200) & (line[:, 1] < 60) & (line[:, 2] < 60)).sum())
+    assert red >= 2, "the split-word probe did not run"
+    return (red - 2) // 4
+
+
+@pytest.mark.parametrize("size", [LAPTOP, PHONE], ids=["1400px", "390px"])
+def test_no_word_is_split_across_lines(synthetic_report, size, tmp_path):
+    """Engine names, ids, numbers with their exponent ("4.4e-4") and hyphenated
+    modes ("after-impact") stay whole at laptop and phone width."""
+    assert split_words(synthetic_report, size, tmp_path) == 0
+
+
+def test_the_split_word_probe_detects_a_split(tmp_path):
+    """Control: a 40 px column that may break anywhere splits 'PyBullet'."""
+    page = tmp_path / "split.html"
+    page.write_text("<!DOCTYPE html><html><head><meta name='viewport' "
+                    "content='width=device-width'></head><body><table><tr>"
+                    "<td style='width:40px;max-width:40px;overflow-wrap:anywhere'>PyBullet "
+                    "MuJoCoMuJoCo</td></tr></table></body></html>")
+    assert split_words(page, LAPTOP, tmp_path) >= 1

@@ -183,3 +183,36 @@ def test_settings_validation():
     with pytest.raises(ValueError, match="omega_stop"):
         FigureSettings(omega_start=10.0, omega_stop=5.0)
     assert math.isfinite(FigureSettings().omega_step)
+
+
+def test_quick_output_is_marked_quick(quick_run):
+    from compare.report.figures import QUICK_MARK
+
+    _, _, doc = quick_run
+    assert doc["quick"] is True and doc["settings"]["quick"] is True
+    for fig in doc["figures"].values():
+        assert QUICK_MARK in fig["caption"]
+
+
+def test_pdf_embeds_truetype_fonts(fig5_spectra, tmp_path):
+    path = tmp_path / "fig5.pdf"
+    plot_figure(FIGURES[0], fig5_spectra, path, dpi=300)
+    data = path.read_bytes()
+    assert b"/Type3" not in data  # Type 3 bitmap-like fonts: refused by journals
+    assert b"/TrueType" in data or b"/CIDFontType2" in data
+
+
+def test_every_panel_carries_the_models_validity(quick_run):
+    """Per frequency and curve; the Fig. 5 trilith at Omega = 30 rad/s (4.8 Hz), where
+    the threshold is near 98 m/s^2 (10 g), throws its lintel off: invalid there."""
+    _, _, doc = quick_run
+    n = len(doc["omega"])
+    for fig in doc["figures"].values():
+        for panel in fig["panels"]:
+            for curve in ("pendulum", "no_pendulum"):
+                assert len(panel["model_validity"][curve]) == n
+    fig5 = doc["figures"]["fig5"]["panels"][0]
+    last = fig5["model_validity"]["pendulum"][-1]
+    assert doc["omega"][-1] == 30.0 and last["model_valid"] is False
+    assert "thrown off" in last["model_reason"] or "hop" in last["model_reason"]
+    assert fig5["model_validity"]["pendulum"][0]["model_valid"] is True  # 3 rad/s: gentle

@@ -171,8 +171,10 @@ def test_missing_cause_reads_not_measured():
 def test_html_first_screen_provenance_and_layout(synthetic):
     _, doc, out = synthetic
     html = (out / "index.html").read_text(encoding="utf-8")
-    # The trust table comes before any evidence; settings are folded away at the end.
-    assert html.index("Trust table") < html.index("Verdicts") < html.index("<details>")
+    # The recommendation and the trust table come before any evidence; the scene and
+    # configuration are folded away at the end.
+    assert (html.index("Recommendation") < html.index("Trust table") < html.index("Verdicts")
+            < html.index("Engine settings") < html.index("<details><summary>Scene"))
     assert "QUICK RUN" in html and doc["quick"] is True
     assert "name='viewport'" in html and "max-width:100%" in html
     assert html.count("class='scroll'") >= 5  # every table scrolls inside its own box
@@ -185,8 +187,10 @@ def test_html_first_screen_provenance_and_layout(synthetic):
     for key in ("date", "commit", "command", "versions", "machine"):
         assert prov[key]
     assert {"python", "numpy", "scipy", "pybullet", "pymunk"} <= set(prov["versions"])
-    # Percentages where the tolerance is a percentage.
-    assert "≤ 0.5 %" in html and "within 2 %" in html
+    # Percentages where the tolerance is a percentage (a no-break space keeps the
+    # number on the line of its unit).
+    text = html.replace("\u00a0", " ")
+    assert "≤ 0.5 %" in text and "within 2 %" in text
 
 
 def test_command_line_is_recorded(tmp_path, monkeypatch):
@@ -196,3 +200,89 @@ def test_command_line_is_recorded(tmp_path, monkeypatch):
 
     args = argparse.Namespace(command="report", scene="fig5", quick=True, out="x y", dt=None)
     assert command_line(args) == "trilith report --scene fig5 --quick --out 'x y'"
+
+
+def test_errors_print_at_the_bracket_resolution():
+    from compare.report import units
+
+    # Both thresholds are ends of 0.2 % brackets: a difference inside one is no number.
+    assert units.rel_error(-1.12e-14, 0.002) == "|e| ≤ 0.2 %"
+    assert units.rel_error(0.0, 0.001875) == "|e| ≤ 0.19 %"
+    assert units.rel_error(-0.03, 0.002) == "-3.0 %"
+    assert units.rel_error(None) == "not bracketed"
+    assert units.accel(9.80665) == "9.81 m/s² (1 g)"
+    assert units.freq(2 * 3.141592653589793) == "6.28 rad/s (1 Hz)"
+
+
+def test_recommendation_names_the_excluded_engine_with_its_number(synthetic):
+    from compare.report.recommend import recommendations
+
+    _, doc, out = synthetic
+    lines = recommendations(doc)
+    thresholds = next(line for line in lines if line.startswith("Overturning thresholds"))
+    # Synthetic PyBullet misses a threshold by -6.6 % (cause contact): not recommended.
+    assert "Pymunk at dt = 1e-4 s" in thresholds
+    first = doc["trust"]["pybullet"]["thresholds"]["first_disagreement"]
+    assert (f"not PyBullet (-6.6 % at Ω = {first['omega']:g} rad/s, engine contact broke)"
+            in thresholds)
+    eq19 = next(line for line in lines if line.startswith("Restitution with the pendulum"))
+    assert "not PyBullet (off by 0.6 %" in eq19
+    assert "Recommendation" in (out / "index.html").read_text(encoding="utf-8")
+
+
+def test_csv_exports_match_the_tables(synthetic):
+    import csv
+
+    from compare.report import tables
+
+    _, doc, out = synthetic
+    rows = list(csv.DictReader((out / "thresholds.csv").open()))
+    n_points = sum(len(p) for s in doc["spectra"].values() for p in s["engines"].values())
+    assert len(rows) == n_points
+    for r in rows:
+        a_ref, a_eng = float(r["a_model_m_s2"]), float(r["a_engine_m_s2"])
+        assert float(r["rel_error"]) == pytest.approx(a_eng / a_ref - 1.0, abs=1e-9)
+        assert float(r["f_hz"]) == pytest.approx(float(r["omega_rad_s"]) / (2 * 3.141592653589793))
+    trust = list(csv.reader((out / "trust.csv").open()))
+    header, table_rows = tables.trust_rows(doc)
+    assert trust[0] == header and len(trust) == 1 + len(table_rows)
+    # The page itself carries both as downloads (one self-contained file).
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "download='thresholds.csv'" in html and "download='trust.csv'" in html
+
+
+def test_an_engine_is_not_blamed_where_the_model_is_invalid(synthetic):
+    import copy
+
+    from compare.report import tables
+
+    _, doc, _ = synthetic
+    doc = copy.deepcopy(doc)
+    pts = [p for spec in doc["spectra"].values() for p in spec["engines"]["pybullet"]]
+    bad = next(p for p in pts if abs(p["rel_error"]) > 0.02)
+    bad["cause"], bad["cause_detail"] = "model", "at A = 60 m/s^2: lintel would be thrown off"
+    rows = tables.threshold_rows(doc)
+    row = next(r for r in rows if r[1] == "PyBullet" and r[2].startswith(f"{bad['omega']:g} "))
+    error, valid = row[5], row[7]
+    assert error["ok"] is None  # not coloured as a failure
+    assert valid["text"].startswith("no (engine not blamed)")
+    # The same point left with another cause stays a failure.
+    bad["cause"] = "contact"
+    row = next(r for r in tables.threshold_rows(doc)
+               if r[1] == "PyBullet" and r[2].startswith(f"{bad['omega']:g} "))
+    assert row[5]["ok"] is False
+
+
+def test_model_validity_is_in_the_summary_and_shaded(synthetic):
+    _, doc, _ = synthetic
+    for case, spec in doc["spectra"].items():
+        assert len(spec["model_validity"]) == len(spec["omega"])
+        assert {v["model_valid"] for v in spec["model_validity"]} <= {True, False, None}
+
+
+def test_settings_are_a_table_not_a_repr(synthetic):
+    _, doc, out = synthetic
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "<h2>Engine settings</h2>" in html
+    assert "{'" not in html and '{"' not in html  # no dict printed as Python or JSON
+    assert "solver iterations" in html

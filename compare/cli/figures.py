@@ -25,7 +25,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--format", default="png", choices=FORMATS, metavar="FMT",
                         help=f"output format: {', '.join(FORMATS)}")
     parser.add_argument("--quick", action="store_true",
-                        help="5 frequencies and coarser tolerances: a smoke run in seconds")
+                        help="7 frequencies and coarser tolerances: a smoke run, marked QUICK in "
+                             "every caption and in figures.json")
     return parser
 
 
@@ -40,6 +41,13 @@ def run(args: argparse.Namespace) -> int:
                        dpi=args.dpi, fmt=args.format)
     for name, fig in doc["figures"].items():
         print(f"{args.out}/{fig['file']}: {fig['caption']}")
+    n_invalid = sum(v["model_valid"] is False for fig in doc["figures"].values()
+                    for p in fig["panels"] for curve in p["model_validity"].values()
+                    for v in curve)
+    if n_invalid:
+        info(f"note: {n_invalid} threshold point(s) where the model is invalid (a contact "
+             f"would pull or the bob meets a column) are hatched; see model_validity in "
+             f"figures.json")
     info(f"{args.out}/figures.json: {doc['n_spectra']} spectra, {len(doc['omega'])} "
          f"frequencies each, {doc['n_runs']} runs ({doc['n_undecided']} undecided) "
          f"in {doc['wall_time']:.1f} s")

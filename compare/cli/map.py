@@ -86,9 +86,29 @@ class _EngineRun:
                              settings).verdict
 
 
-def plot_maps(maps, path) -> None:
+def _hatch_invalid(ax, first, validity) -> None:
+    """Hatch, above the first-overturning curve, the frequencies where the model
+    is invalid on that curve's run (checked there only: the cells above it are
+    not checked one by one)."""
+    import numpy as np
+
+    from analytic.threshold_validity import invalid_spans
+
+    w, a = np.asarray(first.omega, float), np.asarray(first.first, float)
+    top = float(np.max(first.amplitude))
+    for k, (lo, hi) in enumerate(invalid_spans(w, [v["model_valid"] for v in validity])):
+        xs = np.concatenate(([lo], w[(w > lo) & (w < hi)], [hi]))
+        ys = np.interp(xs, w[np.isfinite(a)], a[np.isfinite(a)])
+        ax.fill_between(xs, ys, top, facecolor="none", edgecolor="tab:red", hatch="///",
+                        lw=0, zorder=2,
+                        label="model invalid at the first overturning" if k == 0 else None)
+
+
+def plot_maps(maps, path, validity=None) -> None:
     """One panel per map: cells coloured by label, the analytic first-overturning
-    curve (black line) on every panel."""
+    curve (black line) on every panel and, above it, the frequencies where the
+    model is invalid on that curve's run hatched (``validity``: one
+    :func:`analytic.threshold_validity.point_validity` per frequency)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -110,6 +130,8 @@ def plot_maps(maps, path) -> None:
         ax.pcolormesh(m.omega, m.amplitude, m.cells, cmap=ListedColormap(cols),
                       vmin=-0.5, vmax=len(cols) - 0.5, shading="nearest")
         ax.plot(first.omega, first.first, "k-", lw=1.2, label="first overturning (analytic)")
+        if validity:
+            _hatch_invalid(ax, first, validity)
         present = [i for i, n in enumerate(np.bincount(m.cells.ravel(),
                                                        minlength=len(m.labels))) if n]
         handles = [Patch(facecolor=cols[i], edgecolor="k", label=m.labels[i]) for i in present]
@@ -127,7 +149,7 @@ def plot_maps(maps, path) -> None:
             getattr(ax, set_)(min(lo for lo, _ in lims), max(hi for _, hi in lims))
     fig.tight_layout()
     from compare.run.atomic import savefig
-    savefig(fig, path, dpi=120)
+    savefig(fig, path, dpi=150)
     plt.close(fig)
 
 
@@ -160,15 +182,25 @@ def run(args: argparse.Namespace) -> int:
         maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
                                 *eng_grid,
                                 backend=name, pulse=args.pulse, workers=workers))
+    from analytic.threshold_validity import curve_validity
+    validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)
+    valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
+
+    def valid_text(w):
+        v = valid_at.get(round(float(w), 9))
+        return "" if v is None else str(v)
+
     if args.csv:
         from compare.run.atomic import write_text
-        rows = ["backend,omega,amplitude,verdict"] + [
-            f"{m.backend},{w:.12g},{a:.12g},{lab}" for m in maps for w, a, lab in m.csv_rows()]
+        rows = ["backend,omega,amplitude,verdict,model_valid_at_first_overturning"] + [
+            f"{m.backend},{w:.12g},{a:.12g},{lab},{valid_text(w)}"
+            for m in maps for w, a, lab in m.csv_rows()]
         write_text(args.csv, "\n".join(rows) + "\n")
     if args.plot:
-        plot_maps(maps, args.plot)
+        plot_maps(maps, args.plot, validity)
     if args.json:
-        print_json(clean_nan({"maps": [m.to_dict() for m in maps]}))
+        first = {**maps[0].to_dict(), "model_validity_first_overturning": validity}
+        print_json(clean_nan({"maps": [first] + [m.to_dict() for m in maps[1:]]}))
         return 0
     for m in maps:
         print(f"{m.backend}: scene {scene.name}, {m.pulse} pulse, {m.omega.size} frequencies x "
@@ -176,6 +208,10 @@ def run(args: argparse.Namespace) -> int:
         for lab, n in m.counts().items():
             if n:
                 print(f"  {lab:>26}: {n}")
+    bad = [float(w) for w, v in zip(maps[0].omega, validity) if v["model_valid"] is False]
+    if bad:
+        print(f"note: the model is invalid at the first overturning for {len(bad)} "
+              f"frequencies (Omega {min(bad):g} to {max(bad):g} rad/s; hatched in --plot)")
     first = maps[0].first
     n_miss = int(sum(1 for a in first if not math.isfinite(a)))
     if n_miss:

@@ -1,8 +1,9 @@
 """``trilith report``: run the validation campaign and write the report.
 
 ``trilith report [--scene fig5] [--engine pybullet,pymunk] [--quick] [--out DIR]
-[--strict]`` writes ``DIR/index.html`` (self-contained), ``DIR/summary.json``
-and ``DIR/summary.md``.  ``DIR`` is created (with its parents) when missing.
+[--strict]`` writes ``DIR/index.html`` (self-contained), ``DIR/summary.json``,
+``DIR/summary.md``, ``DIR/trust.csv`` and ``DIR/thresholds.csv``.  ``DIR`` is
+created (with its parents) when missing.
 Exit code 0 when the report was written, whatever the verdicts say (they are
 the report's content), unless ``--strict``: then 1 when a verdict fails (for
 CI jobs); 2 on bad input.

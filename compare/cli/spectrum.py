@@ -120,19 +120,30 @@ def _settings(args: argparse.Namespace):
     return SpectrumSettings(**kw)
 
 
-def plot_spectrum(spec, path) -> None:
-    """Fig. 5 layout: both curves on top (dashed = without pendulum), Delta below."""
+def plot_spectrum(spec, path, validity: dict | None = None) -> None:
+    """Fig. 5 layout: both curves on top (dashed = without pendulum), Delta below;
+    the frequencies where the model is invalid on a curve's threshold run
+    (``validity``: :func:`analytic.threshold_validity.spectrum_validity`) hatched."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from compare.report.figures import shade_validity
+
     fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.4),
                                    gridspec_kw={"height_ratios": [2, 1]})
+    for ax in (ax1, ax2):
+        shade_validity(ax, spec, validity, label=ax is ax1)
     ax1.plot(spec.omega, spec.a_pendulum, "k-", label="with pendulum")
     ax1.plot(spec.omega, spec.a_no_pendulum, "k--", label="without pendulum")
-    for jump in spec.mode_jumps():
-        ax1.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0)
+    for k, jump in enumerate(spec.mode_jumps()):
+        ax1.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0,
+                    label="mode jump" if k == 0 else None)
     ax1.set_ylabel(r"overturning amplitude $A_s$ [m/s$^2$]")
+    ax1.secondary_yaxis("right", functions=(lambda a: a / 9.80665,
+                                            lambda a: a * 9.80665)).set_ylabel("[g]")
+    ax1.secondary_xaxis("top", functions=(lambda w: w / (2 * math.pi),
+                                          lambda f: f * 2 * math.pi)).set_xlabel("f [Hz]")
     sc = spec.scene
     ax1.set_title(f"{spec.settings.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
                   f"gamma={sc.gamma:g}, mu={sc.mu:g}; {spec.criterion.kind}, "
@@ -144,8 +155,17 @@ def plot_spectrum(spec, path) -> None:
     ax2.set_ylabel(r"gain $\Delta$ [%]")
     fig.tight_layout()
     from compare.run.atomic import savefig
-    savefig(fig, path, dpi=120)
+    savefig(fig, path, dpi=150)
     plt.close(fig)
+
+
+def _valid_text(validity: dict, i: int) -> str:
+    """'yes', 'no' (both curves), 'no (np)' / 'no (yp)' (one), '-' (unchecked)."""
+    v = {c: validity[c][i]["model_valid"] for c in ("no_pendulum", "pendulum")}
+    if None in v.values():
+        return "-"
+    bad = [short for c, short in (("no_pendulum", "np"), ("pendulum", "yp")) if not v[c]]
+    return "yes" if not bad else ("no" if len(bad) == 2 else f"no ({bad[0]})")
 
 
 def _number(value: float, width: int) -> str:
@@ -176,13 +196,15 @@ def run(args: argparse.Namespace) -> int:
                                 map_fn=_map_fn(scene, settings, workers))
     if engines_wanted:
         return _run_engines(args, scene, spec, engines_wanted, workers)
+    from analytic.threshold_validity import spectrum_validity
+    validity = spectrum_validity(spec, workers=workers)
     if args.csv is not None:
         with atomic.atomic_path(args.csv) as tmp:
-            spec.to_csv(tmp)
+            spec.to_csv(tmp, validity)
     if args.plot is not None:
-        plot_spectrum(spec, args.plot)
+        plot_spectrum(spec, args.plot, validity)
     if args.json:
-        body = spec.to_dict()
+        body = {**spec.to_dict(), "model_validity": validity}
         timings = {"wall_time": body.pop("wall_time"), "workers": workers}
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
@@ -195,16 +217,24 @@ def run(args: argparse.Namespace) -> int:
           f"{settings.criterion.kind}, t_max = {settings.t_max}, tol = {settings.tol:g} m/s^2, "
           f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)")
     print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13} {'A_yp [m/s^2]':>12} "
-          f"{'mode_yp':>13} {'Delta [%]':>9}")
+          f"{'mode_yp':>13} {'Delta [%]':>9}  model valid")
     gain = spec.gain_percent
     for i, w in enumerate(spec.omega):
         print(f"{w:13.4g} {_number(spec.a_no_pendulum[i], 12)} "
               f"{spec.mode_no_pendulum[i] or '-':>13} {_number(spec.a_pendulum[i], 12)} "
-              f"{spec.mode_pendulum[i] or '-':>13} {_number(gain[i], 9)}")
+              f"{spec.mode_pendulum[i] or '-':>13} {_number(gain[i], 9)}  "
+              f"{_valid_text(validity, i)}")
     for jump in spec.mode_jumps():
         print(f"mode jump ({jump['curve']}): {jump['mode_before']} at Omega = "
               f"{jump['omega_before']:g} rad/s -> {jump['mode_after']} at "
               f"{jump['omega_after']:g} rad/s")
+    invalid = [float(w) for i, w in enumerate(spec.omega) if _valid_text(validity, i) != "yes"
+               and _valid_text(validity, i) != "-"]
+    if invalid:
+        info(f"warning: the model is invalid on the threshold run at {len(invalid)} "
+             f"frequencies (Omega {min(invalid):g} to {max(invalid):g} rad/s): a contact would "
+             f"pull or the bob meets a column; those thresholds are the model's, not a "
+             f"trilith's (model_reason in --json/--csv)")
     missing = int(sum(1 for a in list(spec.a_no_pendulum) + list(spec.a_pendulum)
                       if not math.isfinite(a)))
     if missing:

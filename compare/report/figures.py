@@ -18,7 +18,11 @@ Layouts follow the captions:
 
 Mode jumps (a change between 'after-impact' and 'no-impact' overturning between
 two neighbouring frequencies, Section 5.2, the paper's dashed circles) are
-marked by dashed circles between the two points.
+marked by dashed circles between the two points.  Frequencies where the model
+itself is invalid on its threshold run (a contact would pull, or the bob would
+meet a column: :mod:`analytic.threshold_validity`) are hatched, and every
+panel's JSON carries the per-point validity of both curves.  A ``--quick`` run
+says so in every caption and in ``figures.json``.
 """
 from __future__ import annotations
 
@@ -32,13 +36,14 @@ from pathlib import Path
 import numpy as np
 
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
+from analytic.threshold_validity import invalid_spans, spectrum_validity
 from compare.run import atomic
 from compare.run.jsonable import plain as clean_nan
 from scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",
            "plot_figure", "make_figures", "omega_grid", "quick_settings", "figure_size",
-           "check_output_options", "plain_text",
+           "check_output_options", "plain_text", "QUICK_MARK", "shade_validity",
            "FORMATS", "DEFAULT_DPI"]
 
 from compare.report.figure_options import DEFAULT_DPI, FORMATS, check_output_options  # noqa: F401
@@ -57,6 +62,8 @@ class FigureSettings:
     omega_step: float = 0.5
     # Scan/bisection settings shared by every spectrum (defaults of analytic.spectrum).
     spectrum: SpectrumSettings = field(default_factory=SpectrumSettings)
+    # A smoke run (quick_settings): its captions and JSON say so.
+    quick: bool = False
 
     def __post_init__(self) -> None:
         for name in ("omega_start", "omega_stop", "omega_step"):
@@ -81,7 +88,8 @@ def quick_settings() -> FigureSettings:
     # paper's gain range.  tol/scan steps 5x coarser: the scan to ~100 m/s^2
     # dominates the cost.
     return FigureSettings(omega_step=4.5,
-                          spectrum=SpectrumSettings(tol=0.05, scan_step=0.5, scan_rel_step=0.1))
+                          spectrum=SpectrumSettings(tol=0.05, scan_step=0.5, scan_rel_step=0.1),
+                          quick=True)
 
 
 def omega_grid(fs: FigureSettings) -> np.ndarray:
@@ -200,7 +208,24 @@ def compute_spectra(fs: FigureSettings, workers: int = 1, progress: bool = False
 
 
 # --- plotting -------------------------------------------------------------------------
-def _draw_spectrum(ax, sp: Spectrum, legend: bool) -> None:
+QUICK_MARK = "QUICK (coarse grid, not the paper's figure)"
+
+
+def shade_validity(ax, sp: Spectrum, validity: dict | None, label: bool = True) -> None:
+    """Hatch the frequencies where either curve's model is invalid on its
+    threshold run (``/``: with the pendulum, ``\\``: without)."""
+    if not validity:
+        return
+    for curve, hatch, text in (("pendulum", "///", "model invalid (with pendulum)"),
+                               ("no_pendulum", "\\\\", "model invalid (without)")):
+        spans = invalid_spans(sp.omega, [v["model_valid"] for v in validity[curve]])
+        for k, (lo, hi) in enumerate(spans):
+            ax.axvspan(lo, hi, facecolor="none", edgecolor="0.55", hatch=hatch, lw=0,
+                       zorder=0, label=text if (label and k == 0) else None)
+
+
+def _draw_spectrum(ax, sp: Spectrum, legend: bool, validity: dict | None = None) -> None:
+    shade_validity(ax, sp, validity)
     ax.plot(sp.omega, sp.a_no_pendulum, "k--", lw=1.0, label="without pendulum")
     ax.plot(sp.omega, sp.a_pendulum, "k-", lw=1.2, label="with pendulum")
     curves = {"no_pendulum": sp.a_no_pendulum, "pendulum": sp.a_pendulum}
@@ -227,29 +252,37 @@ def figure_size(spec: FigureSpec) -> tuple[float, float]:
 
 
 def plot_figure(spec: FigureSpec, spectra: dict[tuple, Spectrum], path: Path,
-                dpi: int = DEFAULT_DPI) -> None:
+                dpi: int = DEFAULT_DPI, validity: dict | None = None,
+                quick: bool = False) -> None:
     """Draw one figure of :data:`FIGURES` from computed ``spectra`` into ``path``;
-    the format (PNG, PDF or SVG) follows the suffix, ``dpi`` sets the raster
-    resolution (and the PNG's pixel size, :func:`figure_size` x ``dpi``)."""
+    the format (PNG, PDF or SVG, fonts embedded as TrueType) follows the suffix,
+    ``dpi`` sets the raster resolution (and the PNG's pixel size,
+    :func:`figure_size` x ``dpi``).  ``validity``: ``{key: spectrum_validity}``
+    (hatched where invalid); ``quick`` puts :data:`QUICK_MARK` in the caption."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     with plt.rc_context(_RC):
-        _draw_figure(plt, spec, spectra, path, dpi)
+        _draw_figure(plt, spec, spectra, path, dpi, validity or {}, quick)
 
 
-# Type sizes for a figure printed at its own size (7 pt text, 6 pt ticks).
+# Type sizes for a figure printed at its own size (7 pt text, 6 pt ticks); fonts
+# embedded as TrueType (Type 42) in PDF and PostScript: Type 3 fonts are refused
+# by journals and render poorly in some viewers.
 _RC = {"font.size": 7, "axes.titlesize": 7, "axes.labelsize": 7, "xtick.labelsize": 6,
-       "ytick.labelsize": 6, "legend.fontsize": 6, "lines.markersize": 3}
+       "ytick.labelsize": 6, "legend.fontsize": 6, "lines.markersize": 3,
+       "pdf.fonttype": 42, "ps.fonttype": 42, "hatch.linewidth": 0.5}
 
 
-def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int) -> None:
+def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int,
+                 validity: dict, quick: bool) -> None:
     if spec.name == "fig5":
         sp = spectra[_key(spec.panels[0])]
         fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=figure_size(spec),
                                        gridspec_kw={"height_ratios": [2, 1]})
-        _draw_spectrum(ax1, sp, legend=True)
+        _draw_spectrum(ax1, sp, legend=True, validity=validity.get(_key(spec.panels[0])))
+        shade_validity(ax2, sp, validity.get(_key(spec.panels[0])), label=False)
         ax1.set_ylabel(r"$A_s$ [m/s$^2$]")
         ax1.set_title("(a) overturning spectrum")
         ax2.plot(sp.omega, sp.gain_percent, "k-", lw=1.2)
@@ -262,13 +295,15 @@ def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int) -> 
                                  figsize=figure_size(spec))
         for k, panel in enumerate(spec.panels):
             ax = axes[panel.row][panel.col]
-            _draw_spectrum(ax, spectra[_key(panel)], legend=(k == 0))
+            _draw_spectrum(ax, spectra[_key(panel)], legend=(k == 0),
+                           validity=validity.get(_key(panel)))
             ax.set_title(panel.title)
             if panel.row == spec.nrows - 1:
                 ax.set_xlabel(r"$\Omega$ [rad/s]")
             if panel.col == 0:
                 ax.set_ylabel(r"$A_s$ [m/s$^2$]")
-    fig.suptitle(spec.caption, fontsize=8)
+    fig.suptitle(spec.caption + (f"\n{QUICK_MARK}" if quick else ""), fontsize=8,
+                 color="tab:red" if quick else "k")
     fig.tight_layout()
     atomic.savefig(fig, path, dpi=dpi, format=Path(path).suffix.lstrip(".").lower() or "png")
     plt.close(fig)
@@ -297,8 +332,10 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     Returns
     -------
     dict
-        The JSON document (NaN as None): per figure its caption and panels, each
-        panel with its scene name, pulse and the spectrum's ``to_dict()``.
+        The JSON document (NaN as None): ``quick``, per figure its caption and
+        panels, each panel with its scene name, pulse, the spectrum's
+        ``to_dict()`` and ``model_validity`` (both curves, one
+        :func:`analytic.threshold_validity.point_validity` per frequency).
     """
     fs = FigureSettings() if fs is None else fs
     check_output_options(dpi, fmt)
@@ -309,17 +346,19 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
         raise ValueError(f"out_dir (--out) must be a directory, {str(out)!r} is a file")
     t0 = time.perf_counter()
     spectra = compute_spectra(fs, workers=workers, progress=progress)
+    validity = {key: spectrum_validity(sp, workers=workers) for key, sp in spectra.items()}
     out.mkdir(parents=True, exist_ok=True)
-    doc = {"settings": fs.describe(), "omega": omega_grid(fs).tolist(), "figures": {},
-           "dpi": dpi, "format": fmt}
+    doc = {"quick": fs.quick, "settings": fs.describe(), "omega": omega_grid(fs).tolist(),
+           "figures": {}, "dpi": dpi, "format": fmt}
     for spec in FIGURES:
         path = out / f"{spec.name}.{fmt}"
-        plot_figure(spec, spectra, path, dpi)
+        plot_figure(spec, spectra, path, dpi, validity, fs.quick)
         doc["figures"][spec.name] = {
-            "caption": plain_text(spec.caption), "file": path.name,
+            "caption": plain_text(spec.caption) + (f" [{QUICK_MARK}]" if fs.quick else ""),
+            "file": path.name,
             "panels": [{"scene": p.scene, "pulse": p.pulse, "title": plain_text(p.title),
-                        "row": p.row,
-                        "col": p.col, "spectrum": spectra[_key(p)].to_dict()}
+                        "row": p.row, "col": p.col, "spectrum": spectra[_key(p)].to_dict(),
+                        "model_validity": validity[_key(p)]}
                        for p in spec.panels]}
     doc["n_spectra"] = len(spectra)
     doc["n_runs"] = int(sum(s.n_runs for s in spectra.values()))

@@ -4,17 +4,23 @@ Each plot puts the engines on the analytic reference *and* shows the error
 explicitly in its own panel, so agreement is read off a scale rather than
 guessed from overlapping curves:
 
-* :func:`spectra_figure`: engine threshold points on the reference spectra; below,
-  relative error vs Omega with the tolerance band and the mode jumps marked.
+* :func:`spectra_figures`: engine threshold points on the reference spectrum, one
+  figure per case; below, relative error vs Omega with the tolerance band, the
+  mode jumps marked and the frequencies where the model is invalid hatched.
 * :func:`convergence_figure`: relative error vs time step for the points that
   failed (when the campaign measured a step-convergence study).
-* :func:`history_figure`: theta/alpha at one of the paper's points; below,
-  ``|theta_engine - theta_model| / alpha`` vs time, first impact marked.
-* :func:`restitution_figure`: relative error of every impact against Eq. 20/19.
+* :func:`history_figures`: theta/alpha at one of the paper's points, one figure
+  per case; below, ``|theta_engine - theta_model| / alpha`` vs time.
+* :func:`restitution_figures`: relative error of every impact against Eq. 20/19.
+
+Sizes: one case per figure, 5 in wide at :data:`DPI` (1000 px); the page sets
+two side by side in its 1100 px column (text about 13 px on screen) and one
+above the other on a phone (about 9 px at 390 px).
 """
 from __future__ import annotations
 
 import base64
+import functools
 import io
 import math
 
@@ -25,11 +31,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
+from analytic.threshold_validity import invalid_spans  # noqa: E402
 from compare.report.trust import label  # noqa: E402
 
-__all__ = ["spectra_figure", "convergence_figure", "history_figure", "restitution_figure",
-           "color", "marker", "DPI"]
-
+__all__ = ["spectra_figures", "convergence_figure", "history_figures", "restitution_figures",
+           "shade_invalid", "color", "marker", "DPI", "WIDTH"]
 
 
 def color(name: str) -> str | None:
@@ -49,9 +55,22 @@ def _style(name: str, attr: str, default):
     except ValueError:
         return default
 
-# 100 dpi on figures 7 in wide: 700 px, sharp on a laptop, scaled down on a phone.
-DPI = 100
+
+DPI = 200  # 5 in -> 1000 px: sharp at the page's 540 px per figure on a 2x screen
+WIDTH = 5.0  # in
+# 9 pt text at 200 dpi is 25 px in the PNG: ~13 px shown at 540 px, ~9 px on a phone.
+_RC = {"font.size": 9, "axes.titlesize": 9.5, "axes.labelsize": 9, "xtick.labelsize": 8.5,
+       "ytick.labelsize": 8.5, "legend.fontsize": 8.5, "legend.frameon": False}
 _CASES = {"pendulum": "with pendulum", "no_pendulum": "without pendulum"}
+
+
+def _styled(fn):
+    """Draw under the report's type sizes."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        with plt.rc_context(_RC):
+            return fn(*args, **kwargs)
+    return wrapper
 
 
 def _png(fig) -> str:
@@ -71,52 +90,74 @@ def _jump_omegas(spec: dict) -> list[float]:
     return ws + ([tip] if tip is not None else [])
 
 
-def spectra_figure(doc: dict) -> str | None:
-    """Engine thresholds on the reference spectra (top) and their relative error
-    [%] against Omega with the +-tolerance band (bottom), one column per case."""
-    cases = [c for c in ("pendulum", "no_pendulum") if c in doc.get("spectra", {})]
-    if not cases:
-        return None
+def shade_invalid(axes, omega, valid, label_it: bool = True) -> bool:
+    """Hatch the frequencies where the model is invalid on its threshold run
+    (``valid`` False; None: not checked) on every axis of ``axes``; True when
+    something was shaded."""
+    spans = invalid_spans(omega, valid)
+    for k, (lo, hi) in enumerate(spans):
+        for j, ax in enumerate(axes):
+            ax.axvspan(lo, hi, facecolor="0.88", edgecolor="0.6", hatch="///", lw=0, zorder=0,
+                       label="model invalid" if (label_it and k == 0 and j == 0) else None)
+    return bool(spans)
+
+
+@_styled
+def _spectrum_case(doc: dict, case: str) -> str:
+    spec = doc["spectra"][case]
     tol = 100.0 * doc["config"]["tolerances"]["threshold"]
-    fig, axes = plt.subplots(2, len(cases), figsize=(3.6 * len(cases), 4.6), squeeze=False,
-                             sharex="col", gridspec_kw={"height_ratios": [2, 1.2]})
-    for col, case in enumerate(cases):
-        spec = doc["spectra"][case]
-        top, bot = axes[0, col], axes[1, col]
-        w, a = _arr(spec["omega"]), _arr(spec["a"])
-        for jp in spec.get("jumps", []):  # no line across a jump: the curve is discontinuous
-            i = int(np.searchsorted(w, jp["omega_hi"]))
-            w, a = np.insert(w, i, np.nan), np.insert(a, i, np.nan)
-        top.plot(w, a, "k-", lw=1.0, label="model")
-        bot.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0,
-                    label=f"±{tol:g} % tolerance")
-        bot.axhline(0.0, color="0.5", lw=0.6)
-        for name, pts in spec.get("engines", {}).items():
-            style = dict(color=color(name), marker=marker(name), ls="none",
-                         mfc="none", ms=5)
-            top.plot([p["omega"] for p in pts], _arr([p["a_engine"] for p in pts]),
-                     label=label(name), **style)
-            bot.plot([p["omega"] for p in pts],
-                     100.0 * _arr([p["rel_error"] for p in pts]), **style)
-        for k, wj in enumerate(_jump_omegas(spec)):
-            for ax in (top, bot):
-                ax.axvline(wj, color="tab:red", lw=0.7, ls=":",
-                           label="mode jump" if (k == 0 and ax is top) else None)
-        top.set_title(_CASES.get(case, case), fontsize=9)
-        top.set_ylabel("first overturning A [m/s²]", fontsize=8)
-        bot.set_ylabel("engine / model − 1 [%]", fontsize=8)
-        bot.set_xlabel("Ω [rad/s]", fontsize=8)
-        lim = max([2.0 * tol] + [abs(v) * 1.2 for v in
-                                 100.0 * _arr([p["rel_error"] for pts in
-                                               spec.get("engines", {}).values() for p in pts])
-                                 if math.isfinite(v)])
-        bot.set_ylim(-lim, lim)
+    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
+                                   gridspec_kw={"height_ratios": [2, 1.2]})
+    w, a = _arr(spec["omega"]), _arr(spec["a"])
+    validity = spec.get("model_validity")
+    if validity:
+        shade_invalid((top, bot), w, [v.get("model_valid") for v in validity])
+    for jp in spec.get("jumps", []):  # no line across a jump: the curve is discontinuous
+        i = int(np.searchsorted(w, jp["omega_hi"]))
+        w, a = np.insert(w, i, np.nan), np.insert(a, i, np.nan)
+    top.plot(w, a, "k-", lw=1.0, label="model")
+    bot.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
+    bot.axhline(0.0, color="0.5", lw=0.6)
+    for name, pts in spec.get("engines", {}).items():
+        style = dict(color=color(name), marker=marker(name), ls="none",
+                     mfc="none", ms=6)
+        top.plot([p["omega"] for p in pts], _arr([p["a_engine"] for p in pts]),
+                 label=label(name), **style)
+        bot.plot([p["omega"] for p in pts], 100.0 * _arr([p["rel_error"] for p in pts]), **style)
+    for k, wj in enumerate(_jump_omegas(spec)):
         for ax in (top, bot):
-            ax.tick_params(labelsize=7)
-        top.legend(fontsize=7, frameon=False)
-    axes[1, 0].legend(fontsize=7, frameon=False, loc="lower left")
+            ax.axvline(wj, color="tab:red", lw=0.8, ls=":",
+                       label="mode jump" if (k == 0 and ax is top) else None)
+    top.set_title(_CASES.get(case, case), loc="left")
+    top.set_ylabel("first overturning A [m/s²]")
+    g_axis = top.secondary_yaxis("right", functions=(lambda x: x / 9.80665,
+                                                     lambda x: x * 9.80665))
+    g_axis.set_ylabel("[g]")
+    bot.set_ylabel("engine / model − 1 [%]")
+    bot.set_xlabel("Ω [rad/s]")
+    hz = top.secondary_xaxis("top", functions=(lambda x: x / (2 * math.pi),
+                                               lambda x: x * 2 * math.pi))
+    hz.set_xlabel("f = Ω/2π [Hz]")
+    lim = max([2.0 * tol] + [abs(v) * 1.2 for v in
+                             100.0 * _arr([p["rel_error"] for pts in
+                                           spec.get("engines", {}).values() for p in pts])
+                             if math.isfinite(v)])
+    bot.set_ylim(-lim, lim)
+    # One legend, on the spectrum's empty upper left: the error panel's points
+    # can lie anywhere in it.
+    handles, labels = top.get_legend_handles_labels()
+    extra = bot.get_legend_handles_labels()
+    top.legend(handles + extra[0], labels + extra[1], loc="upper left")
     fig.tight_layout()
     return _png(fig)
+
+
+def spectra_figures(doc: dict) -> list[tuple[str, str]]:
+    """``[(case, png)]``: engine thresholds on the reference spectrum (top) and
+    their relative error [%] against Omega with the +-tolerance band (bottom),
+    one figure per case (with, then without pendulum)."""
+    return [(case, _spectrum_case(doc, case)) for case in ("pendulum", "no_pendulum")
+            if case in doc.get("spectra", {})]
 
 
 def _convergence(point: dict) -> tuple[np.ndarray, np.ndarray] | None:
@@ -133,6 +174,7 @@ def _convergence(point: dict) -> tuple[np.ndarray, np.ndarray] | None:
     return (np.array(dts), np.array(errs)) if dts else None
 
 
+@_styled
 def convergence_figure(doc: dict) -> str | None:
     """Relative threshold error against the engine time step for every point
     that carries a step-convergence study (a flat line away from zero: the
@@ -147,7 +189,7 @@ def convergence_figure(doc: dict) -> str | None:
     if not series:
         return None
     tol = 100.0 * doc["config"]["tolerances"]["threshold"]
-    fig, ax = plt.subplots(figsize=(5.0, 3.2))
+    fig, ax = plt.subplots(figsize=(WIDTH, 3.4))
     ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
     ax.axhline(0.0, color="0.5", lw=0.6)
     for name, case, p, (dt, err) in series:
@@ -155,10 +197,9 @@ def convergence_figure(doc: dict) -> str | None:
         ax.semilogx(dt[order], 100.0 * err[order], marker=marker(name),
                     color=color(name), lw=0.9, ms=4,
                     label=f"{label(name)}, Ω = {p['omega']:g} ({_CASES.get(case, case)})")
-    ax.set_xlabel("engine time step dt [s]", fontsize=8)
-    ax.set_ylabel("engine / model − 1 [%]", fontsize=8)
-    ax.tick_params(labelsize=7)
-    ax.legend(fontsize=6, frameon=False)
+    ax.set_xlabel("engine time step dt [s]")
+    ax.set_ylabel("engine / model − 1 [%]")
+    ax.legend()
     fig.tight_layout()
     return _png(fig)
 
@@ -176,83 +217,85 @@ def _error_vs_time(ref, traj, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     return grid, err
 
 
-def history_figure(histories: dict, point: str, alphas: dict, reference: str,
-                   title: str) -> str | None:
+@_styled
+def _history_case(histories: dict, point: str, pend: bool, alpha: float, reference: str,
+                  title: str) -> str:
+    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 4.6), sharex=True,
+                                   gridspec_kw={"height_ratios": [1.5, 1]})
+    ref = histories.get((point, pend, reference))
+    for (pt, p, name), traj in sorted(histories.items(), key=lambda kv: str(kv[0])):
+        if pt != point or p != pend:
+            continue
+        is_ref = name == reference
+        top.plot(traj.t, traj.theta / alpha, color=color(name), lw=1.5 if is_ref else 1.0,
+                 ls="-" if is_ref else "--", label=label(name), zorder=1 if is_ref else 2)
+        if ref is not None and not is_ref:
+            grid, err = _error_vs_time(ref, traj, alpha)
+            if grid.size:
+                bot.semilogy(grid, np.maximum(err, 1e-7), color=color(name), lw=0.9,
+                             label=label(name))
+    if ref is not None and ref.impacts:
+        for ax in (top, bot):
+            ax.axvline(ref.impacts[0].t, color="0.4", lw=0.7, ls=":")
+        top.annotate("1st impact", (ref.impacts[0].t, 1.6), color="0.3",
+                     xytext=(2, 0), textcoords="offset points")
+    for y in (-1.0, 1.0):
+        top.axhline(y, color="0.75", lw=0.5)
+    top.set_ylim(-2.0, 2.0)
+    top.set_title(f"{title}, {'with' if pend else 'without'} pendulum")
+    top.set_ylabel("θ / α")
+    bot.set_ylabel("|θ − θ_model| / α")
+    bot.set_xlabel("t [s]")
+    bot.set_ylim(1e-7, 10.0)
+    top.legend(loc="lower left", ncol=2)
+    fig.tight_layout()
+    return _png(fig)
+
+
+def history_figures(histories: dict, point: str, alphas: dict, reference: str,
+                    title: str) -> list[str]:
     """theta/alpha of every backend at ``point`` (top) and the engines' error
-    ``|theta - theta_model|/alpha`` on a log scale (bottom); one column per case.
+    ``|theta - theta_model|/alpha`` on a log scale (bottom); one figure per case
+    (with, then without pendulum).
 
     ``histories``: ``(point, pendulum, backend) -> Trajectory``; ``alphas``:
     ``pendulum -> alpha`` [rad].  The model's first impact is a dotted line:
     before it the error measures the integration, after it the impact model.
     """
     cases = sorted({p for (pt, p, _) in histories if pt == point}, reverse=True)
-    if not cases:
-        return None
-    fig, axes = plt.subplots(2, len(cases), figsize=(3.6 * len(cases), 4.4), squeeze=False,
-                             sharex="col", gridspec_kw={"height_ratios": [1.5, 1]})
-    for col, pend in enumerate(cases):
-        top, bot = axes[0, col], axes[1, col]
-        alpha = alphas[pend]
-        ref = histories.get((point, pend, reference))
-        for (pt, p, name), traj in sorted(histories.items(), key=lambda kv: str(kv[0])):
-            if pt != point or p != pend:
-                continue
-            is_ref = name == reference
-            top.plot(traj.t, traj.theta / alpha, color=color(name), lw=1.4 if is_ref else 0.9,
-                     ls="-" if is_ref else "--", label=label(name), zorder=1 if is_ref else 2)
-            if ref is not None and not is_ref:
-                grid, err = _error_vs_time(ref, traj, alpha)
-                if grid.size:
-                    bot.semilogy(grid, np.maximum(err, 1e-7), color=color(name), lw=0.8,
-                                 label=label(name))
-        if ref is not None and ref.impacts:
-            for ax in (top, bot):
-                ax.axvline(ref.impacts[0].t, color="0.4", lw=0.7, ls=":")
-            top.annotate("1st impact", (ref.impacts[0].t, 1.6), fontsize=6, color="0.3",
-                         xytext=(2, 0), textcoords="offset points")
-        for y in (-1.0, 1.0):
-            top.axhline(y, color="0.75", lw=0.5)
-        top.set_ylim(-2.0, 2.0)
-        top.set_title(f"{title}, {'with' if pend else 'without'} pendulum", fontsize=8)
-        top.set_ylabel("θ / α", fontsize=8)
-        bot.set_ylabel("|θ − θ_model| / α", fontsize=8)
-        bot.set_xlabel("t [s]", fontsize=8)
-        bot.set_ylim(1e-7, 10.0)
-        for ax in (top, bot):
-            ax.tick_params(labelsize=7)
-        top.legend(fontsize=6, frameon=False, loc="lower left")
+    return [_history_case(histories, point, pend, alphas[pend], reference, title)
+            for pend in cases]
+
+
+@_styled
+def _restitution_group(doc: dict, pend: bool, title: str, key: str) -> str:
+    rows = [r for r in doc.get("restitution", []) if r["pendulum"] == pend]
+    fig, ax = plt.subplots(figsize=(WIDTH, 3.2))
+    tol = 100.0 * doc["config"]["tolerances"][key]
+    ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} %")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    seen = set()
+    for r in rows:
+        name = r["backend"]
+        errs = [100.0 * i["rel_error"] for i in r["impacts"] if i.get("rel_error") is not None]
+        ax.plot(np.arange(1, len(errs) + 1), errs, marker=marker(name), ms=5,
+                lw=0.8, color=color(name), label=label(name) if name not in seen else None)
+        seen.add(name)
+    ax.set_title(title)
+    ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+    ax.set_xlabel("impact number")
+    ax.set_ylabel("measured / predicted − 1 [%]")
+    ax.legend()
     fig.tight_layout()
     return _png(fig)
 
 
-def restitution_figure(doc: dict) -> str | None:
-    """Relative error of each measured impact against Eq. 20 (left) and Eq. 19
-    at the measured psi (right), with the tolerance band."""
+def restitution_figures(doc: dict) -> list[str]:
+    """Relative error of each measured impact against Eq. 20 (no pendulum) and
+    Eq. 19 at the measured psi (with it), with the tolerance band; one figure per
+    equation that the campaign measured."""
     rows = doc.get("restitution", [])
     groups = [(False, "Eq. 20 (no pendulum)", "restitution"),
               (True, "Eq. 19 (with pendulum)", "restitution_pendulum")]
-    groups = [g for g in groups if any(r["pendulum"] == g[0] for r in rows)]
-    if not groups:
-        return None
-    fig, axes = plt.subplots(1, len(groups), figsize=(3.6 * len(groups), 2.8), squeeze=False,
-                             sharey=True)
-    for ax, (pend, title, key) in zip(axes[0], groups):
-        tol = 100.0 * doc["config"]["tolerances"][key]
-        ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} %")
-        ax.axhline(0.0, color="0.5", lw=0.6)
-        seen = set()
-        for r in (r for r in rows if r["pendulum"] == pend):
-            name = r["backend"]
-            errs = [100.0 * i["rel_error"] for i in r["impacts"] if i.get("rel_error") is not None]
-            ax.plot(np.arange(1, len(errs) + 1), errs, marker=marker(name), ms=4,
-                    lw=0.7, color=color(name),
-                    label=label(name) if name not in seen else None)
-            seen.add(name)
-        ax.set_title(title, fontsize=8)
-        ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
-        ax.set_xlabel("impact number", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.legend(fontsize=6, frameon=False)
-    axes[0, 0].set_ylabel("measured / predicted − 1 [%]", fontsize=8)
-    fig.tight_layout()
-    return _png(fig)
+    return [_restitution_group(doc, *g) for g in groups
+            if any(r["pendulum"] == g[0] for r in rows)]

@@ -3,14 +3,19 @@
 :mod:`compare.report.html`."""
 from __future__ import annotations
 
-import html
 import math
 
+TWO_PI = 2.0 * math.pi
 
+
+from compare.report import units
+from compare.report.cells import _cell, cause_phrase, csv_text, table
 from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
 
-__all__ = ["HEADERS", "table", "error_rows", "history_rows", "jump_rows", "provenance_rows",
-           "restitution_rows", "threshold_rows", "timing_rows", "trust_rows", "verdict_rows"]
+__all__ = ["HEADERS", "table", "csv_text", "error_rows", "history_rows", "jump_rows",
+           "provenance_rows", "restitution_rows", "threshold_rows", "threshold_points",
+           "threshold_csv", "timing_rows", "trust_rows", "verdict_rows", "settings_rows",
+           "key_value_rows", "cause_phrase"]
 
 _JOBS = {"threshold": "overturning thresholds (bisections)", "history": "time histories A-D",
          "restitution": "free-rocking restitution", "jump": "mode-jump frequency",
@@ -21,11 +26,15 @@ _TIMINGS = {"reference_spectra": "reference spectra (analytic model, both curves
 
 
 # ---------------------------------------------------------------- formatting
-def _value(v: dict) -> str:
-    """A verdict value in the unit of its tolerance: percent, alpha or a count."""
+def _value(v: dict, bracket: float | None = None) -> str:
+    """A verdict value in the unit of its tolerance: percent, alpha or a count;
+    a threshold error (``bracket``: the bisection's relative width) at the
+    bracket's resolution."""
     x, unit = v.get("value"), v.get("unit")
     if x is None:
         return "not measured"
+    if bracket is not None and unit == "relative":
+        return units.rel_error(x, bracket).lstrip("+")
     if unit == "relative":
         return fmt_pct(x)
     if unit == "fraction of alpha":
@@ -54,31 +63,6 @@ def _status(status, mode) -> str:
     return f"{status} ({mode})" if mode else str(status)
 
 
-def _cell(text: str, ok: bool | None = None) -> dict:
-    return {"text": text, "ok": ok}
-
-
-def table(header: list[str], rows: list[list], md: bool = False) -> str:
-    """HTML (in a horizontally scrolling wrapper) or Markdown table.  A cell is a
-    string or :func:`_cell` (coloured pass/fail)."""
-    def text(c):
-        return c["text"] if isinstance(c, dict) else c
-
-    if md:
-        lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-        lines += ["| " + " | ".join(text(c).replace("|", "/") for c in r) + " |" for r in rows]
-        return "\n".join(lines)
-
-    def td(c):
-        ok = c.get("ok") if isinstance(c, dict) else None
-        cls = "" if ok is None else (" class='pass'" if ok else " class='fail'")
-        return f"<td{cls}>{html.escape(text(c))}</td>"
-
-    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
-    body = "".join("<tr>" + "".join(td(c) for c in r) + "</tr>" for r in rows)
-    return f"<div class='scroll'><table><tr>{head}</tr>{body}</table></div>"
-
-
 # ---------------------------------------------------------------- tables
 def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     trust = doc["trust"]
@@ -98,7 +82,9 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
             text = "none agree"
         else:
             lo, hi = t["omega_range"]
-            text = f"A ≤ {t['agree_up_to']:.3g} m/s² (Ω {lo:g}-{hi:g} rad/s)"
+            span = (f"Ω {lo:g} rad/s ({lo / TWO_PI:.2g} Hz)" if lo == hi else
+                    f"Ω {lo:g} to {hi:g} rad/s ({lo / TWO_PI:.2g} to {hi / TWO_PI:.2g} Hz)")
+            text = f"A ≤ {units.accel(t['agree_up_to'])}, {span}"
         return _cell(f"{text}; {t['n_agree']} of {t['n_points']} points",
                      t["n_agree"] == t["n_points"])
 
@@ -108,18 +94,14 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
             return _cell("not measured")
         if not t["failing"]:
             return _cell("all agree")
-        measured = any(p.get("cause") for p in t["failing"])
-        parts = []
+        short, long = [], []
         for p in t["failing"]:
-            err = "not bracketed" if p["rel_error"] is None else f"{100 * p['rel_error']:+.2g} %"
-            where = f"Ω {p['omega']:g}{'' if p['case'] == 'pendulum' else ' (no pend.)'}"
-            cause = ""
-            if measured:
-                cause = f", {p.get('cause') or 'not measured'}"
-                cause += f" ({p['cause_detail']})" if p.get("cause_detail") else ""
-            parts.append(f"{where}: {err}{cause}")
-        text = "; ".join(parts)
-        return _cell(text if measured else f"not measured ({text})", False)
+            err = units.rel_error(p["rel_error"])
+            where = f"Ω {p['omega']:g} rad/s{'' if p['case'] == 'pendulum' else ' (no pend.)'}"
+            short.append(f"{where}: {err}, {cause_phrase(p.get('cause'))}")
+            long.append(f"{where}: {p.get('cause_detail') or 'not measured'}")
+        blamed = any(p.get("cause") != "model" for p in t["failing"])
+        return _cell("; ".join(short), False if blamed else None, "; ".join(long))
 
     def ad(row):
         v = row.get("verdicts_AD")
@@ -131,7 +113,8 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
     def cost(row, key):
         c = row["cost"]
         if key == "run":
-            return _cell(fmt_seconds(c["run_cpu_s"]) + " CPU")
+            return _cell("not measured" if c["run_cpu_s"] is None
+                         else fmt_seconds(c["run_cpu_s"]) + " CPU")
         if c["threshold_point_cpu_s"] is None:
             return _cell("not measured")
         return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per point "
@@ -139,8 +122,9 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
                      f"for {c['spectrum_frequencies']} frequencies")
 
     def settings(row):
-        return _cell(", ".join(f"{k} = {fmt_sci(v)}" if isinstance(v, float) else f"{k} = {v}"
-                               for k, v in row["settings"].items()) or "defaults")
+        dt = row["settings"].get("dt")
+        return _cell(("defaults" if dt is None else f"dt = {fmt_sci(dt)} s")
+                     + "; all settings in the table below")
 
     spec = [("restitution vs Eq. 20, worst impact", f"≤ {fmt_pct(tols['restitution'])}",
              lambda r: verdict_cell(r, "restitution_eq20")),
@@ -165,26 +149,113 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
 
 
 def verdict_rows(doc: dict) -> list[list]:
-    return [[v.get("id", ""), label(v["backend"]), _cell(_value(v), v["passed"]), _tolerance(v),
-             _cell("pass" if v["passed"] else "FAIL", v["passed"]), v["metric"],
-             f"{v.get('detail', '')}. {v['reason']}"] for v in doc["verdicts"]]
+    bracket = doc.get("config", {}).get("rel_tol")
+
+    def value(v):
+        return _value(v, bracket if str(v.get("id", "")).startswith("threshold") else None)
+
+    return [[v.get("id", ""), label(v["backend"]), _cell(value(v), v["passed"]), _tolerance(v),
+             _cell("pass" if v["passed"] else "FAIL", v["passed"]),
+             _cell(v["metric"], None, f"{v.get('detail', '')}. Tolerance: {v['reason']}")]
+            for v in doc["verdicts"]]
+
+
+def _validity_at(case, omega) -> dict | None:
+    """The model's validity on its own threshold run at ``omega`` (the case's
+    ``model_validity`` list, aligned with its ``omega``; written by
+    :func:`compare.report.html.add_model_validity`), or None."""
+    val = case.raw.get("model_validity")
+    if not val or omega is None:
+        return None
+    for w, v in zip(case.omega, val):
+        if w is not None and abs(w - omega) < 1e-9:
+            return v
+    return None
+
+
+def _point_validity(case, p) -> tuple[bool | None, str]:
+    """``(valid, reason)`` of the model at an engine point: the point's own
+    checks (at the model's and the engine's thresholds and along the bracket)
+    when the campaign made them, else the model's threshold run at its Ω."""
+    if p.valid is not None or p.cause == "model":
+        bad = [v for v in p.validity if not v.valid]
+        reason = "; ".join(f"{v.where}: {v.reason}" for v in bad) or p.cause_detail
+        return (False, reason) if (p.valid is False or p.cause == "model") else (True, "")
+    v = _validity_at(case, p.omega) or {}
+    return v.get("model_valid"), v.get("model_reason", "")
+
+
+def threshold_points(doc: dict) -> list[dict]:
+    """Every engine threshold point as a flat record (SI numbers, g and Hz
+    beside), for the CSV export and the table; read through the typed summary
+    (:class:`compare.campaign.summary.Summary`)."""
+    from compare.campaign.summary import Summary
+
+    summary = Summary.from_dict(doc)
+    tol = summary.threshold_tolerance
+    out = []
+    for case in summary.spectra.values():
+        for name, pts in case.engines.items():
+            for p in pts:
+                err, w = p.rel_error, p.omega
+                valid, reason = _point_validity(case, p)
+                resolution = p.rel_resolution if p.rel_resolution is not None else p.rel_tol
+                out.append({
+                    "case": case.name, "engine": name, "omega_rad_s": w,
+                    "f_hz": None if w is None else w / TWO_PI,
+                    "pulse_period_s": None if not w else TWO_PI / w,
+                    "a_model_m_s2": p.a_reference,
+                    "a_model_g": None if p.a_reference is None else p.a_reference / units.G,
+                    "a_engine_m_s2": p.a_engine, "a_survives_m_s2": p.a_survives,
+                    "rel_error": err, "rel_resolution": resolution, "tolerance_rel": tol,
+                    "within_tolerance": err is not None and abs(err) <= tol,
+                    "mode_model": p.mode_reference, "mode_engine": p.mode_engine,
+                    "model_valid": valid, "model_reason": reason,
+                    "cause": p.cause, "cause_detail": p.cause_detail, "n_runs": p.n_runs,
+                    "cpu_s": p.cpu_s, "from_store": p.from_store})
+    return out
+
+
+def threshold_csv(doc: dict) -> str:
+    """:func:`threshold_points` as CSV: one row per engine point, numbers in SI
+    at full precision (empty: not measured)."""
+    import csv
+    import io
+
+    pts = threshold_points(doc)
+    buf = io.StringIO()
+    fields = list(pts[0]) if pts else ["case", "engine"]
+    w = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n")
+    w.writeheader()
+    for p in pts:
+        w.writerow({k: "" if v is None else (f"{v:.12g}" if isinstance(v, float) else v)
+                    for k, v in p.items()})
+    return buf.getvalue()
+
+
+def _valid_cell(valid: bool | None, reason: str) -> dict:
+    if valid is None:
+        return _cell("not checked")
+    return _cell("yes") if valid else _cell("no (engine not blamed)", None, reason)
 
 
 def threshold_rows(doc: dict) -> list[list]:
-    tol = doc["config"]["tolerances"]["threshold"]
     rows = []
-    for case, spec in doc["spectra"].items():
-        for name, pts in spec.get("engines", {}).items():
-            for p in pts:
-                err = p.get("rel_error")
-                ok = err is not None and abs(err) <= tol
-                rows.append([case.replace("_", " "), label(name), _num(p["omega"]),
-                             _num(p["a_reference"]), _num(p["a_engine"]),
-                             _cell("n/a" if err is None else f"{100 * err:+.3g} %", ok),
-                             f"{p['mode_reference']} / {p['mode_engine']}", str(p["n_runs"]),
-                             p.get("cause") or "not measured",
-                             fmt_seconds(p.get("cpu_s")) + (" (store)" if p.get("from_store")
-                                                            else "")])
+    for p in threshold_points(doc):
+        ok = p["within_tolerance"]
+        if not ok and p["model_valid"] is False:
+            ok = None  # the model is invalid there: no engine is to blame
+        w = p["omega_rad_s"]
+        rows.append([p["case"].replace("_", " "), label(p["engine"]),
+                     "n/a" if w is None else f"{w:g} ({p['f_hz']:.2g} Hz)",
+                     units.accel(p["a_model_m_s2"]), units.accel(p["a_engine_m_s2"]),
+                     _cell(units.rel_error(p["rel_error"], p["rel_resolution"]), ok),
+                     f"{p['mode_model'] or '—'} / {p['mode_engine'] or '—'}",
+                     _valid_cell(p["model_valid"], p["model_reason"]),
+                     str(p["n_runs"]),
+                     _cell(cause_phrase(p["cause"]), None,
+                           "" if p["cause"] == "agrees" else (p["cause_detail"] or "")),
+                     fmt_seconds(p["cpu_s"]) + (" (store)" if p["from_store"] else "")])
     return rows
 
 
@@ -207,10 +278,66 @@ def history_rows(doc: dict) -> list[list]:
                      _cell("n/a" if rms is None else f"{fmt_sci(rms)} α",
                            None if rms is None else rms <= tol),
                      "n/a" if c.get("theta_max_all") is None else f"{fmt_sci(c['theta_max_all'])} α",
-                     "n/a" if c.get("uplift_time_error") is None
-                     else f"{1e3 * c['uplift_time_error']:+.3g} ms",
+                     _uplift(c),
                      fmt_seconds(c["test"].get("wall_time"))])
     return rows
+
+
+def _sample_interval(prov: dict) -> float | None:
+    """An engine run's sample interval [s]: ``sample_every`` steps of ``dt``."""
+    s = prov.get("settings") or {}
+    dt, every = s.get("dt", prov.get("dt")), s.get("sample_every")
+    return dt * every if (dt and every) else None
+
+
+def _uplift(c: dict) -> str:
+    """The uplift time error (both runs timed where ``|theta|`` first reaches
+    1e-4 rad, linear between samples) with the coarser run's sample interval,
+    the resolution of that reading."""
+    err = c.get("uplift_time_error")
+    if err is None:
+        return "n/a"
+    res = _sample_interval(c.get("test") or {})
+    return f"{1e3 * err:+.2g} ms" + ("" if res is None else f" (samples every {1e3 * res:.2g} ms)")
+
+
+def settings_rows(doc: dict) -> tuple[list[str], list[list]]:
+    """The engines' settings side by side, one row per setting (nested
+    dictionaries such as the run monitor flattened as ``monitor: uplift_angle``),
+    values as numbers a person reads: ``1e-4``, yes/no, "engine default" for None."""
+    engines = list(doc.get("config", {}).get("engines", []))
+    flat = {e: _flatten(doc.get("settings", {}).get(e, {})) for e in engines}
+    keys = list(dict.fromkeys(k for e in engines for k in flat[e]))
+    rows = [[k.replace("_", " ")] + [_setting(flat[e].get(k, "—")) for e in engines]
+            for k in keys]
+    return ["setting"] + [label(e) for e in engines], rows
+
+
+def key_value_rows(d: dict) -> list[list]:
+    """A flat (or nested) dictionary as ``[name, value]`` rows, values readable."""
+    return [[k.replace("_", " "), _setting(v)] for k, v in _flatten(d).items()]
+
+
+def _flatten(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flatten(v, f"{prefix}{k}: "))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def _setting(v) -> str:
+    if v is None:
+        return "engine default"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        return fmt_sci(v, 3)
+    if isinstance(v, (list, tuple)):
+        return ", ".join(_setting(x) for x in v)
+    return str(v)
 
 
 def restitution_rows(doc: dict) -> list[list]:
@@ -254,14 +381,16 @@ def provenance_rows(doc: dict) -> list[list]:
     return rows or [["provenance", "not recorded"]]
 
 
-HEADERS = {"verdicts": ["id", "engine", "value", "tolerance", "result", "metric", "detail and reason"],
-      "thresholds": ["case", "engine", "Ω [rad/s]", "A model [m/s²]", "A engine [m/s²]",
-                     "error", "mode (model / engine)", "runs", "cause", "wall"],
+HEADERS = {"verdicts": ["id", "engine", "value", "tolerance", "result",
+                        "metric (detail and the tolerance's reason folded)"],
+      "thresholds": ["case", "engine", "Ω [rad/s]", "A model", "A engine",
+                     "error (bracket)", "mode (model / engine)", "model valid", "runs", "cause",
+                     "CPU"],
       "jumps": ["case", "engine", "probe A [m/s²]", "Ω jump model", "Ω jump engine",
                 "shift [rad/s]", "runs"],
       "histories": ["point", "pendulum", "engine", "verdict (model)", "verdict (engine)",
                     "θ RMS error before 1st impact", "θ max error (whole run)",
-                    "uplift time error", "wall"],
+                    "uplift time error (resolution)", "wall"],
       "restitution": ["engine", "λ", "μ", "γ", "equation", "impacts", "worst error"],
       "timings": ["what", "time"],
       "errors": ["job", "engine", "pendulum", "label", "error"],

@@ -1,0 +1,134 @@
+"""One recommendation line per use of an engine, read off the trust table.
+
+A reader of the validation report mostly wants "which engine, at which step,
+for what I am about to do".  The uses are the campaign's checks grouped by
+what a user computes:
+
+* **overturning thresholds** (spectra, maps): every threshold point within the
+  tolerance; an engine whose disagreements all converge at a smaller step
+  (cause ``discretisation`` with "dt <= X s meets") is recommended at that step;
+  points where the model itself is invalid (cause ``model``) count against no
+  engine;
+* **restitution without the pendulum** (Eq. 20) and **with it** (Eq. 19 at the
+  measured psi);
+* **time histories** (the paper's verdicts at A-D and theta(t) before the first
+  impact);
+* **long runs** (tens of seconds at rest and after a pulse: the pivots must not
+  creep).
+
+Engines not recommended are named with the number that excludes them, so the
+line is checked against the tables below it, never typed.
+"""
+from __future__ import annotations
+
+import re
+
+from compare.report.cells import cause_phrase
+from compare.report.trust import fmt_pct, fmt_sci, label
+
+__all__ = ["recommendations"]
+
+_DT_MEETS = re.compile(r"dt <= ([0-9.eE+-]+) s (?:meets|would meet)")
+
+
+def _dt(row: dict) -> str:
+    dt = row.get("settings", {}).get("dt")
+    return "its default step" if dt is None else f"dt = {fmt_sci(dt)} s"
+
+
+def _thresholds(trust: dict) -> str | None:
+    good, finer, bad = [], [], []
+    for e, row in trust.items():
+        t = row["thresholds"]
+        if not t["n_points"]:
+            continue
+        blamed = [p for p in t["failing"] if p.get("cause") != "model"]
+        if not blamed:
+            good.append((label(e), _dt(row)))
+            continue
+        steps = [_DT_MEETS.search(p.get("cause_detail") or "") for p in blamed]
+        if all(p.get("cause") == "discretisation" for p in blamed) and all(steps):
+            finer.append((label(e),
+                          f"dt ≤ {fmt_sci(min(float(m.group(1)) for m in steps))} s"))
+        else:
+            worst = max(blamed, key=lambda p: abs(p["rel_error"] or 0.0))
+            err = ("not bracketed" if worst["rel_error"] is None
+                   else f"{100 * worst['rel_error']:+.1f} %")
+            bad.append(f"{label(e)} ({err} at Ω = {worst['omega']:g} rad/s, "
+                       f"{cause_phrase(worst.get('cause'))})")
+    return _line("Overturning thresholds", good + finer, bad)
+
+
+def _verdict_use(trust: dict, title: str, key: str, what) -> str | None:
+    good, bad = [], []
+    for e, row in trust.items():
+        v = row.get(key)
+        if v is None or v.get("value") is None:
+            continue
+        if v["passed"]:
+            good.append((label(e), _dt(row)))
+        else:
+            bad.append(f"{label(e)} ({what(v, row)})")
+    return _line(title, good, bad)
+
+
+def _histories(trust: dict) -> str | None:
+    good, bad = [], []
+    for e, row in trust.items():
+        checks = [row.get(k) for k in ("verdicts_AD", "theta_first_impact")]
+        checks = [c for c in checks if c is not None and c.get("value") is not None]
+        if not checks:
+            continue
+        if all(c["passed"] for c in checks):
+            good.append((label(e), _dt(row)))
+        else:
+            bad.append(label(e))
+    return _line("Time histories (verdicts at A-D, θ(t) to the first impact)", good, bad)
+
+
+def _line(title: str, good: list[tuple[str, str]], bad: list[str]) -> str | None:
+    """``title: A or B at dt = X; C at dt <= Y; not D (why)``: the engines that
+    pass, grouped by the step they pass at, then the ones that do not."""
+    if not good and not bad:
+        return None
+    steps: dict[str, list[str]] = {}
+    for name, step in good:
+        steps.setdefault(step, []).append(name)
+    groups = [(", ".join(n[:-1]) + " or " + n[-1] if len(n) > 1 else n[0]) + f" at {step}"
+              for step, n in steps.items()]
+    text = f"{title}: " + ("; ".join(groups) if groups else "no engine passes")
+    if bad:
+        text += "; not " + ", not ".join(bad)
+    return text + "."
+
+
+def recommendations(doc: dict) -> list[str]:
+    """The recommendation lines of the summary document ``doc`` (its ``trust``
+    table), one per use that the campaign measured."""
+    trust = doc.get("trust", {})
+
+    def off(v, row):
+        return f"off by {fmt_pct(v['value'])}, tolerance {fmt_pct(v['tolerance'])}"
+
+    lines = [_thresholds(trust),
+             _verdict_use(trust, "Restitution without the pendulum (Eq. 20)",
+                          "restitution_eq20", off),
+             _verdict_use(trust, "Restitution with the pendulum (Eq. 19)",
+                          "restitution_eq19", lambda v, row: off(v, row) + _worst_lam(doc, row)),
+             _histories(trust),
+             _verdict_use(trust, "Long runs (rest, and rocking after a pulse)", "long_run",
+                          lambda v, row: f"pivots slid {1e3 * v['value']:.2g} mm, tolerance "
+                                         f"{1e3 * v['tolerance']:.2g} mm")]
+    return [line for line in lines if line]
+
+
+def _worst_lam(doc: dict, row: dict) -> str:
+    """", worst at λ = 7" for the engine of ``row``: the pendulum restitution case
+    with the largest error."""
+    cases = [r for r in doc.get("restitution", []) if r.get("pendulum")
+             and label(r.get("backend", "")) == row.get("label")
+             and r.get("max_rel_error") is not None]
+    if not cases:
+        return ""
+    worst = max(cases, key=lambda r: abs(r["max_rel_error"]))
+    return f", worst at λ = {worst['lam']:g}"
