@@ -129,7 +129,7 @@ def test_record_with_bom_keeps_its_first_sample(here, capsys):
 
 # -------------------------------------------------------------------- options
 @pytest.mark.parametrize("argv, needle", [
-    (["simulate", "-A", "twenty", "-w", "11"], "--amplitude/-A: invalid float value"),
+    (["simulate", "-A", "twenty", "-w", "11"], "-A/--amplitude: 'twenty' is not an acceleration"),
     (["spectrum", "--omega", "10", "--workers", "1.5"], "--workers: invalid int value"),
     (["figures", "--format", "exe"], "--format: invalid choice"),
     (["nonsense"], "invalid choice"),
