@@ -46,12 +46,13 @@ survival rules, a certain overturn ends the run) with the criterion and
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from .equations import overturn_energy_barrier
-from .excitation import PULSE_KINDS
+from .excitation import OMEGA_RANGE, PULSE_KINDS
 from .fast_settings import Settings as FastSettings
 from .parameters import Scene
 from .trajectory import OverturnCriterion
@@ -193,6 +194,10 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
     (``a_overturn - a_safe <= tol``), the overturning mode at ``a_overturn``.
     ``a_overturn`` is NaN (mode None) when nothing overturns up to ``a_max``.
     """
+    if isinstance(omega, bool) or not isinstance(omega, numbers.Real) or not (
+            math.isfinite(omega) and OMEGA_RANGE[0] <= omega <= OMEGA_RANGE[1]):
+        raise ValueError(f"omega must be in [{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}] rad/s, "
+                         f"got {omega!r}")
     run = _Runner(scene, omega, ss)
     a0 = _a_start(scene, ss)
     over, ni0, quiet0 = run([a0])

@@ -115,3 +115,17 @@ def test_cli_subprocess_one_line_error():
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: omega")
     assert proc.stdout == ""
+
+
+@pytest.mark.parametrize("omega", [float("nan"), -5.0, 0, 0.0, 1e6])
+def test_first_overturn_amplitude_refuses_a_frequency_outside_the_pulse_range(omega):
+    from analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
+    from scenes import load_scene
+    with pytest.raises(ValueError, match=r"omega must be in \[0.1, 10000\] rad/s"):
+        first_overturn_amplitude(load_scene("fig5"), omega, SpectrumSettings())
+
+
+def test_a_size_beyond_the_float_range_is_a_value_error():
+    from analytic import Scene
+    with pytest.raises(ValueError, match="b must be finite, got an integer of 401 digits"):
+        Scene(b=10 ** 400)
