@@ -12,13 +12,17 @@ from dataclasses import dataclass, field
 
 from .trajectory import OverturnCriterion
 
-__all__ = ["RunOptions", "check_real", "MAX_RUN_STEPS"]
+__all__ = ["RunOptions", "check_real", "MAX_RUN_STEPS", "MAX_ENGINE_DT"]
 
 # Largest run any backend accepts: engine steps (length / dt) or analytic output
 # samples (length / sample_dt).  5e6 steps is about 3 min of PyBullet and 1 min
 # of Pymunk on the reference machine (30 and 90 thousand steps/s, README), 200 MB
 # of analytic samples; the default runs need at most 1.3e6 (62.8 s pulse + 60 s).
 MAX_RUN_STEPS = 5_000_000
+# Largest engine time step [s], the one range of every --dt, campaign step and
+# engine Settings: an engine spreads an impact over a few steps and a 30 rad/s
+# pulse lasts 0.2 s, so steps above 10 ms resolve neither.
+MAX_ENGINE_DT = 0.01
 
 
 def check_real(owner: str, name: str, value, lo: float, hi: float, lo_open: bool = True,

@@ -21,7 +21,7 @@ from typing import ClassVar
 
 from analytic.bounds import required_friction
 from analytic.excitation import Pulse, SampledRecord, Still
-from analytic.options import MAX_RUN_STEPS, RunOptions, check_real
+from analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
 from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
 
@@ -95,7 +95,7 @@ class EngineSettings(RunOptions):
     def __post_init__(self) -> None:
         super().__post_init__()
         owner = type(self).__name__
-        check_real(owner, "dt", self.dt, 0.0, 0.1)
+        check_real(owner, "dt", self.dt, 0.0, MAX_ENGINE_DT)
         if self.base_motion not in BASE_MOTIONS:
             raise ValueError(f"{owner}: base_motion must be one of {BASE_MOTIONS}, "
                              f"got {self.base_motion!r}")

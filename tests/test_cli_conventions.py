@@ -91,13 +91,17 @@ def test_simulate_json_inputs(capsys):
     assert doc["inputs"]["scene"]["name"] == "fig5" and doc["inputs"]["engine"] == "analytic"
 
 
-def test_deprecated_engines_spelling_notes_once(monkeypatch, capsys):
-    import compare.cli.bench as bench_cmd
-    fake = SimpleNamespace(run=lambda **kw: {"points": []}, _dominates=lambda p, d: False)
-    monkeypatch.setattr(bench_cmd, "_load_bench", lambda: fake)
-    assert main(["bench", "--engines", "pymunk"]) == 0
-    err = capsys.readouterr().err.splitlines()
-    assert err == ["note: --engines is deprecated, use --engine (the same NAME[,NAME...] list)"]
+@pytest.mark.parametrize("command", ["report", "bench", "spectrum", "map", "fragility"])
+def test_engine_all_names_every_registered_engine(command, capsys):
+    import argparse
+
+    from compare.cli.main import build_parser
+    from compare.cli.options import parse_engine_list
+    from engines import engine_names
+    parser, _ = build_parser()
+    args = parser.parse_args([command, "--engine", "all"] +
+                             (["--records", "sample"] if command == "fragility" else []))
+    assert parse_engine_list(args.engine) == engine_names()
 
 
 def _point(family, error, time, default=False):

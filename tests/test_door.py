@@ -157,13 +157,14 @@ CLI_CASES = [
     (["simulate", "-A", "5", "--record", str(SAMPLE_CSV)], "--record replaces the pulse"),
     # --- engines, workers, steps
     (["bench", "--engine", ""], "--engine must name at least one"),
-    (["bench", "--engines", ""], "--engine must name at least one"),  # old spelling
+    (["report", "--engine", "all,pymunk"], "unknown engine 'all' in a list"),
     (["bench", "--engine", "ode"], "unknown engine 'ode'"),
     (["bench", "--engine", "none", "--no-analytic"], "nothing to measure"),
     (["report", "--engine", ""], "--engine"),
     (["report", "--engine", "pymunk,pymunk"], "named twice"),
     (["report", "--engine", "havok"], "unknown engine"),
-    (["report", "--dt", "1e-9"], "--dt must be in"),
+    (["report", "--dt", "1e-9"], "over the budget of 5e+06"),
+    (["report", "--dt", "0.02"], "--dt must be in (0, 0.01] s"),
     (["report", "--dt", "-1"], "--dt must be in"),
     (["report", "--workers", "0"], "--workers"),
     (["report", "--scene", "{bad_b}"], "bad_b.toml"),

@@ -16,7 +16,7 @@ from analytic.reactions import ground_reaction, reaction_history, system_mass
 from analytic.simulate import Settings, simulate
 from analytic.trajectory import OverturnCriterion
 from finite_differences import central_difference_force
-from compare.cli.options import clean_nan
+from compare.run.jsonable import plain
 
 G = 9.81
 
@@ -182,7 +182,7 @@ def test_extreme_pulse_is_flagged_invalid(fig5, monkeypatch):
     idx, r_fd = _fd_reactions(scene, pulse, dense)
     assert np.min(r_fd[1]) / (system_mass(1.0, 0.0) * scene.g) < -1.0
     # Strict JSON: the infinite demand becomes null, validity stays a bool.
-    text = json.dumps(clean_nan(tr.summary()), allow_nan=False)
+    text = json.dumps(plain(tr.summary()), allow_nan=False)
     assert '"model_valid": false' in text
 
 

@@ -13,7 +13,7 @@ from analytic import equations as eq
 from analytic.excitation import Pulse, SampledRecord
 from analytic.simulate import NAME, Settings, simulate, version
 from analytic.trajectory import OverturnCriterion
-from compare.cli.options import clean_nan
+from compare.run.jsonable import plain
 from engines import get_backend
 
 FREE = Pulse(0.0, 1e4)  # zero-amplitude pulse over 0.6 ms: free motion from the initial state
@@ -36,7 +36,7 @@ def test_trajectory_is_self_describing(fig5):
     assert tr.settings["t_max"] == 2.0 and tr.t_max == 2.0 and tr.criterion == st.criterion
     assert {"n_steps", "n_rhs_evals", "n_segments"} <= set(tr.diagnostics)
     assert tr.diagnostics["n_steps"] > 0 and tr.wall_time > 0.0
-    json.dumps(clean_nan(tr.summary()), allow_nan=False)  # strict JSON
+    json.dumps(plain(tr.summary()), allow_nan=False)  # strict JSON
 
 
 def test_samples_grid_and_event_instants(fig5):

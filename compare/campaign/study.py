@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analytic.options import MAX_ENGINE_DT
 from engines import ENGINES
 from scenes import load_scene, read_toml, scene_names
 
@@ -141,8 +142,8 @@ def load_study(path) -> Study:
     steps = ([_number(s, where, "steps") for s in _list(table, "steps", where)]
              if "steps" in table else [0.0])
     for s in steps:
-        if not (math.isfinite(s) and 0.0 <= s <= 0.01):
-            raise ValueError(f"{where}: steps: each time step must be in [0, 0.01] s "
+        if not (math.isfinite(s) and 0.0 <= s <= MAX_ENGINE_DT):
+            raise ValueError(f"{where}: steps: each time step must be in [0, {MAX_ENGINE_DT:g}] s "
                              f"(0: calibrated), got {s!r}")
     cases = [str(c) for c in _list(table, "cases", where)] if "cases" in table else [
         "pendulum", "no_pendulum"]

@@ -24,6 +24,7 @@ import time
 from dataclasses import dataclass, field
 
 from analytic.excitation import Pulse
+from analytic.options import MAX_ENGINE_DT
 from engines import ENGINES, configure
 from scenes import POINTS, load_scene
 
@@ -114,8 +115,9 @@ class CampaignConfig:
         if self.n_frequencies < 0 or self.n_impacts < 1 or self.workers < 1:
             raise ValueError("n_frequencies must be >= 0, n_impacts >= 1 and workers >= 1")
         if self.engine_dt is not None and not (math.isfinite(self.engine_dt)
-                                               and 0.0 < self.engine_dt <= 0.01):
-            raise ValueError(f"engine_dt must be in (0, 0.01] s, got {self.engine_dt!r}")
+                                               and 0.0 < self.engine_dt <= MAX_ENGINE_DT):
+            raise ValueError(f"engine_dt must be in (0, {MAX_ENGINE_DT:g}] s, "
+                             f"got {self.engine_dt!r}")
         for case in (*self.spectrum_cases, *self.jump_cases):
             if case not in ("pendulum", "no_pendulum"):
                 raise ValueError(f"spectrum_cases: unknown case {case!r}; allowed: pendulum, "

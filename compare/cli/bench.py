@@ -32,7 +32,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="the < 2 min variant (fewer points, coarser bisection)")
     parser.add_argument("--out", default=None, metavar="DIR",
                         help="output directory, created if missing (default: benchmarks/out)")
-    add_engine_list_arg(parser, engine_names(), engine_names(), none_ok=True)
+    add_engine_list_arg(parser, engine_names(), none_ok=True)
     parser.add_argument("--no-analytic", action="store_true",
                         help="skip the analytic paths")
     parser.add_argument("--strict", action="store_true",
@@ -60,7 +60,7 @@ def failed_defaults(bench, points) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    engines = parse_engine_list(args.engine, engine_names(), none_ok=True)  # before any heavy work
+    engines = parse_engine_list(args.engine, none_ok=True)  # before any heavy work
     if not engines and args.no_analytic:
         raise ValueError("--engine none with --no-analytic leaves nothing to measure")
     out = check_output_path(args.out, "--out", directory=True) if args.out is not None else None

@@ -5,10 +5,12 @@ import argparse
 import math
 import sys
 
+from analytic.options import MAX_ENGINE_DT
+
 from compare.cli import options as _common
-from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg,
-                                 check_output_path, clean_nan, envelope, info, print_json,
-                                 resolve_workers, sig)
+from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
+                                 envelope, info, print_json, resolve_workers, sig)
+from compare.run.jsonable import plain
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -93,8 +95,8 @@ def _check_budget(engine: str, space: dict, vs) -> None:
 
     settings = get_backend(engine).Settings()
     for dt in space.get("dt", [settings.dt]):
-        if not dt > 0:
-            raise ValueError(f"--dt: each step must be > 0 s, got {dt!r}")
+        if not 0.0 < dt <= MAX_ENGINE_DT:
+            raise ValueError(f"--dt: each step must be in (0, {MAX_ENGINE_DT:g}] s, got {dt!r}")
         _common.check_run_budget(engine, dataclasses.replace(settings, dt=dt),
                                  Pulse(1.0, min(vs.omegas)), option="--dt")
 
@@ -105,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
     from compare.campaign.settings_file import settings_toml
     from compare.run import atomic
 
-    engine = engines.engine_list(args.engine)
+    engine = _common.parse_engine_list(args.engine)
     if len(engine) != 1:
         raise ValueError("--engine: calibrate one engine at a time")
     engine = engine[0]
@@ -137,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     if bar is not None:
         bar.close()
     _print(cal)
-    body = clean_nan(cal.to_dict())
+    body = plain(cal.to_dict())
     if args.json is not None:
         import json
         atomic.write_text(args.json, json.dumps(envelope("calibrate", {

@@ -196,9 +196,9 @@ def write_campaign(doc: dict, out: Path) -> None:
 
     from compare.run import atomic
 
-    from compare.cli.options import clean_nan
+    from compare.run.jsonable import plain
 
-    atomic.write_text(out / "campaign.json", json.dumps(clean_nan(doc), indent=1,
+    atomic.write_text(out / "campaign.json", json.dumps(plain(doc), indent=1,
                                                         allow_nan=False))
 
     def table(rows, cols):

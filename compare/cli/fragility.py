@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     from scenes.ground_motion import load_suite
 
     scene = scene_from_args(args)
-    engines_ = parse_engine_list(args.engine, ENGINES, none_ok=True)
+    engines_ = parse_engine_list(args.engine, none_ok=True)
     st = ida_settings(args)
     workers = resolve_workers(args.workers)
     out = check_output_path(args.out, "--out", directory=True)

@@ -23,10 +23,6 @@ from engines import engine_names
 _WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 
 
-class UsageError(ValueError):
-    """Raised for bad command-line values; reported with exit code 2."""
-
-
 def _version() -> str:
     try:
         from importlib.metadata import PackageNotFoundError, version
@@ -146,10 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         code = int(modules[args.command].run(args) or 0)
         sys.stdout.flush()  # a closed pipe fails here, inside the handler below
-        for note in getattr(args, "deprecation_notes", None) or ():
-            print(note, file=sys.stderr)
         return code
-    except ValueError as exc:  # includes UsageError: validation at the boundary
+    except ValueError as exc:  # validation at the boundary
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:

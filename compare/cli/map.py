@@ -7,9 +7,11 @@ import math
 
 from engines import engine_names
 
-from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_workers_arg,
-                      check_output_path, clean_nan, parse_omega_range, parse_range,
-                      print_json, resolve_workers, scene_from_args)
+from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
+                                 add_workers_arg, check_output_path, parse_engine_list,
+                                 parse_omega_range, parse_range, print_json, resolve_workers,
+                                 scene_from_args)
+from compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:0.5"
 DEFAULT_AMPLITUDE = "0.5:100:0.5"
@@ -168,8 +170,7 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     engines, eng_grid = (), None
     if args.engine is not None:
-        from engines import engine_list
-        engines = engine_list(args.engine)  # unknown name: ValueError before any work
+        engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
     from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
@@ -200,7 +201,7 @@ def run(args: argparse.Namespace) -> int:
         plot_maps(maps, args.plot, validity)
     if args.json:
         first = {**maps[0].to_dict(), "model_validity_first_overturning": validity}
-        print_json(clean_nan({"maps": [first] + [m.to_dict() for m in maps[1:]]}))
+        print_json(plain({"maps": [first] + [m.to_dict() for m in maps[1:]]}))
         return 0
     for m in maps:
         print(f"{m.backend}: scene {scene.name}, {m.pulse} pulse, {m.omega.size} frequencies x "

@@ -185,11 +185,6 @@ def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] 
     return Pulse(amplitude, omega, args.pulse)
 
 
-def excitation_inputs(excitation) -> dict:
-    """The excitation as echoed in JSON (pulse: kind, amplitude, omega, period)."""
-    return excitation.describe()
-
-
 def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",
                    allowed: tuple[str, ...] | None = None) -> None:
     from engines import backend_names
@@ -198,46 +193,37 @@ def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",
                         help=f"backend: {', '.join(names)}")
 
 
-class _DeprecatedAlias(argparse.Action):
-    """``--engines`` (old spelling): stored in ``--engine``'s place; ``compare.cli.main``
-    prints a one-line note on stderr once the command succeeded (an error
-    stays one line)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        notes = list(getattr(namespace, "deprecation_notes", None) or [])
-        notes.append(f"note: {option_string} is deprecated, use --engine "
-                     f"(the same NAME[,NAME...] list)")
-        namespace.deprecation_notes = notes
-        setattr(namespace, self.dest, values)
-
-
-def add_engine_list_arg(parser: argparse.ArgumentParser, allowed: tuple[str, ...],
-                        default: tuple[str, ...], none_ok: bool = False) -> None:
-    """``--engine NAME[,NAME...]`` (and the deprecated ``--engines``)."""
-    extra = " or none" if none_ok else ""
+def add_engine_list_arg(parser: argparse.ArgumentParser, default: tuple[str, ...],
+                        none_ok: bool = False) -> None:
+    """``--engine NAME[,NAME...]``, ``all`` (and ``none`` where ``none_ok``); read
+    with :func:`parse_engine_list`."""
+    from engines import engine_names
+    extra = ", or none" if none_ok else ""
     parser.add_argument("--engine", dest="engine", default=",".join(default),
                         metavar="NAME[,NAME...]",
-                        help=f"comma-separated engines from {', '.join(allowed)}{extra}")
-    parser.add_argument("--engines", dest="engine", action=_DeprecatedAlias,
-                        help=argparse.SUPPRESS)
+                        help=f"comma-separated engines from {', '.join(engine_names())}, "
+                             f"all{extra}")
 
 
-def parse_engine_list(text: str, allowed: tuple[str, ...], option: str = "--engine",
+def parse_engine_list(text: str, option: str = "--engine",
                       none_ok: bool = False) -> tuple[str, ...]:
-    """``'a,b'`` -> ``('a', 'b')``; refuses an empty list, unknown or repeated names."""
+    """The door's one engine list: ``'a,b'``, ``'all'`` (every registered engine,
+    :func:`engines.engine_list`) or, where ``none_ok``, ``'none'``; an empty list,
+    an unknown or a repeated name is refused naming ``option``."""
+    from engines import engine_list, engine_names
     if none_ok and text.strip() == "none":
         return ()
-    names = tuple(n.strip() for n in text.split(","))
+    names = [n.strip() for n in text.split(",")]
+    allowed = ", ".join(engine_names()) + ", all" + (", none" if none_ok else "")
     if not any(names):
-        raise ValueError(f"{option} must name at least one of {', '.join(allowed)}"
-                         + (" (or none)" if none_ok else "") + f", got {text!r}")
-    for n in names:
-        if n not in allowed:
-            raise ValueError(f"{option}: unknown engine {n!r}; allowed: {', '.join(allowed)}"
-                             + (" or none" if none_ok else ""))
+        raise ValueError(f"{option} must name at least one of {allowed}, got {text!r}")
+    unknown = [n for n in names if n not in engine_names() and n != "all"]
+    if unknown or ("all" in names and len(names) > 1):
+        bad = unknown[0] if unknown else "all"
+        raise ValueError(f"{option}: unknown engine {bad!r} in a list; allowed: {allowed}")
     if len(set(names)) != len(names):
         raise ValueError(f"{option}: an engine is named twice in {text!r}")
-    return names
+    return engine_list(text)
 
 
 def add_workers_arg(parser: argparse.ArgumentParser) -> None:
@@ -405,7 +391,6 @@ def print_json(obj) -> None:
     sys.stdout.write("\n")
 
 
-clean_nan = plain  # the one JSON cleaner (compare.run.jsonable); old name kept for callers
 
 
 # --- run store, scheduler and interruption (issue 12; appended by the store12 helper) ---

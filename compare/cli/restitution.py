@@ -6,8 +6,9 @@ import math
 
 from engines import engine_names
 
-from compare.cli.options import (add_scene_args, add_store_args, clean_nan, detail, envelope, info,
-                      print_json, scene_from_args, sig, use_store)
+from compare.cli.options import (add_scene_args, add_store_args, detail, envelope, info,
+                                 print_json, scene_from_args, sig, use_store)
+from compare.run.jsonable import plain
 
 # Half the static overturning angle: large, clean impacts far from toppling.
 DEFAULT_THETA0_FRACTION = 0.5
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"scene": scene.to_dict(), "excitation": {"type": "still"},
                   "engine": args.engine, "theta0": theta0, "psi0": args.psi0, "n_impacts": n}
         body = {"engine": body.pop("engine"), "engine_version": body.pop("version"), **body}
-        print_json(clean_nan(envelope("restitution", inputs, body, timings)))
+        print_json(plain(envelope("restitution", inputs, body, timings)))
         return 0
     eq_name = "Eq. 19 at measured psi" if scene.has_pendulum else "Eq. 20"
     print(f"{result.engine} ({result.version}), scene {scene.name}: lam = {sig(scene.lam)}, "

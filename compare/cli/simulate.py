@@ -8,8 +8,10 @@ from analytic.contact_forces import violations
 
 from compare.cli.units import acceleration_text, frequency_text, velocity_text
 from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
-                      add_scene_args, check_output_path, check_run_budget, clean_nan, detail,
-                      envelope, excitation_from_args, info, print_json, scene_from_args, sig)
+                                 add_scene_args, check_output_path, check_run_budget, detail,
+                                 envelope, excitation_from_args, info, print_json, scene_from_args,
+                                 sig)
+from compare.run.jsonable import plain
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -117,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"scene": scene.to_dict(), "excitation": excitation.describe(),
                   "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max}
         body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
-        print_json(clean_nan(envelope("simulate", inputs, body, timings)))
+        print_json(plain(envelope("simulate", inputs, body, timings)))
         return 0
     v = traj.verdict
     print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "

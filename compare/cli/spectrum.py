@@ -5,14 +5,16 @@ import argparse
 import math
 import sys
 
+from analytic.options import MAX_ENGINE_DT
 from engines import engine_names
 
 from compare.cli import options as _common
 from compare.cli.fragility import add_ida_args, record_spectrum
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
-                      add_workers_arg, check_output_path, clean_nan, envelope, info,
-                      parse_omega_range, print_json, resolve_workers, scene_from_args,
-                      use_store)
+                                 add_workers_arg, check_output_path, parse_engine_list, envelope,
+                                 info, parse_omega_range, print_json, resolve_workers,
+                                 scene_from_args, use_store)
+from compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
 ENGINE = "analytic-fast"  # the spectra's backend (compiled model, same verdicts)
@@ -210,7 +212,7 @@ def run(args: argparse.Namespace) -> int:
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": ENGINE}
         body = {"engine": ENGINE, "engine_version": version(), **body}
-        print_json(clean_nan(envelope("spectrum", inputs, body, timings)))
+        print_json(plain(envelope("spectrum", inputs, body, timings)))
         return 0
     print(f"scene {scene.name}: lam = {scene.lam:.4g}, b = {scene.b:.4g} m, mu = {scene.mu:.4g}, "
           f"gamma = {scene.gamma:.4g}; {settings.pulse} pulse; criterion "
@@ -265,14 +267,13 @@ def _record_spectrum(args: argparse.Namespace, scene) -> int:
 
 def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     """The engines asked for (empty for the analytic spectrum); checked up front."""
-    from engines import engine_list
     if args.engine.strip() == "analytic":
         if args.dt is not None or args.convergence:
             raise ValueError("--dt and --convergence need --engine NAME (an engine)")
         return ()
-    names = engine_list(args.engine)
-    if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= 0.01):
-        raise ValueError(f"--dt must be in (0, 0.01] s, got {args.dt!r}")
+    names = parse_engine_list(args.engine)
+    if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_ENGINE_DT):
+        raise ValueError(f"--dt must be in (0, {MAX_ENGINE_DT:g}] s, got {args.dt!r}")
     return names
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
 from analytic.threshold_validity import invalid_spans, spectrum_validity
 from compare.run import atomic
-from compare.run.jsonable import plain as clean_nan
+from compare.run.jsonable import plain
 from scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",
@@ -364,6 +364,6 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     doc["n_runs"] = int(sum(s.n_runs for s in spectra.values()))
     doc["n_undecided"] = int(sum(s.n_undecided for s in spectra.values()))
     doc["wall_time"] = time.perf_counter() - t0
-    doc = clean_nan(doc)
+    doc = plain(doc)
     atomic.write_text(out / "figures.json", json.dumps(doc, indent=1, allow_nan=False))
     return doc

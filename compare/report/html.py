@@ -31,7 +31,7 @@ from compare.report.cells import unbroken
 from compare.report.recommend import recommendations
 from scenes import POINTS
 
-from compare.run.jsonable import plain as clean_nan
+from compare.run.jsonable import plain
 from compare.measure.trajectories import _plain
 from compare.report.trust import AGREEMENT_RULE, trust_table
 
@@ -44,7 +44,7 @@ from compare.campaign.summary import SCHEMA_VERSION  # noqa: E402
 
 def summary_dict(result, provenance: dict | None = None) -> dict:
     """``summary.json``: strict JSON (non-finite numbers become null)."""
-    doc = clean_nan(_plain(result.to_dict()))
+    doc = plain(_plain(result.to_dict()))
     prov = provenance or {}
     out = {"schema_version": SCHEMA_VERSION, "quick": bool(prov.get("quick", False)),
            "provenance": prov, **doc}
@@ -213,7 +213,7 @@ def add_model_validity(doc: dict, scene, workers: int = 1) -> dict:
     scenes = {"pendulum": scene, "no_pendulum": scene.without_pendulum()}
     for case, spec in doc.get("spectra", {}).items():
         if case in scenes and "model_validity" not in spec:
-            spec["model_validity"] = clean_nan(curve_validity(
+            spec["model_validity"] = plain(curve_validity(
                 scenes[case], spec["omega"], spec["a"], "sine", workers))
     return doc
 
