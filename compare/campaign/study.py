@@ -218,11 +218,11 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float):
 
 def threshold_description(job: tuple) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
-    from compare.run.keys import _engine_version, scene_dict, settings_dict
+    from compare.run.keys import backend_version, scene_dict, settings_dict
 
     n, c, p, w, a_ref, mode, e, dt, rb, rt = job
     scene = _scene(n, c)
-    return {"engine": e, "version": _engine_version(e), "scene": scene_dict(scene),
+    return {"engine": e, "version": backend_version(e), "scene": scene_dict(scene),
             "pulse": p, "omega": w, "a_ref": a_ref, "mode_ref": mode,
             "settings": settings_dict(job_settings(e, dt, scene, a_ref, w)),
             "rel_bracket": rb, "rel_tol": rt}

@@ -33,6 +33,8 @@ from compare.measure import trajectories as metrics
 
 
 from compare.run import runs
+from compare.run.jsonable import plain
+from compare.run.keys import backend_version
 from compare.measure.restitution import RestitutionResult, measure_restitution
 from compare.measure.reference_spectra import choose_frequencies, reference_spectrum
 from compare.measure.jump_shift import engine_jump_frequency
@@ -135,7 +137,7 @@ class CampaignConfig:
         return cls(**base)
 
     def to_dict(self) -> dict:
-        return metrics._plain(self)
+        return plain(self)
 
 
 def backend_settings(name: str, config: CampaignConfig, **options):
@@ -288,7 +290,7 @@ def _describe_args(args) -> list:
         if isinstance(a, CampaignConfig):
             continue
         out.append(a.to_dict() if hasattr(a, "to_dict") else a)
-    return metrics._plain(out)
+    return plain(out)
 
 
 # ------------------------------------------------------------------ campaign
@@ -333,8 +335,8 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     backends = tuple(dict.fromkeys((config.reference, config.spectrum_backend, *config.engines)))
     result = CampaignResult(
         config=config, scene=scene,
-        settings={b: metrics._plain(backend_settings(b, config)) for b in backends},
-        versions={b: metrics.backend_version(b) for b in (*backends, config.spectrum_backend)})
+        settings={b: plain(backend_settings(b, config)) for b in backends},
+        versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)})
 
     # Reference spectra first (in this process: the compiled kernels are then
     # inherited by the forked workers).

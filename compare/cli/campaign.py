@@ -166,9 +166,9 @@ def _bar(total: float):
 
 
 def _versions(study) -> dict:
-    from compare.run.keys import _engine_version, project_version
-    return {"project": project_version(), "analytic-fast": _engine_version("analytic-fast"),
-            **{e: _engine_version(e) for e in study.engines}}
+    from compare.run.keys import backend_version, project_version
+    return {"project": project_version(), "analytic-fast": backend_version("analytic-fast"),
+            **{e: backend_version(e) for e in study.engines}}
 
 
 def summarise(rows: list[dict]) -> list[dict]:

@@ -14,7 +14,6 @@ in :mod:`compare.measure.thresholds` (both run backends).
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from dataclasses import dataclass, field
 
@@ -23,8 +22,9 @@ import numpy as np
 from analytic.trajectory import Trajectory
 
 from compare.run.jsonable import plain
+from compare.run.keys import backend_version
 
-__all__ = ["Provenance", "TrajectoryComparison", "backend_version", "provenance_of",
+__all__ = ["Provenance", "TrajectoryComparison", "provenance_of",
            "settings_provenance", "compare_trajectories", "common_grid_values"]
 
 # |theta| [rad] that counts as uplifted when comparing uplift times: the engines'
@@ -35,21 +35,6 @@ UPLIFT_ANGLE = 1e-4
 # Grid step of the common time grid [s]: engines sample every ~1 ms and the
 # analytic path writes 1 ms samples; a finer grid only interpolates further.
 GRID_DT = 1e-3
-
-
-def _plain(value):
-    """JSON-friendly copy of a settings value (see :func:`compare.run.jsonable.plain`)."""
-    return plain(value)
-
-
-@functools.lru_cache(maxsize=None)
-def backend_version(name: str) -> str:
-    """``version()`` of a registered backend, or ``'unknown'`` if it has none."""
-    from engines import get_backend
-    try:
-        return str(get_backend(name).version())
-    except (ValueError, ImportError, AttributeError):
-        return "unknown"
 
 
 @dataclass(frozen=True)
@@ -66,13 +51,13 @@ class Provenance:
 
     def to_dict(self) -> dict:
         return {"backend": self.backend, "version": self.version, "dt": self.dt,
-                "settings": _plain(self.settings), "wall_time": self.wall_time,
+                "settings": plain(self.settings), "wall_time": self.wall_time,
                 "cpu_time": self.cpu_time}
 
 
 def provenance_of(traj: Trajectory, wall_time: float | None = None) -> Provenance:
     """The provenance of a trajectory (``dt`` is None for adaptive backends)."""
-    settings = _plain(traj.settings or {})
+    settings = plain(traj.settings or {})
     dt = settings.get("dt") if isinstance(settings, dict) else None
     cpu = (traj.diagnostics or {}).get("cpu_time")
     return Provenance(traj.backend, backend_version(traj.backend),
@@ -83,10 +68,10 @@ def provenance_of(traj: Trajectory, wall_time: float | None = None) -> Provenanc
 
 def settings_provenance(backend: str, settings, wall_time: float) -> Provenance:
     """Provenance of a result made of several runs with the same ``settings``."""
-    plain = _plain(settings) if settings is not None else {}
-    dt = plain.get("dt") if isinstance(plain, dict) else None
+    values = plain(settings) if settings is not None else {}
+    dt = values.get("dt") if isinstance(values, dict) else None
     return Provenance(backend, backend_version(backend),
-                      float(dt) if dt is not None else None, plain, float(wall_time))
+                      float(dt) if dt is not None else None, values, float(wall_time))
 
 
 # --------------------------------------------------------------------- angles

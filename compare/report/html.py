@@ -32,7 +32,6 @@ from compare.report.recommend import recommendations
 from scenes import POINTS
 
 from compare.run.jsonable import plain
-from compare.measure.trajectories import _plain
 from compare.report.trust import AGREEMENT_RULE, trust_table
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict", "add_model_validity",
@@ -44,7 +43,7 @@ from compare.campaign.summary import SCHEMA_VERSION  # noqa: E402
 
 def summary_dict(result, provenance: dict | None = None) -> dict:
     """``summary.json``: strict JSON (non-finite numbers become null)."""
-    doc = plain(_plain(result.to_dict()))
+    doc = plain(result.to_dict())
     prov = provenance or {}
     out = {"schema_version": SCHEMA_VERSION, "quick": bool(prov.get("quick", False)),
            "provenance": prov, **doc}

@@ -17,8 +17,8 @@ import json
 import math
 from pathlib import Path
 
-__all__ = ["run_key", "canonical_json", "digest", "project_version", "source_digest",
-           "code_version", "run_code", "scene_dict", "settings_dict", "excitation_dict",
+__all__ = ["backend_version", "run_key", "canonical_json", "digest", "project_version",
+           "source_digest", "code_version", "run_code", "scene_dict", "settings_dict", "excitation_dict",
            "CODE_SETS"]
 
 # The sets of source packages a key can depend on: the analytic backends
@@ -28,7 +28,9 @@ CODE_SETS = (("analytic",), ("analytic", "engines"), ("analytic", "engines", "co
 _ROOT = Path(__file__).resolve().parents[2]
 
 def _plain(value):
-    """JSON-ready form of dataclasses, numpy values, tuples (recursively)."""
+    """The canonical form hashed into a key: like :func:`compare.run.jsonable.plain`,
+    but a dataclass keeps its type's name and NaN/inf are strings, so two different
+    inputs never hash alike."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {"__type__": type(value).__name__,
                 **{f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}}
@@ -81,10 +83,12 @@ def _code_packages(backend: str) -> tuple[str, ...]:
 
 
 @functools.lru_cache(maxsize=None)
-def _engine_version(backend: str) -> str:
+@functools.lru_cache(maxsize=None)
+def backend_version(name: str) -> str:
+    """The version string of registered backend ``name`` (its ``version()``), the
+    one every key, result and report carries."""
     from engines import get_backend
-    module = get_backend(backend)
-    return module.version() if hasattr(module, "version") else "unknown"
+    return str(get_backend(name).version())
 
 
 def settings_dict(settings) -> dict:
@@ -119,7 +123,7 @@ def run_code(backend: str) -> str:
 
 def run_key(backend: str, scene, excitation, settings) -> str:
     """The store key of one backend run (``settings`` already resolved)."""
-    return digest({"kind": "run", "backend": backend, "engine": _engine_version(backend),
+    return digest({"kind": "run", "backend": backend, "engine": backend_version(backend),
                    "scene": scene_dict(scene), "excitation": excitation_dict(excitation),
                    "settings": settings_dict(settings), "project": project_version(),
                    "code": source_digest(_code_packages(backend))})
