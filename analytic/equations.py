@@ -17,7 +17,7 @@ equations are homogeneous in mass), so the model parameters are
 (``b -> -b``) maps one onto the other, which is how both are written here.
 
 Corrections to the print (see ``docs/paper-errata.md``; each is checked against
-an independent sympy derivation in ``tests/test_derivation.py``):
+an independent sympy derivation in ``tests/analytic/test_derivation.py``):
 
 * Eq. 8, first equation: the gravity term is ``g M (b cos(theta) - h sin(theta))``
   and the centripetal pendulum term ``l m4 psi_dot^2 (b cos(theta-psi) -

@@ -28,7 +28,7 @@ re-scanned interval is found, so the reported amplitude is the lowest
 overturning amplitude within ``+-w(A)`` (``+-tol`` where ``w = tol``, i.e. below
 ``window_step / window_rel_step``).  Limit: windows narrower than ``w(A)``, and
 windows inside quiet intervals, are not searched for; both are checked against
-an independent brute-force scan in ``tests/test_windows.py`` and
+an independent brute-force scan in ``tests/analytic/test_windows.py`` and
 ``benchmarks/bench_spectrum.py``.
 
 ``method='scan'`` is the previous search (coarse scan, then bisection, no

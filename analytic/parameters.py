@@ -8,7 +8,7 @@ columns are equal.  SI units throughout.
 
 The analytic model depends only on ``b, lam, mu, gamma, l, J_G/m1, g``; the gap,
 lintel shape, depth and hinge position are there for the engines (the paper shows,
-and ``tests/test_derivation.py`` re-derives, that the hinge position and the
+and ``tests/analytic/test_derivation.py`` re-derives, that the hinge position and the
 lintel's centre of mass drop out of the equations).
 """
 from __future__ import annotations

@@ -5,7 +5,7 @@ No finding is typed by hand: :func:`render` turns a stored summary (the full
 campaign's, kept in ``docs/validation/summary.json``) into the Markdown block
 between :data:`BEGIN` and :data:`END` in ``README.md``, :func:`render_trust` into
 the block between :data:`TRUST_BEGIN` and :data:`TRUST_END` in
-``docs/engine-trust.md``; ``tests/test_readme_findings.py`` checks that both
+``docs/engine-trust.md``; ``tests/compare/report/test_readme_findings.py`` checks that both
 files hold exactly that.
 
 Update after a new full campaign::

@@ -20,7 +20,7 @@ stated numeric dtype, and fills the fields of a dataclass the project defines
 (``object.__new__`` and ``object.__setattr__``: neither ``__init__`` nor
 ``__post_init__`` runs, so the object is the stored one field for field).
 Anything else, including an old pickle, raises :class:`ForeignValue`.
-Floats and arrays round-trip bit for bit (tests/test_store.py).
+Floats and arrays round-trip bit for bit (tests/compare/run/test_store.py).
 """
 from __future__ import annotations
 

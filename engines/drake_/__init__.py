@@ -149,7 +149,7 @@ class DrakeEngine(Engine):
         "pendulum_follows_eq1": "compliant contact: the swinging pendulum tilts the frame "
                                 "elastically by 3.3e-6 rad, above the check's 1e-6 rad for "
                                 "'stayed down' (uplift is 1e-4 rad); psi follows Eq. 1 within "
-                                "9.2e-6 rad, 2.8e-4 rad/s (tests/test_drake_engine.py)",
+                                "9.2e-6 rad, 2.8e-4 rad/s (tests/engines/test_drake_engine.py)",
         "restitution_eq19_lam3": "Eq. 19 at lam 3: first impact -0.52 %, third +0.51 % "
                                  "(tolerance 0.5 %): the compliant contact's impact loss "
                                  "scatters +-0.4 % at lam 3 with any damping ratio tried "

@@ -124,7 +124,7 @@ def lintel_state(client: int, bodies: Bodies) -> tuple[tuple, tuple, tuple, tupl
 # Idle DIRECT clients kept for the next World: connecting costs 10-20 ms, about
 # a tenth of a short run (benchmarks/bench_overhead.py).  Every World resets its
 # client (resetSimulation, every engine parameter set again), so a reused client
-# gives the same numbers, bit for bit, as a new one (tests/test_pybullet_small_step.py).
+# gives the same numbers, bit for bit, as a new one (tests/engines/test_pybullet_small_step.py).
 _IDLE_CLIENTS: list[int] = []
 _MAX_IDLE_CLIENTS = 2
 

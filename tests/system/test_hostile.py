@@ -24,7 +24,7 @@ from compare.cli.main import main
 from compare.run import atomic, runs
 from compare.run.store import DB_NAME, RunStore
 
-ROOT = Path(__file__).resolve().parents[2]
+from tests.support.paths import ROOT
 TRILITH = [sys.executable, "-m", "compare.cli.main"]
 
 

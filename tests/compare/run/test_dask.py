@@ -1,0 +1,83 @@
+"""The Dask path of compare.run.runs.run_many against the local one, on a real local
+cluster: a scheduler and two worker processes (``LocalCluster(processes=True)``:
+each worker is a separate Python process started by its nanny)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from compare.run import runs
+from compare.campaign.validation import CampaignConfig, _run_one
+from compare.run.store import RunStore
+from tests.support.trajectories import assert_same_trajectory
+
+distributed = pytest.importorskip("distributed")
+from tests.support.paths import ROOT
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    # The workers import compare/ from this checkout.
+    os.environ["PYTHONPATH"] = os.pathsep.join(
+        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None, silence_logs=40) as c:
+        yield c
+
+
+def _jobs(fig5):
+    """Campaign history jobs: pymunk at the paper's A and D, coarse steps (fast)."""
+    config = CampaignConfig(engines=("pymunk",), engine_dt=5e-4)
+    return [("history", ("pymunk", scene, point, config))
+            for scene in (fig5, fig5.without_pendulum()) for point in ("A", "D")]
+
+
+def test_dask_results_equal_local_results(cluster, fig5):
+    jobs = _jobs(fig5)
+    local = [out for out, *_ in runs.run_many(_run_one, jobs, workers=2)]
+    remote = [out for out, *_ in runs.run_many(_run_one, jobs,
+                                               scheduler=cluster.scheduler_address)]
+    assert len(remote) == len(jobs)
+    for a, b in zip(local, remote):
+        assert_same_trajectory(a, b, timings=False)
+
+
+def test_dask_workers_fill_the_callers_store(cluster, fig5, tmp_path):
+    jobs = _jobs(fig5)
+    store = RunStore(tmp_path)
+    with runs.using(store):
+        remote = [out for out, *_ in runs.run_many(_run_one, jobs,
+                                                   scheduler=cluster.scheduler_address)]
+        assert store.count("run") == len(jobs)  # stored by the workers
+        runs.STATS.clear()
+        again = [out for out, *_ in runs.run_many(_run_one, jobs, workers=1)]
+        assert runs.STATS["hits"] == len(jobs) and runs.STATS["computed"] == 0
+    for a, b in zip(remote, again):
+        assert_same_trajectory(a, b)  # what the cluster computed, bit for bit
+
+
+def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
+    def spectrum(*extra):
+        proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega",
+                               "8:14:2", "--json", "--no-cache", *extra], cwd=ROOT,
+                              env=os.environ, capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr
+        doc = json.loads(proc.stdout)
+        doc.pop("timings")  # wall times live apart from the results
+        return doc
+    assert spectrum("--scheduler", cluster.scheduler_address) == spectrum("--workers", "2")
+
+
+def test_unreachable_scheduler_is_a_usage_error():
+    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10",
+                           "--no-cache", "--scheduler", "tcp://127.0.0.1:9"], cwd=ROOT,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines()[-1].startswith("error: --scheduler")
+

@@ -1,0 +1,1 @@
+"""Code the tests share (fixtures live in tests/conftest.py)."""
