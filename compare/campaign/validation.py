@@ -64,9 +64,9 @@ class Tolerances:
             "restitution_pendulum": "Eq. 19 at the measured psi: same 0.5 % as Eq. 20, since "
                                     "its relative slope in psi is <= 0.11/rad (a 0.01 rad psi "
                                     "error costs < 0.1 %)",
-            "threshold": "2 % of the overturning amplitude, 10x the 0.2 % bisection bracket "
-                         "(a miss is a measured difference, not bracket noise); away from mode "
-                         "jumps, where the threshold is discontinuous in Omega",
+            "threshold": "2 % of the overturning amplitude, 4x the 0.5 % bracket of the "
+                         "robust search (a miss is a measured difference, not bracket noise); "
+                         "away from mode jumps, where the threshold is discontinuous in Omega",
             "theta_rms_first": "worst measured 3e-4 of alpha at the calibrated 1e-4 s step; the "
                                "error grows ~linearly with dt (3.5e-3 at 2e-3 s), 1e-3 rejects "
                                "steps >= 1e-3 s",

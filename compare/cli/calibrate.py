@@ -161,7 +161,8 @@ def run(args: argparse.Namespace) -> int:
             atomic.write_text(args.settings_out, settings_toml(engine, rec.options, (
                 f"trilith calibrate --engine {engine} --metric {args.metric} "
                 f"--scene {scene.name}\nworst error {rec.worst_error:.3g} "
-                f"(tolerance {cal.tolerance:g}), {rec.cpu_s:.3g} CPU s on the validation set")))
+                f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the validation "
+                f"set")))
             info(f"wrote {args.settings_out}")
     return 0 if rec is not None else 1
 
@@ -175,12 +176,14 @@ def _print(cal) -> None:
     load = ", ".join(f"{x:.2f}" for x in cal.load_average)
     print(f"{cal.engine} ({cal.version}), metric {cal.metric}, tolerance {cal.tolerance:g}, "
           f"load average {load}")
-    print(f"{'settings':<34} {'worst error':>11} {'CPU [s]':>8} {'CPU/sim':>8} {'runs':>5}")
-    for e in sorted(cal.evaluations, key=lambda e: e.cpu_s):
+    print(f"{'settings':<30} {'worst error':>11} {'engine CPU [s]':>14} {'CPU/sim s':>9} "
+          f"{'all CPU [s]':>11} {'runs':>5}")
+    for e in sorted(cal.evaluations, key=lambda e: e.engine_cpu_s):
         mark = ("<- recommended" if e is rec else "front" if id(e) in front else "")
         rtf = e.real_time_factor
-        print(f"{_label(e.options):<34} {e.worst_error:11.3g} {e.cpu_s:8.3g} "
-              f"{(f'{rtf:.3g}' if math.isfinite(rtf) else '-'):>8} {e.runs:5d}  {mark}")
+        print(f"{_label(e.options):<30} {e.worst_error:11.3g} {e.engine_cpu_s:14.3g} "
+              f"{(f'{rtf:.3g}' if math.isfinite(rtf) else '-'):>9} {e.cpu_s:11.3g} "
+              f"{e.runs:5d}  {mark}")
     if rec is None:
         print(f"no candidate meets {cal.tolerance:g}: widen the search (--dt, --vary) "
               f"or the tolerance")
@@ -189,11 +192,12 @@ def _print(cal) -> None:
 def _csv(cal) -> str:
     names = list(cal.evaluations[0].options) if cal.evaluations else []
     front = {id(e) for e in cal.front}
-    lines = [",".join([*names, "worst_error", "cpu_s", "simulated_s", "cpu_per_simulated_s",
-                       "runs", "on_front", "recommended"])]
+    lines = [",".join([*names, "worst_error", "engine_cpu_s", "cpu_s", "simulated_s",
+                       "engine_cpu_per_simulated_s", "runs", "on_front", "recommended"])]
     for e in cal.evaluations:
         lines.append(",".join([*(repr(e.options[n]) for n in names), repr(e.worst_error),
-                               repr(e.cpu_s), repr(e.simulated_s), repr(e.real_time_factor),
+                               repr(e.engine_cpu_s), repr(e.cpu_s), repr(e.simulated_s),
+                               repr(e.real_time_factor),
                                str(e.runs), str(id(e) in front).lower(),
                                str(e is cal.recommended).lower()]))
     return "\n".join(lines) + "\n"

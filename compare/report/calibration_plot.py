@@ -16,23 +16,23 @@ def pareto_plot(cal, path) -> None:
 
     from compare.run import atomic
 
-    pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.cpu_s > 0]
+    pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.engine_cpu_s > 0]
     front = [e for e in cal.front if e in pts]
     fig, ax = plt.subplots(figsize=(7.0, 4.6), dpi=150, layout="constrained")
-    ax.scatter([e.cpu_s for e in pts], [max(e.worst_error, 1e-6) for e in pts], s=28,
+    ax.scatter([e.engine_cpu_s for e in pts], [max(e.worst_error, 1e-6) for e in pts], s=28,
                color="0.55", label="candidate", zorder=2)
     if front:
-        ax.plot([e.cpu_s for e in front], [max(e.worst_error, 1e-6) for e in front], "-o",
+        ax.plot([e.engine_cpu_s for e in front], [max(e.worst_error, 1e-6) for e in front], "-o",
                 color="C0", ms=5, lw=1.5, label="Pareto front", zorder=3)
     for e in pts:
-        ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()), (e.cpu_s,
+        ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()), (e.engine_cpu_s,
                     max(e.worst_error, 1e-6)), textcoords="offset points", xytext=(5, 4),
                     fontsize=8, color="0.25")
     ax.axhline(cal.tolerance, color="C3", ls="--", lw=1.2,
                label=f"tolerance {cal.tolerance:g}")
     rec = cal.recommended
     if rec is not None:
-        ax.scatter([rec.cpu_s], [max(rec.worst_error, 1e-6)], s=140, facecolors="none",
+        ax.scatter([rec.engine_cpu_s], [max(rec.worst_error, 1e-6)], s=140, facecolors="none",
                    edgecolors="C2", linewidths=2, label="recommended (cheapest within)",
                    zorder=4)
     ax.set_xscale("log")
@@ -40,7 +40,7 @@ def pareto_plot(cal, path) -> None:
     unit = {"restitution": "relative error vs Eq. 19/20",
             "thresholds": "relative threshold error",
             "histories": "theta RMS / alpha before the first impact"}[cal.metric]
-    ax.set_xlabel("CPU time on the validation set [s]")
+    ax.set_xlabel("engine CPU time on the validation set [s]")
     ax.set_ylabel(f"worst error ({unit})")
     load = ", ".join(f"{x:.2f}" for x in cal.load_average)
     ax.set_title(f"{cal.engine}: {cal.metric}, {cal.validation.scene} (load {load})",
