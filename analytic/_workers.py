@@ -41,13 +41,27 @@ def init_worker(parent_pid: int) -> None:
     _die_with_parent(parent_pid)
 
 
+class _ForkPool(ProcessPoolExecutor):
+    """Forks its workers with SIGINT blocked.  A Ctrl-C that lands during a fork
+    would otherwise raise inside an at-fork handler (logging's lock release), where
+    Python reports it as "Exception ignored" and drops it: the command ran on.
+    Blocked, it stays pending and is raised in the caller once the fork is done."""
+
+    def submit(self, *args, **kwargs):
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            return super().submit(*args, **kwargs)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 @contextlib.contextmanager
 def fork_pool(workers: int):
     """A forked :class:`ProcessPoolExecutor` of ``workers`` processes (see the module
     docstring).  Leaving the block normally waits for the work; leaving it by an
     exception (Ctrl-C, an error, a generator closed early) kills the workers now."""
-    ex = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                             initializer=init_worker, initargs=(os.getpid(),))
+    ex = _ForkPool(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                   initializer=init_worker, initargs=(os.getpid(),))
     finished = False
     try:
         yield ex
