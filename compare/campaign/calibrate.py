@@ -195,10 +195,8 @@ def _restitution(engine, scene, vs: ValidationSet, options):
     return errors, engine_cpu, simulated, runs
 
 
-def _thresholds(engine, scene, vs: ValidationSet, options, workers):
-    from analytic.spectrum import overturning_spectrum
+def _thresholds(engine, scene, reference, options, workers):
     from compare.measure.engine_spectrum import engine_spectrum
-    reference = overturning_spectrum(scene, list(vs.omegas))
     es = engine_spectrum(engine, scene, reference, workers=workers, **options)
     errors, engine_cpu, runs = [], 0.0, 0
     for curve, points in es.curves.items():
@@ -281,12 +279,17 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
                       load_average=os.getloadavg())
     with runs.using(None):  # measured costs: nothing served from a store
+        reference = None
+        if metric == "thresholds":  # the model's spectrum, once for every candidate
+            from analytic.spectrum import overturning_spectrum
+            reference = overturning_spectrum(scene, list(vs.omegas))
         for i, cand in enumerate(candidates):
             cpu0 = cpu_seconds()
             if metric == "restitution":
                 errors, engine_cpu, simulated, n = _restitution(engine, scene, vs, cand)
             elif metric == "thresholds":
-                errors, engine_cpu, simulated, n = _thresholds(engine, scene, vs, cand, workers)
+                errors, engine_cpu, simulated, n = _thresholds(engine, scene, reference, cand,
+                                                               workers)
             else:
                 errors, engine_cpu, simulated, n = _histories(engine, scene, vs, cand)
             values = [e for _, e in errors]

@@ -35,6 +35,7 @@ def pareto_plot(cal, path) -> None:
         ax.scatter([rec.engine_cpu_s], [max(rec.worst_error, 1e-6)], s=140, facecolors="none",
                    edgecolors="C2", linewidths=2, label="recommended (cheapest within)",
                    zorder=4)
+    ax.margins(x=0.2, y=0.15)  # room for the labels at the ends
     ax.set_xscale("log")
     ax.set_yscale("log")
     unit = {"restitution": "relative error vs Eq. 19/20",
