@@ -49,8 +49,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="analytic (the model's spectrum), or engines to bisect on the same "
                              f"grid around it: {', '.join(engine_names())}, or all")
     parser.add_argument("--dt", type=float, default=None, metavar="S",
-                        help="engine time step [s], in (0, 0.01] (default: each engine's "
-                             "calibrated step)")
+                        help=f"engine time step [s], in (0, {MAX_ENGINE_DT:g}] (default: each "
+                             "engine's calibrated step)")
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
                              "solver iterations to classify the cause")

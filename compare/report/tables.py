@@ -39,6 +39,8 @@ def _value(v: dict, bracket: float | None = None) -> str:
         return fmt_pct(x)
     if unit == "fraction of alpha":
         return f"{fmt_sci(x)} α"
+    if unit == "m":
+        return f"{fmt_sci(x)} m"
     return str(x)
 
 
@@ -48,6 +50,8 @@ def _tolerance(v: dict) -> str:
         return f"≤ {fmt_pct(tol)}"
     if unit == "fraction of alpha":
         return f"≤ {fmt_sci(tol)} α"
+    if unit == "m":
+        return f"≤ {fmt_sci(tol)} m"
     return f"≤ {tol}"
 
 
@@ -137,7 +141,7 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
             ("overturning thresholds agree up to", f"within {fmt_pct(tols['threshold'])}",
              thresholds),
             ("where thresholds disagree: measured cause", "", causes),
-            ("cost per run: median wall time at A-D", "", lambda r: cost(r, "run")),
+            ("cost per run: median CPU time at A-D", "", lambda r: cost(r, "run")),
             ("cost per threshold point and per spectrum", "", lambda r: cost(r, "spectrum")),
             ("settings that achieve it", "", settings),
             ("verdicts passed", "", lambda r: _cell(

@@ -164,7 +164,7 @@ CLI_CASES = [
     (["report", "--engine", "pymunk,pymunk"], "named twice"),
     (["report", "--engine", "havok"], "unknown engine"),
     (["report", "--dt", "1e-9"], "over the budget of 5e+06"),
-    (["report", "--dt", "0.02"], "--dt must be in (0, 0.01] s"),
+    (["report", "--dt", "0.2"], "--dt must be in (0, 0.1] s"),
     (["report", "--dt", "-1"], "--dt must be in"),
     (["report", "--workers", "0"], "--workers"),
     (["report", "--scene", "{bad_b}"], "bad_b.toml"),

@@ -138,7 +138,7 @@ def test_record_with_bom_keeps_its_first_sample(here, capsys):
      "--dt (with --convergence: dt/4)"),
     (["report", "--quick", "--dt", "1e-5", "--out", "r"], "--dt: a pybullet run"),
     (["calibrate", "--engine", "pymunk", "--dt", "1e-9"], "--dt: a pymunk run"),
-    (["calibrate", "--engine", "pymunk", "--dt", "-1"], "each step must be in (0, 0.01] s"),
+    (["calibrate", "--engine", "pymunk", "--dt", "-1"], "each step must be in (0, 0.1] s"),
 ])
 def test_option_refused_in_one_line(argv, needle, here, capsys):
     before = snapshot(here)
