@@ -1,4 +1,4 @@
-"""Harness overhead (issue 3): ``simulate()`` through the registry against the
+"""Harness overhead: ``simulate()`` through the registry against the
 engine's bare stepping loop, same scene, same step, same number of steps.
 
 Case: the Fig. 5 trilith at point B (one-sine, A = 4 m/s^2, Omega = 9 rad/s),
@@ -11,7 +11,7 @@ step to ``t_max`` and reports the number of steps in ``diagnostics["steps"]``.
   then one ``advance(steps)``: the base-motion gravity update (d'Alembert load
   at mid-step, exactly as a run computes it) and the engine's step call.  World
   construction is timed apart ("build"; PyBullet: a new DIRECT client, ~5-20 ms)
-  and left out of the bare step rate, as issue 3 words it ("bare stepping
+  and left out of the bare step rate, as the acceptance words it ("bare stepping
   loop"); "ratio incl. build" adds it to the bare side (what a bare *run*
   costs), for reference.
 * **harness**: ``engines.simulate(name, scene, excitation, settings)``, timed
@@ -19,7 +19,7 @@ step to ``t_max`` and reports the number of steps in ``diagnostics["steps"]``.
   ``sample_every`` steps with the run monitor and the blow-up checks, the
   impact-velocity fits and the Trajectory.
 
-Acceptance: harness steps/s >= 90 % of bare steps/s (issue 15).  Timing: one warm-up of
+Acceptance: harness steps/s >= 90 % of bare steps/s.  Timing: one warm-up of
 each, then ``REPEATS`` repetitions with bare and harness interleaved (order
 alternating) so that load changes hit both; medians are compared (and, as
 "pairwise", the median of the per-pair ratios).  The check
@@ -43,7 +43,7 @@ from . import machine, write
 POINT_B = (4.0, 9.0)  # A [m/s^2], Omega [rad/s]: rocks, one impact, survives
 T_MAX = 0.6  # s; inside the 0.698 s pulse, so nothing stops the run before t_max
 REPEATS = 15  # interleaved pairs; ~25 s in all; the median ignores up to 7 disturbed pairs
-TARGET = 0.9  # issue 15: the harness keeps >= 90 % of the bare step rate
+TARGET = 0.9  # the harness keeps >= 90 % of the bare step rate
 
 
 # ------------------------------------------------------------------ bare loops

@@ -1,6 +1,6 @@
 """Fig. 5 overturning spectra with the compiled fast path, both curves, tol 0.01.
 
-* coarse: Omega = 3..30 step 1 (28 frequencies), 2 workers; target <= 0.5 s (issue 16);
+* coarse: Omega = 3..30 step 1 (28 frequencies), 2 workers; target <= 0.5 s;
 * fine: Omega = 3..30 step 0.1 (271 frequencies), 2 workers; target <= 3 s;
 * ratios: the window-aware search (default) against the previous search
   (``method='scan'``), same run, same machine;
@@ -30,7 +30,7 @@ COARSE = np.arange(3.0, 31.0, 1.0)
 FINE = np.round(np.arange(30, 301) * 0.1, 10)
 CHECK = np.array([3.0, 5.0, 7.0, 8.0, 10.0, 11.0, 17.0, 18.0])
 TARGET_COARSE_S, GOAL_COARSE_S, TARGET_FINE_S = 0.5, 0.5, 3.0
-OLD = SpectrumSettings(method="scan", fast=fast.Settings())  # the search before issue 16 (rtol 1e-8)
+OLD = SpectrumSettings(method="scan", fast=fast.Settings())  # the previous search (rtol 1e-8)
 
 
 def main(argv: list[str] | None = None) -> int:

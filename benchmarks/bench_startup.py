@@ -1,4 +1,4 @@
-"""Process start-up of ``trilith spectrum`` (issue 16): wall time of a whole
+"""Process start-up of ``trilith spectrum``: wall time of a whole
 one-frequency call, and where it goes (``python -X importtime`` top-level
 modules, then the compiled-cache load measured by ``fast.warm_up``)."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Work-precision benchmarks: run time against error for every backend (issue 6).
+"""Work-precision benchmarks: run time against error for every backend.
 
 ``make bench`` (via ``benchmarks/run.py``) and ``trilith bench [--quick] [--out DIR]``
 call :func:`main`.  It measures

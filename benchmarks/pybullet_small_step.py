@@ -1,4 +1,4 @@
-"""Why PyBullet got *worse* as its step shrank (issue 15, item 4): a dt sweep.
+"""Why PyBullet got *worse* as its step shrank: a dt sweep.
 
 Not part of ``make bench`` (a study, ~5 min on one core)::
 
@@ -15,7 +15,7 @@ one suspect at a time at dt = 2.5e-5 s.  Cases:
   analytic threshold at Omega = 12 rad/s (pendulum, A* = 19.95 m/s^2) and
   Omega = 16 rad/s (no pendulum, A* = 18.93 m/s^2), and free rocking from
   alpha/2 (lam 3, 5, 7, mu 1, no pendulum; restitution vs Eq. 20, 4 impacts);
-* where issue 15 saw the failures: Omega = 24 rad/s, A = 55, 60, 64 m/s^2 with
+* where the failures were first seen: Omega = 24 rad/s, A = 55, 60, 64 m/s^2 with
   the pendulum, and ``lam = 30``, A = 19 m/s^2, Omega = 15 rad/s.
 
 Each run records the verdict, max |theta| / alpha, the world's diagnostics

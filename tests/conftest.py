@@ -15,7 +15,7 @@ from analytic.parameters import Scene
 from scenes import load_scene
 
 # Every CLI run of the suite (in process or a subprocess) uses a throwaway run
-# store, never the user's cache (issue 12).
+# store, never the user's cache.
 os.environ["TRILITH_CACHE"] = tempfile.mkdtemp(prefix="trilith-test-cache-")
 atexit.register(shutil.rmtree, os.environ["TRILITH_CACHE"], True)
 

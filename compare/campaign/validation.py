@@ -47,10 +47,10 @@ __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
 class Tolerances:
     """Acceptance tolerances of the verdict table, each with its reason."""
 
-    restitution: float = 0.005  # issue's acceptance: Eq. 20 within 0.5 %
+    restitution: float = 0.005  # acceptance: Eq. 20 within 0.5 %
     restitution_pendulum: float = 0.005  # Eq. 19 at the measured psi: its relative slope in psi
     #   is <= 0.11 /rad on the lam 3-7 grid, so even a 0.01 rad psi error costs < 0.1 %
-    threshold: float = 0.02  # issue's acceptance: overturning amplitude within 2 % away from jumps
+    threshold: float = 0.02  # acceptance: overturning amplitude within 2 % away from jumps
     theta_rms_first: float = 1e-3  # theta RMS / alpha before the first impact: worst measured
     #   3e-4 with calibrated defaults; grows ~linearly with dt (Pymunk, A: 1.2e-4, 7.6e-4, 1.6e-3,
     #   3.5e-3 at 1e-4, 5e-4, 1e-3, 2e-3 s), so 1e-3 rejects steps >= 1e-3 s
@@ -83,8 +83,8 @@ class CampaignConfig:
     reference: str = "analytic"  # accurate scipy path for time histories
     spectrum_backend: str = "analytic-fast"  # compiled path: a spectrum costs ~1 s
     points: tuple[str, ...] = ("A", "B", "C", "D")  # the paper's labelled cases
-    restitution_lams: tuple[float, ...] = (3.0, 5.0, 7.0)  # issue's grid
-    restitution_mus: tuple[float, ...] = (0.5, 1.0, 2.0)  # issue's grid
+    restitution_lams: tuple[float, ...] = (3.0, 5.0, 7.0)  # lam 3-7 x mu 0.5-2, the paper's range
+    restitution_mus: tuple[float, ...] = (0.5, 1.0, 2.0)  # lam 3-7 x mu 0.5-2, the paper's range
     pendulum_lams: tuple[float, ...] = (3.0, 5.0, 7.0)  # Eq. 19 runs (scene's mu, gamma)
     theta0_fraction: float = 0.5  # release tilt / alpha: well inside the well, fast impacts
     n_impacts: int = 4  # per free-rocking run: two of each side, as compare/measure/restitution.py

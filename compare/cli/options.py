@@ -393,7 +393,7 @@ def print_json(obj) -> None:
 
 
 
-# --- run store, scheduler and interruption (issue 12; appended by the store12 helper) ---
+# --- run store, scheduler and interruption ---
 def add_store_args(parser: argparse.ArgumentParser, scheduler: bool = False) -> None:
     """``--cache DIR``, ``--no-cache`` and, with ``scheduler``, ``--scheduler ADDRESS``."""
     from compare.run.store import default_cache_dir

@@ -31,7 +31,7 @@ __all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "measure_point",
            "pulse_settings", "CAUSES", "DEFAULT_TOL", "DEFAULT_REL_TOL"]
 
 CAUSES = ("agrees", *PRIMARY_ORDER, "unknown")
-DEFAULT_TOL = 0.02  # agreement tolerance on the threshold (the 2 %)
+DEFAULT_TOL = 0.02  # agreement tolerance on the threshold (2 %)
 DEFAULT_REL_TOL = SEARCH.rel_tol  # final bracket width / A_analytic: 0.5 %
 
 

@@ -41,7 +41,7 @@ def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
     from compare.run.keys import scene_dict
 
     ss = SpectrumSettings()
-    # One stored threshold point per frequency (the run store, issue 12).
+    # One stored threshold point per frequency (the run store).
     res = [runs.memo("point", {"scene": scene_dict(scene), "omega": float(w),
                                "settings": ss.describe()},
                      lambda w=w: first_overturn_amplitude(scene, float(w), ss)) for w in omegas]

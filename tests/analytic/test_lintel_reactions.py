@@ -1,7 +1,7 @@
 """Force of the column tops on the lintel along an analytic run
 (``analytic/contact_forces.py``, ``analytic/reactions.py``): the static value,
 the formula against finite differences of the Eq. 5 positions, continuity at
-uplift, the values issue 15 quotes, and ``check_model``."""
+uplift, the values first quoted for them, and ``check_model``."""
 from __future__ import annotations
 
 import math
@@ -79,14 +79,14 @@ def test_run_below_uplift_keeps_the_lintel_on(fig5):
 
 @pytest.mark.parametrize("scene_name, amplitude, omega, fd_min_below", [
     ("fig5", 10.0, 9.0, None),  # C: rocking with impacts
-    ("fig5", 55.0, 24.0, 0.05),  # issue 15: the lintel's normal down to 0.04 of its weight
-    ("fig5_bare", 60.0, 25.0, 0.0),  # issue 15: the lintel would be thrown off
+    ("fig5", 55.0, 24.0, 0.05),  # the lintel's normal down to 0.04 of its weight
+    ("fig5_bare", 60.0, 25.0, 0.0),  # the lintel would be thrown off
 ])
 def test_lintel_force_matches_finite_differences_of_eq5_positions(
         request, scene_name, amplitude, omega, fd_min_below):
     scene = request.getfixturevalue(scene_name)
     pulse = Pulse(amplitude, omega)
-    # 'topple': the issue-15 runs pass alpha (max |theta| 0.25 rad) and come back.
+    # 'topple': these runs pass alpha (max |theta| 0.25 rad) and come back.
     st = Settings(t_max=1.5, sample_dt=5e-4, criterion=OverturnCriterion("topple"))
     tr = simulate(scene, pulse, st)
     idx, f_fd = _fd_lintel_force(scene, pulse, tr)
@@ -140,18 +140,18 @@ def test_lintel_force_is_continuous_at_a_simulated_uplift(fig5, run_analytic):
         assert rock == pytest.approx(rest, abs=1e-12 * (fig5.mu + fig5.gamma) * fig5.g)
 
 
-# Issue 15's estimates (two digits) and this module's values, measured with the
+# The first estimates (two digits) and this module's values, measured with the
 # default settings: 0.0368, 8.18 (A 55); -0.257 (A 64); -0.0786 (bare, A 60 at 25).
 ISSUE15 = [("fig5", 55.0, 24.0, 0.04, 8.2), ("fig5", 64.0, 24.0, -0.26, None),
            ("fig5_bare", 60.0, 25.0, -0.08, None)]
 
 
 @pytest.mark.parametrize("scene_name, amplitude, omega, normal, demand", ISSUE15)
-def test_issue15_values_are_reproduced(request, run_analytic, scene_name, amplitude, omega,
+def test_first_quoted_values_are_reproduced(request, run_analytic, scene_name, amplitude, omega,
                                        normal, demand):
     scene = request.getfixturevalue(scene_name)
     d = run_analytic(scene, amplitude, omega).diagnostics
-    # Half a unit of the issue's last quoted digit.
+    # Half a unit of the last quoted digit.
     assert d["min_lintel_normal"] == pytest.approx(normal, abs=0.005)
     if demand is not None:
         assert d["max_lintel_friction_demand"] == pytest.approx(demand, abs=0.05)

@@ -1,5 +1,5 @@
 """The model's validity along a threshold curve (analytic/threshold_validity.py)
-and its shading: the Fig. 5 trilith at the issue's pulse (A = 74.9 m/s^2 = 7.6 g,
+and its shading: the Fig. 5 trilith at the pulse (A = 74.9 m/s^2 = 7.6 g,
 Omega = 26 rad/s = 4.1 Hz) throws the lintel off; a low pulse keeps every contact."""
 from __future__ import annotations
 

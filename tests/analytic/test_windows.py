@@ -1,4 +1,4 @@
-"""Overturning windows (issue 16): the spectrum search must not step over a
+"""Overturning windows: the spectrum search must not step over a
 narrow first overturning window.  Checked against an independent brute-force
 scan: every amplitude on a 0.005 m/s^2 grid, one :func:`analytic.fast.verdict_for`
 call each (no batching, no scan/bisection logic), on the Fig. 5 scene with the

@@ -1,4 +1,4 @@
-"""The MuJoCo backend: what is MuJoCo-specific, plus its acceptance checks (issue 13).
+"""The MuJoCo backend: what is MuJoCo-specific, plus its acceptance checks.
 
 Acceptance: free rocking against Eq. 20 (lam 3/5/7 x mu 0.5/1/2) and Eq. 19
 (pendulum, lam 3/5/7) within 0.5 %; the paper's verdicts and modes at A-D with

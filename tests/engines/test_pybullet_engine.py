@@ -1,4 +1,4 @@
-"""The PyBullet backend against the analytic model (issue 3 acceptance).
+"""The PyBullet backend against the analytic model.
 
 Free rocking against Eq. 20 / 19, the Fig. 5 verdicts at the paper's points A-D,
 "gravity" vs "ground" base motion, conventions (signs of theta and psi), bad
@@ -23,7 +23,7 @@ from engines.pybullet_ import world as ps
 from compare.measure.restitution import measure_restitution
 from scenes import load_scene
 
-# Restitution tolerance (issue acceptance): 0.5 %.  The measured errors are
+# Restitution tolerance: 0.5 %.  The measured errors are
 # ~0.03 % (median); the margin covers the engine's impact spread over 1-2 steps,
 # not a known bias (see the Settings notes: outliers come from columns landing in
 # different steps, which these releases do not show; column mismatch < 1e-5 rad).
@@ -31,7 +31,7 @@ RESTITUTION_TOL = 5e-3
 
 
 # Paper points (A_s [m/s^2], Omega [rad/s]) and the analytic expectations stated
-# in the issue, with and without the pendulum.
+# in the acceptance, with and without the pendulum.
 def test_theta_sign_convention():
     """theta0 > 0 leans left: the left column's left bottom corner stays the pivot,
     the trilith falls back towards theta = 0 and rocks onto the right corners."""

@@ -1,4 +1,4 @@
-"""PyBullet below its calibrated step (issue 15, item 4; docs/engine-trust.md,
+"""PyBullet below its calibrated step (docs/engine-trust.md,
 "PyBullet at small steps"), and the reused DIRECT clients (item 6).
 
 Before the fix the harness kept two per-step solver settings fixed at every

@@ -1,6 +1,6 @@
 """Regression: every engine tied to the paper's equations with its calibrated defaults.
 
-* free rocking restitution against Eq. 20 within 0.5 % (the issue's acceptance)
+* free rocking restitution against Eq. 20 within 0.5 % (the acceptance tolerance)
   on a small lam x mu grid (the grid's corners and centre);
 * with the pendulum, against Eq. 19 at the measured psi, within the campaign's
   stated tolerance (``Tolerances.restitution_pendulum``);

@@ -1,4 +1,4 @@
-"""Numerical stability under stress (issue 6): extreme parameters, Zeno impacts,
+"""Numerical stability under stress: extreme parameters, Zeno impacts,
 near-threshold determinism, engine reruns and blow-up detection.
 
 The grid of the brief -- lam 1.5..30, mu 0..10, gamma 0..1, l from h/10 to 2h,

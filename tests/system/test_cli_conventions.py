@@ -1,4 +1,4 @@
-"""The CLI behaves like the tools users know (issue 11): --version, a quiet closed
+"""The CLI behaves like the tools users know: --version, a quiet closed
 pipe, --strict, one --engine spelling, --workers -1, -q/-v, JSON that echoes its
 inputs and reruns byte-identically, `trilith scenes`, recorded ground motions."""
 from __future__ import annotations

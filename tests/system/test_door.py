@@ -1,4 +1,4 @@
-"""Every bad input refused at the door (issue 11): a matrix of CLI and API cases.
+"""Every bad input refused at the door: a matrix of CLI and API cases.
 
 CLI: exit code 2, exactly one line on stderr starting ``error:`` and naming the
 option, no traceback, and no work started: the ``no_work`` fixture replaces every

@@ -188,7 +188,7 @@ def test_jump_is_located_on_the_model_not_the_grid():
 
 
 def test_same_point_same_cause_with_any_grid(monkeypatch):
-    """The issue's three grids around Omega 12 (no pendulum): the point's causes come
+    """Three grids around Omega 12 (no pendulum): the point's causes come
     from the point and the model, never from its neighbours on the grid.  The engine is
     a fake that overturns 3 % low at every frequency (no engine run)."""
     from compare.measure import thresholds as thr

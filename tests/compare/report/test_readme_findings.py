@@ -56,5 +56,5 @@ def test_stored_summary_is_a_full_campaign_with_a_consistent_trust_table(doc):
 
 
 def test_no_stale_hand_typed_threshold_claim():
-    # Issue 14: "within 0.4 % up to about 53 m/s^2" contradicted the report.
+    # Once: "within 0.4 % up to about 53 m/s^2" contradicted the report.
     assert "0.4 % of the model up to about 53" not in README.read_text(encoding="utf-8")

@@ -66,7 +66,7 @@ def test_verdict_values_come_from_the_measurements(tiny_report):
     # Recompute one impact's error from its measured and predicted ratio.
     imp = result.restitution[0]["impacts"][0]
     assert imp["rel_error"] == pytest.approx(imp["measured"] / imp["predicted"] - 1.0)
-    # Calibrated Pymunk passes the 0.5 % (tests/engines/test_backends.py measures <= 0.24 %).
+    # Calibrated Pymunk passes the 0.5 % tolerance (tests/engines/test_backends.py measures <= 0.24 %).
     assert rest["passed"]
 
 

@@ -96,7 +96,7 @@ def test_fallen_trilith_bob_lies_on_the_ground(theta, psi):
     free = trilith_shape(s, theta, psi)
     hinge = free.hinge
     raw = hinge + s.pendulum_length * np.array([math.sin(psi), -math.cos(psi)])
-    assert raw[1] < 0.0  # the case of the issue: the model's point is under the ground
+    assert raw[1] < 0.0  # the case in point: the model's point is under the ground
     r = bob_radius(s)
     assert free.bob_grounded and free.bob[1] == pytest.approx(r, abs=TOL)
     assert np.linalg.norm(free.bob - hinge) == pytest.approx(s.pendulum_length, abs=TOL)
