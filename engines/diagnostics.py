@@ -34,7 +34,7 @@ from analytic.excitation import Pulse
 
 from . import geometry
 
-__all__ = ["Pose", "PlaneState", "Diagnostics", "peak_ground_speed"]
+__all__ = ["Pose", "PlaneState", "Diagnostics", "peak_ground_speed", "joint_plane_state"]
 
 
 class Pose(NamedTuple):
@@ -70,6 +70,22 @@ class PlaneState(NamedTuple):
     out_of_plane: float = 0.0
     out_of_plane_rotation: float = 0.0
     problem: str | None = None
+
+
+
+def joint_plane_state(states, pendulum=None) -> PlaneState:
+    """The plane state of an engine whose bodies hang on planar joints (DART, Drake).
+
+    ``states``: ``(x, y, angle, vx, vy, omega)`` of the left column, the right
+    column and, when there is one, the lintel; ``pendulum``: the bob's hinge angle
+    and rate relative to the lintel, or None.  ``psi`` is measured from the downward
+    vertical, so the lintel's rotation is added to the relative angle."""
+    bodies = [Pose(*state) for state in states]
+    lintel = bodies[2] if len(bodies) > 2 else None
+    psi = psi_dot = 0.0
+    if pendulum is not None:
+        psi, psi_dot = pendulum[0] + lintel.angle, pendulum[1] + lintel.omega
+    return PlaneState((bodies[0], bodies[1]), lintel, psi, psi_dot)
 
 
 def peak_ground_speed(excitation) -> float:

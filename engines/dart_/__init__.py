@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import dartpy as dart
 
 from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, Pose
+from engines.diagnostics import PlaneState, joint_plane_state
 
 from .world import COLLISION_DETECTORS, DartWorld
 
@@ -93,13 +93,9 @@ class DartEngine(Engine):
         self.step_index = n + steps
 
     def read(self) -> PlaneState:
-        bodies = [Pose(*state) for state in self.world.planar_states()]
-        lintel = bodies[2] if len(bodies) > 2 else None
-        psi = psi_dot = 0.0
-        if self.world.pendulum is not None:
-            rel, rel_dot = self.world.pendulum_state()
-            psi, psi_dot = rel + lintel.angle, rel_dot + lintel.omega
-        return PlaneState((bodies[0], bodies[1]), lintel, psi, psi_dot)
+        world = self.world
+        return joint_plane_state(world.planar_states(),
+                                 world.pendulum_state() if world.pendulum is not None else None)
 
     def close(self) -> None:
         world, self.world = getattr(self, "world", None), None
