@@ -218,9 +218,10 @@ def parse_engine_list(text: str, option: str = "--engine",
     if not any(names):
         raise ValueError(f"{option} must name at least one of {allowed}, got {text!r}")
     unknown = [n for n in names if n not in engine_names() and n != "all"]
-    if unknown or ("all" in names and len(names) > 1):
-        bad = unknown[0] if unknown else "all"
-        raise ValueError(f"{option}: unknown engine {bad!r} in a list; allowed: {allowed}")
+    if unknown:
+        raise ValueError(f"{option}: unknown engine {unknown[0]!r}; allowed: {allowed}")
+    if "all" in names and len(names) > 1:
+        raise ValueError(f"{option}: 'all' stands alone, got {text!r}")
     if len(set(names)) != len(names):
         raise ValueError(f"{option}: an engine is named twice in {text!r}")
     return engine_list(text)
