@@ -77,3 +77,58 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+def _row(doc: dict, engine: str) -> str:
+    """One engine's line of :func:`summary_table` from a ``spectrum --engine --json``
+    document."""
+    es = doc["engines"][engine]
+    pts = [dict(p, curve=c) for c, ps in es["curves"].items() for p in ps]
+    ok = [p for p in pts if p["cause"] == "agrees"]
+    # The agreement region: up to the first frequency where a point disagrees.
+    first_bad = min((p["omega"] for p in pts if p["cause"] != "agrees"), default=math.inf)
+    region = [p for p in ok if p["omega"] < first_bad]
+    inside = max((p["a_reference"] for p in region), default=math.nan)
+    beyond = [p for p in pts if p["omega"] >= first_bad]
+    errs = [100 * p["rel_error"] for p in beyond if p["rel_error"] is not None]
+    causes: dict[str, int] = {}
+    for p in beyond:
+        if p["cause"] != "agrees":
+            causes[p["cause"]] = causes.get(p["cause"], 0) + 1
+    none = sorted({p["omega"] for p in beyond if p["a_engine"] is None})
+    iso = sum(len(p["isolated"]) for p in pts)
+    cost = es["cost"]
+    lo = min((p["omega"] for p in region), default=math.nan)
+    hi = max((p["omega"] for p in region), default=math.nan)
+    search = math.fsum(p["search_cpu_s"] for p in pts)
+    beyond_text = ("none" if not beyond else
+                   f"Omega {first_bad:g}-{max(p['omega'] for p in beyond):g}: "
+                   + (f"{min(errs):+.1f} to {max(errs):+.1f} %" if errs else "")
+                   + (f", no robust bracket at Omega {', '.join(f'{w:g}' for w in none)}"
+                      if none else "")
+                   + " (" + ", ".join(f"{k} {n}" for k, n in sorted(causes.items())) + ")")
+    return (f"| {engine} | {len(ok)} of {len(pts)} | Omega {lo:g}-{hi:g} "
+            f"(A <= {inside:.1f} m/s^2), {len(region)} points | {beyond_text} | {iso} "
+            f"| {cost['runs']} | {search:.0f} / {cost['cpu_s']:.0f} "
+            f"| {cost['cpu_per_sim_s']:.3f} |")
+
+
+def summary_table(paths) -> str:
+    """A Markdown table of the ``spectrum --engine --json`` documents at ``paths``:
+    points within the tolerance, the agreement region (every point up to the first
+    frequency with a disagreeing point), what lies beyond, isolated overturns, runs
+    and CPU seconds when computed (the searches / with the convergence reruns)."""
+    import json
+    from pathlib import Path
+    lines = ["| engine | agree within 2 % | region | beyond (error, primary causes) "
+             "| isolated overturns | runs | CPU s (search / all) | CPU per simulated s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for path in paths:
+        doc = json.loads(Path(path).read_text())
+        lines += [_row(doc, engine) for engine in doc["engines"]]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    import sys
+    print(summary_table(sys.argv[1:]))
