@@ -69,7 +69,7 @@ def _plot(traj, scene, path: str) -> None:
     ax.axhline(1.0, color="0.6", lw=0.6, ls="--")
     ax.axhline(-1.0, color="0.6", lw=0.6, ls="--")
     ax.set_ylabel(r"$\theta/\alpha$")
-    for e in traj.impacts:
+    for e in traj.sampled_events().impacts:  # the rule every backend's are read by
         ax.axvline(e.t, color="0.85", lw=0.5, zorder=0)
     v = traj.verdict
     ax.set_title(f"{traj.backend}: {v.status}" + (f" ({v.mode}, t = {v.time:.3f} s)"
