@@ -1,12 +1,14 @@
 """Engine spectra as files: CSV rows and the plot (analytic curves, every engine's
-points, relative error vs Omega with the cause of each point outside tolerance)."""
+points, relative error vs Omega with the cause of each point outside tolerance),
+and from stored ``spectrum --engine --json`` documents the summary table and the
+plot again (``python -m compare.measure.engine_spectrum_files``)."""
 from __future__ import annotations
 
 import math
 
 from compare.measure.engine_spectrum import DEFAULT_TOL, EngineSpectrum
 
-__all__ = ["write_csv", "plot", "CSV_FIELDS"]
+__all__ = ["write_csv", "plot", "plot_document", "summary_table", "CSV_FIELDS"]
 
 
 # Labels of the error panel: the cause of each point outside the tolerance.
@@ -53,11 +55,18 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     markers = {"pendulum": "o", "no_pendulum": "s"}
     for k, es in enumerate(spectra):
         color = f"C{k}"
+        unlabelled = es
         for curve, points in es.curves.items():
             w = [p.omega for p in points]
             fill = "full" if curve == "pendulum" else "none"
             top.plot(w, [p.a_engine for p in points], markers[curve], color=color, ms=4,
                      fillstyle=fill, label=f"{es.engine}, {curve.replace('_', ' ')}")
+            lost = [p for p in points if not _finite(p.a_engine)]
+            if lost:  # no robust bracket: marked on the model's curve
+                top.plot([p.omega for p in lost], [p.a_reference for p in lost], "x",
+                         color=color, ms=5, label=None if unlabelled is not es else
+                         f"{es.engine}: no robust bracket")
+                unlabelled = None
             low.plot(w, [100 * p.rel_error for p in points], markers[curve] + "-", color=color,
                      ms=4, lw=0.7, fillstyle=fill)
             for p in points:
@@ -77,6 +86,31 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     fig.tight_layout()
     fig.savefig(path, dpi=150)
     plt.close(fig)
+
+
+def _finite(x) -> bool:
+    return x is not None and math.isfinite(x)
+
+
+def plot_document(doc: dict, path) -> None:
+    """:func:`plot` from a stored ``trilith spectrum --engine --json`` document."""
+    from types import SimpleNamespace as NS
+
+    ref = doc["analytic"]
+    def values(key):
+        return [math.nan if v is None else v for v in ref[key]]
+
+    reference = NS(omega=ref["omega"], a_pendulum=values("a_pendulum"),
+                   a_no_pendulum=values("a_no_pendulum"),
+                   mode_jumps=lambda: ref["mode_jumps"], settings=NS(pulse=ref["pulse"]),
+                   scene=NS(**{k: doc["inputs"]["scene"][k] for k in ("lam", "b", "gamma", "mu")}))
+    spectra = []
+    for name, es in doc["engines"].items():
+        curves = {c: [NS(**{k: (math.nan if p[k] is None else p[k]) for k in
+                            ("omega", "a_engine", "a_reference", "rel_error")}, cause=p["cause"])
+                      for p in pts] for c, pts in es["curves"].items()}
+        spectra.append(NS(engine=name, curves=curves))
+    plot(reference, spectra, path, tol=next(iter(doc["engines"].values()))["tol"])
 
 
 def _row(doc: dict, engine: str) -> str:
@@ -129,6 +163,22 @@ def summary_table(paths) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
+def main(argv=None) -> int:
+    """``FILE.json ...``: print the summary table; ``--plot OUT.png FILE.json``:
+    redraw a stored spectrum's figure."""
+    import json
     import sys
-    print(summary_table(sys.argv[1:]))
+    from pathlib import Path
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args[:1] == ["--plot"]:
+        out, source = args[1], args[2]
+        from compare.run.atomic import atomic_path
+        with atomic_path(out, Path(out).suffix) as tmp:
+            plot_document(json.loads(Path(source).read_text()), tmp)
+        return 0
+    print(summary_table(args))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -39,3 +39,16 @@ def test_docs_table_is_the_stored_spectra():
     block = text[text.index("\n", start) + 1:text.index("<!-- engine spectra: end -->")]
     paths = sorted((root / "docs" / "validation").glob("engine_spectrum_*.json"))
     assert paths and block.strip() == summary_table(paths)
+
+
+def test_plot_from_a_stored_document(tmp_path):
+    from compare.measure.engine_spectrum_files import main
+    curves = {"pendulum": [_point(3, 2.5, 0.002, "agrees"), _point(6, 12.0, None, "model")]}
+    doc = {"inputs": {"scene": {"lam": 5.0, "b": 0.6, "gamma": 0.3, "mu": 1.0}},
+           "analytic": {"omega": [3.0, 6.0], "a_pendulum": [2.5, 12.0],
+                        "a_no_pendulum": [2.4, None], "mode_jumps": [], "pulse": "sine"},
+           "engines": {"toy": {"curves": curves, "tol": 0.02}}}
+    src, out = tmp_path / "s.json", tmp_path / "s.png"
+    src.write_text(json.dumps(doc))
+    assert main(["--plot", str(out), str(src)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
