@@ -51,7 +51,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              "doubled solver iterations to classify the cause")
     add_workers_arg(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
-    parser.add_argument("--csv", metavar="FILE", help="write the cells as CSV")
+    parser.add_argument("--csv", metavar="FILE",
+                        help="write the cells and the engines' robust thresholds as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
     return parser
 
@@ -118,7 +119,7 @@ def _hatch_invalid(ax, first, validity) -> None:
 def _draw_thresholds(ax, points, colour) -> None:
     """An engine's robust brackets: survives at the open mark, overturns at the
     filled one, joined; the cause beside a point outside the tolerance."""
-    from compare.measure.engine_spectrum_files import _SHORT
+    from compare.measure.engine_spectrum_files import SHORT_CAUSE
     label = "engine's robust threshold (survives / overturns)"
     for p in points:
         if not p.point.bracketed:
@@ -129,7 +130,7 @@ def _draw_thresholds(ax, points, colour) -> None:
             ax.plot([p.omega], [p.a_engine], "^", color=colour, ms=5, label=label)
         label = None
         if p.cause != "agrees":
-            ax.annotate(_SHORT.get(p.cause, p.cause), (p.omega, p.a_reference), fontsize=7,
+            ax.annotate(SHORT_CAUSE.get(p.cause, p.cause), (p.omega, p.a_reference), fontsize=7,
                         color=colour, xytext=(3, -9), textcoords="offset points")
 
 

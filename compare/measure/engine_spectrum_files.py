@@ -8,13 +8,14 @@ import math
 
 from compare.measure.engine_spectrum import DEFAULT_TOL, EngineSpectrum
 
-__all__ = ["write_csv", "plot", "plot_document", "summary_table", "CSV_FIELDS"]
+__all__ = ["write_csv", "plot", "plot_document", "summary_table", "CSV_FIELDS",
+           "SHORT_CAUSE"]
 
 
 # Labels of the error panel: the cause of each point outside the tolerance.
-_SHORT = {"model": "model", "jump": "jump", "window": "window", "discretisation": "dt",
-          "iterations": "iter", "contact": "contact", "sensitivity": "sens", "unknown": "?",
-          "no-bracket": "none"}
+SHORT_CAUSE = {"model": "model", "jump": "jump", "window": "window", "discretisation": "dt",
+               "iterations": "iter", "contact": "contact", "sensitivity": "sens", "unknown": "?",
+               "no-bracket": "none"}
 
 CSV_FIELDS = ("engine", "curve", "omega", "a_reference", "a_engine", "a_survives", "rel_error",
               "rel_resolution", "mode_reference", "mode_engine", "n_runs", "collapsed_below",
@@ -71,7 +72,7 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
                      ms=4, lw=0.7, fillstyle=fill)
             for p in points:
                 if p.cause != "agrees" and math.isfinite(p.rel_error):
-                    low.annotate(_SHORT.get(p.cause, p.cause), (p.omega, 100 * p.rel_error),
+                    low.annotate(SHORT_CAUSE.get(p.cause, p.cause), (p.omega, 100 * p.rel_error),
                                  fontsize=6, xytext=(2, 2), textcoords="offset points")
     low.axhspan(-100 * tol, 100 * tol, color="C2", alpha=0.12, lw=0)
     low.axhline(0.0, color="0.5", lw=0.6)

@@ -75,7 +75,8 @@ def test_zero_samples_and_a_run_ending_on_an_impact():
 def test_overturn_is_the_last_rise_through_alpha_before_the_verdict():
     t = np.linspace(0.0, 3.0, 301)
     # Up past alpha at 0.5 s, back below, then up for good: |theta| = alpha at 2.0 s.
-    theta = np.where(t < 1.0, 0.25 * np.sin(math.pi * t), 0.0) + np.where(t > 1.5, 0.4 * (t - 1.5), 0.0)
+    theta = (np.where(t < 1.0, 0.25 * np.sin(math.pi * t), 0.0)
+             + np.where(t > 1.5, 0.4 * (t - 1.5), 0.0))
     read = read_events(t, theta, np.gradient(theta, t), ALPHA, overturned_at=2.9)
     assert read.overturn.t == pytest.approx(2.0, abs=1e-9)
     assert read.overturn.resolution == pytest.approx(0.0, abs=1e-9)  # a sample sits on it
