@@ -183,8 +183,21 @@ class Trajectory:
     def max_abs_theta(self) -> float:
         return float(np.max(np.abs(self.theta))) if len(self.theta) else 0.0
 
+    def sampled_events(self, rule=None):
+        """Uplift, impacts and overturn read from the samples by the rule every
+        backend shares (:func:`analytic.sampled_events.events_of`); the backend's
+        own (for the model: exact) events stay in :attr:`events`."""
+        from .sampled_events import events_of
+        return events_of(self, rule=rule)
+
     def summary(self) -> dict:
         """The result part of ``trilith simulate --json``.
+
+        ``uplift_time``, ``n_impacts`` and ``overturn_time`` (the last rise of
+        ``|theta|`` through alpha) are read by the shared rule of
+        :mod:`analytic.sampled_events`, each time with its resolution [s], so that
+        every backend's are comparable; ``verdict_time`` is when the backend's
+        criterion was met, ``events`` the backend's own events.
 
         ``engine`` names the backend (the key every JSON document uses); wall
         and CPU times (``wall_time``, and the engines' ``diagnostics['wall_time']``
@@ -197,14 +210,21 @@ class Trajectory:
             timings["engine_wall_time"] = diagnostics.pop("wall_time")
         if "cpu_time" in diagnostics:
             timings["engine_cpu_time"] = diagnostics.pop("cpu_time")
+        read = self.sampled_events() if self.scene is not None else None
         return {
             "engine": self.backend,
             "status": self.verdict.status,
             "overturned": self.overturned,
             "mode": self.verdict.mode,
-            "n_impacts": self.n_impacts,
-            "uplift_time": self.uplift_time,
-            "overturn_time": self.overturn_time,
+            "verdict_time": self.verdict.time,
+            "n_impacts": None if read is None else read.n_impacts,
+            "uplift_time": None if read is None or read.uplift is None else read.uplift.t,
+            "uplift_resolution": (None if read is None or read.uplift is None
+                                  else read.uplift.resolution),
+            "overturn_time": None if read is None or read.overturn is None else read.overturn.t,
+            "overturn_resolution": (None if read is None or read.overturn is None
+                                    else read.overturn.resolution),
+            "sampled_events": None if read is None else read.to_dict(),
             "max_abs_theta": self.max_abs_theta,
             "criterion": self.criterion.kind,
             "topple_angle": self.criterion.topple_angle,

@@ -25,6 +25,7 @@ from scipy.integrate import solve_ivp
 from analytic import equations as eq
 from analytic.events import free_pendulum_period
 from analytic.options import check_real
+from analytic.sampled_events import EventRule, read_events
 from analytic.trajectory import Event, Trajectory, Verdict
 
 __all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero"]
@@ -35,7 +36,10 @@ class MonitorSettings:
     """Thresholds of the run monitor (shared by every engine).
 
     uplift_angle : |theta| [rad] above which the trilith counts as uplifted
-        (contact compliance tilts a resting engine trilith by ~1e-6 rad).
+        (contact compliance tilts a resting engine trilith by ~1e-6 rad); the
+        uplift event is timed between samples by the rule every backend shares
+        (:mod:`analytic.sampled_events`), and the mode's impacts are sign changes
+        of theta outside this angle.
     impact_window : |theta| [rad] outside which a sample counts as "clearly away
         from an impact" for the velocity measurement (impacts in engines last a
         few steps, i.e. |theta| below ~1e-4 rad at dt = 1e-4 s).
@@ -160,7 +164,6 @@ class RunMonitor:
         self.verdict: Verdict | None = None
         self._sign = 0
         self._impacts: list[float] = []
-        self._uplift: float | None = None
         self._rest_since: float | None = None
         self.t_stop = (t_max if t_max is not None else self.t_end_pulse + self.cfg.t_cap)
         # Read once: record() runs every sample and Scene.alpha is a computed property.
@@ -196,8 +199,6 @@ class RunMonitor:
         # Parted columns: a sign change of their mean angle is no impact.
         if abs(theta) > cfg.uplift_angle and not self._parted:
             sign = 1 if theta > 0 else -1
-            if self._uplift is None:
-                self._uplift = t
             if self._sign and sign != self._sign:
                 self._impacts.append(t)
             self._sign = sign
@@ -335,8 +336,11 @@ class RunMonitor:
             self.verdict = Verdict("undecided", None, None, len(self._impacts), "run ended early")
         data = np.asarray(self.samples) if self.samples else np.zeros((0, 5))
         events: list[Event] = []
-        if self._uplift is not None:
-            events.append(Event("uplift", self._uplift))
+        # The uplift is timed by the rule every backend shares, between samples.
+        uplift = read_events(data[:, 0], data[:, 1], data[:, 2], self._alpha,
+                             rule=EventRule(uplift_angle=self.cfg.uplift_angle)).uplift
+        if uplift is not None:
+            events.append(Event("uplift", uplift.t, uplift.side))
         # A verdict-only run (a threshold probe) needs no impact velocities: the
         # propagation across each impact is skipped, the impacts are still counted.
         impacts = [] if self.verdict_only else self.measured_impacts()

@@ -11,6 +11,7 @@ from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_ar
                                  add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
+from compare.measure.map_thresholds import LEAST_RUNS
 from compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:0.5"
@@ -40,11 +41,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--t-max", type=float, default=None, metavar="S",
                         help="fixed window of every engine run [s], no early stop (default: "
                              "each run stops when its verdict is certain)")
-    parser.add_argument("--max-engine-runs", type=int, default=100, metavar="N",
-                        help="refuse engine grids with more runs than this in all")
+    parser.add_argument("--max-engine-runs", type=int, default=200, metavar="N",
+                        help="refuse engine work of more runs than this in all: every grid "
+                             f"cell, and at least {LEAST_RUNS} runs per robust threshold "
+                             "point (one per engine frequency; more where the engine "
+                             "disagrees)")
+    parser.add_argument("--convergence", action="store_true",
+                        help="rerun disagreeing engine threshold points at dt/2, dt/4 and "
+                             "doubled solver iterations to classify the cause")
     add_workers_arg(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
-    parser.add_argument("--csv", metavar="FILE", help="write the cells as CSV")
+    parser.add_argument("--csv", metavar="FILE",
+                        help="write the cells and the engines' robust thresholds as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
     return parser
 
@@ -61,10 +69,12 @@ def _engine_grid(args, omegas, amps, n_engines: int):
          else _subsample(omegas, ENGINE_POINTS))
     a = (parse_range(args.engine_amplitude, "--engine-amplitude", "m/s^2")
          if args.engine_amplitude else _subsample(amps, ENGINE_POINTS))
-    if n_engines * w.size * a.size > args.max_engine_runs:
-        raise ValueError(f"the engine grids need {n_engines * w.size * a.size} runs, more than "
-                         f"--max-engine-runs {args.max_engine_runs}: coarsen --engine-omega/"
-                         f"--engine-amplitude or raise --max-engine-runs")
+    need = n_engines * w.size * (a.size + LEAST_RUNS)
+    if need > args.max_engine_runs:
+        raise ValueError(f"the engine grids need at least {need} runs ({w.size * a.size} cells "
+                         f"and {LEAST_RUNS} per threshold point at {w.size} frequencies, per "
+                         f"engine), more than --max-engine-runs {args.max_engine_runs}: coarsen "
+                         f"--engine-omega/--engine-amplitude or raise --max-engine-runs")
     return w, a
 
 
@@ -106,11 +116,31 @@ def _hatch_invalid(ax, first, validity) -> None:
                         label="model invalid at the first overturning" if k == 0 else None)
 
 
-def plot_maps(maps, path, validity=None) -> None:
+def _draw_thresholds(ax, points, colour) -> None:
+    """An engine's robust brackets: survives at the open mark, overturns at the
+    filled one, joined; the cause beside a point outside the tolerance."""
+    from compare.measure.engine_spectrum_files import SHORT_CAUSE
+    label = "engine's robust threshold (survives / overturns)"
+    for p in points:
+        if not p.point.bracketed:
+            ax.plot([p.omega], [p.a_reference], "x", color=colour, ms=7, mew=1.5, label=label)
+        else:
+            ax.plot([p.omega, p.omega], [p.a_survives, p.a_engine], "-", color=colour, lw=1.5)
+            ax.plot([p.omega], [p.a_survives], "v", color=colour, mfc="white", ms=5)
+            ax.plot([p.omega], [p.a_engine], "^", color=colour, ms=5, label=label)
+        label = None
+        if p.cause != "agrees":
+            ax.annotate(SHORT_CAUSE.get(p.cause, p.cause), (p.omega, p.a_reference), fontsize=7,
+                        color=colour, xytext=(3, -9), textcoords="offset points")
+
+
+def plot_maps(maps, path, validity=None, thresholds=None) -> None:
     """One panel per map: cells coloured by label, the analytic first-overturning
     curve (black line) on every panel and, above it, the frequencies where the
     model is invalid on that curve's run hatched (``validity``: one
-    :func:`analytic.threshold_validity.point_validity` per frequency)."""
+    :func:`analytic.threshold_validity.point_validity` per frequency); on an
+    engine's panel its robust threshold brackets (``thresholds``: backend ->
+    :class:`~compare.measure.engine_spectrum.EnginePoint` list)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -134,6 +164,9 @@ def plot_maps(maps, path, validity=None) -> None:
         ax.plot(first.omega, first.first, "k-", lw=1.2, label="first overturning (analytic)")
         if validity:
             _hatch_invalid(ax, first, validity)
+        if thresholds and thresholds.get(m.backend):
+            from compare.report.plots import color
+            _draw_thresholds(ax, thresholds[m.backend], color(m.backend) or "tab:blue")
         present = [i for i, n in enumerate(np.bincount(m.cells.ravel(),
                                                        minlength=len(m.labels))) if n]
         handles = [Patch(facecolor=cols[i], edgecolor="k", label=m.labels[i]) for i in present]
@@ -153,6 +186,34 @@ def plot_maps(maps, path, validity=None) -> None:
     from compare.run.atomic import savefig
     savefig(fig, path, dpi=150)
     plt.close(fig)
+
+
+CSV_COLUMNS = ("backend", "omega", "amplitude", "verdict", "model_valid_at_first_overturning",
+               "a_survives", "a_reference", "rel_error", "rel_resolution", "cause", "valid",
+               "isolated", "cpu_s")
+THRESHOLD_COLUMNS = CSV_COLUMNS[5:]  # empty on the cells' rows
+
+
+def _threshold_row(name: str, p) -> str:
+    """A robust threshold as a CSV row: ``amplitude`` is where it overturns."""
+    d = p.to_dict()
+    iso = "; ".join(f"{i['amplitude']:.6g}" for i in d["isolated"])
+    return (f"{name},{p.omega:.12g},{p.a_engine:.12g},first overturning (robust),,"
+            f"{p.a_survives:.12g},{p.a_reference:.12g},{p.rel_error:.6g},"
+            f"{p.point.rel_resolution:.6g},{p.cause},{p.valid},{iso},{p.cpu_s:.6g}")
+
+
+def _print_thresholds(name: str, points) -> None:
+    from compare.measure.map_thresholds import threshold_cost
+    cost = threshold_cost(points)
+    print(f"{name}: robust thresholds at {cost['points']} frequencies, {cost['runs']} runs, "
+          f"{cost['cpu_s']:.1f} CPU s when computed ({cost['cpu_s_spent']:.1f} spent now)")
+    print(f"{'Omega':>7} {'A_model':>8} {'survives':>9} {'overturns':>9} {'error':>8}  cause")
+    for p in points:
+        res = 100 * p.point.rel_resolution
+        print(f"{p.omega:7.3g} {p.a_reference:8.3f} {p.a_survives:9.3f} {p.a_engine:9.3f} "
+              f"{100 * p.rel_error:+7.2f}% (bracket {res:.2g} %)  {p.cause}"
+              + (f" [{len(p.isolated)} isolated]" if p.isolated else ""))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -183,6 +244,14 @@ def run(args: argparse.Namespace) -> int:
         maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
                                 *eng_grid,
                                 backend=name, pulse=args.pulse, workers=workers))
+    thresholds = {}
+    if engines:
+        from compare.measure.map_thresholds import map_thresholds, model_thresholds
+        reference = model_thresholds(scene, eng_grid[0], args.pulse, workers)
+        for name in engines:
+            thresholds[name] = map_thresholds(name, scene, eng_grid[0], args.pulse,
+                                              workers=workers, convergence=args.convergence,
+                                              t_max=args.t_max, reference=reference)
     from analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
@@ -193,15 +262,22 @@ def run(args: argparse.Namespace) -> int:
 
     if args.csv:
         from compare.run.atomic import write_text
-        rows = ["backend,omega,amplitude,verdict,model_valid_at_first_overturning"] + [
-            f"{m.backend},{w:.12g},{a:.12g},{lab},{valid_text(w)}"
-            for m in maps for w, a, lab in m.csv_rows()]
+        blank = "," * (len(THRESHOLD_COLUMNS) - 1)
+        rows = [",".join(CSV_COLUMNS)] + [
+            f"{m.backend},{w:.12g},{a:.12g},{lab},{valid_text(w)},{blank}"
+            for m in maps for w, a, lab in m.csv_rows()] + [
+            _threshold_row(name, p) for name, pts in thresholds.items() for p in pts]
         write_text(args.csv, "\n".join(rows) + "\n")
     if args.plot:
-        plot_maps(maps, args.plot, validity)
+        plot_maps(maps, args.plot, validity, thresholds)
     if args.json:
+        from compare.measure.map_thresholds import threshold_cost
         first = {**maps[0].to_dict(), "model_validity_first_overturning": validity}
-        print_json(plain({"maps": [first] + [m.to_dict() for m in maps[1:]]}))
+        engine_maps = [{**m.to_dict(),
+                        "thresholds": [p.to_dict() for p in thresholds[m.backend]],
+                        "threshold_cost": threshold_cost(thresholds[m.backend])}
+                       for m in maps[1:]]
+        print_json(plain({"maps": [first] + engine_maps}))
         return 0
     for m in maps:
         print(f"{m.backend}: scene {scene.name}, {m.pulse} pulse, {m.omega.size} frequencies x "
@@ -209,6 +285,8 @@ def run(args: argparse.Namespace) -> int:
         for lab, n in m.counts().items():
             if n:
                 print(f"  {lab:>26}: {n}")
+    for name, pts in thresholds.items():
+        _print_thresholds(name, pts)
     bad = [float(w) for w, v in zip(maps[0].omega, validity) if v["model_valid"] is False]
     if bad:
         print(f"note: the model is invalid at the first overturning for {len(bad)} "

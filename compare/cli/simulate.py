@@ -69,7 +69,7 @@ def _plot(traj, scene, path: str) -> None:
     ax.axhline(1.0, color="0.6", lw=0.6, ls="--")
     ax.axhline(-1.0, color="0.6", lw=0.6, ls="--")
     ax.set_ylabel(r"$\theta/\alpha$")
-    for e in traj.impacts:
+    for e in traj.sampled_events().impacts:  # the rule every backend's are read by
         ax.axvline(e.t, color="0.85", lw=0.5, zorder=0)
     v = traj.verdict
     ax.set_title(f"{traj.backend}: {v.status}" + (f" ({v.mode}, t = {v.time:.3f} s)"
@@ -128,10 +128,18 @@ def run(args: argparse.Namespace) -> int:
     if v.overturned:
         line += f" ({v.mode}) at t = {v.time:.4f} s"
     print(line + (f" -- {v.reason}" if v.reason else ""))
-    up = traj.uplift_time
-    print(f"uplift: {'none' if up is None else f'{up:.4f} s'}, impacts: {traj.n_impacts}, "
-          f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "
+    read = traj.sampled_events()
+    rule = read.rule
+    up = "none" if read.uplift is None else read.uplift.text()
+    over = "" if read.overturn is None else f", past alpha for good at {read.overturn.text()}"
+    print(f"uplift (|theta| = {rule.uplift_angle:g} rad): {up}, impacts (theta = 0 crossed "
+          f"faster than {rule.impact_speed:g} rad/s): {read.n_impacts}{over}")
+    print(f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "
           f"t_end = {traj.t[-1]:.3f} s")
+    if traj.backend.startswith("analytic"):  # the model's own, exact events
+        exact = traj.uplift_time
+        print(f"model's exact events: lift-off {'none' if exact is None else f'{exact:.4f} s'}, "
+              f"{traj.n_impacts} impacts (down to its rest speed)")
     detail(f"engine {backend.version()}, wall time {traj.wall_time:.3f} s")
     if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
         info(f"warning: the analytic model is not valid along this run: "

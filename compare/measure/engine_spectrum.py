@@ -27,7 +27,7 @@ from compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, m
                                     sensitivity_detail)
 from compare.measure.thresholds import SEARCH, ThresholdPoint, engine_threshold
 
-__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "measure_point",
+__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "engine_points", "measure_point",
            "pulse_settings", "CAUSES", "DEFAULT_TOL", "DEFAULT_REL_TOL"]
 
 CAUSES = ("agrees", *PRIMARY_ORDER, "unknown")
@@ -234,6 +234,19 @@ def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", worker
     for key, point in zip(keys, results):
         out.curves.setdefault(key, []).append(point)
     return out
+
+
+def engine_points(engine: str, scene, omegas, a_references, modes, *, case: str = "",
+                  kind: str = "sine", workers: int = 1, tol: float = DEFAULT_TOL,
+                  rel_tol: float = DEFAULT_REL_TOL, convergence: bool = False,
+                  **options) -> list[EnginePoint]:
+    """:func:`measure_point` at each ``(omega, a_reference, mode)`` of one curve of
+    one scene (``case`` names it), in order, ``workers`` processes (one frequency
+    each); frequencies whose model threshold is not finite are skipped."""
+    configure(engine, **options)  # validates the options up front
+    jobs = [(engine, scene, case, float(w), float(a), m, kind, options, tol, rel_tol,
+             convergence) for w, a, m in zip(omegas, a_references, modes) if math.isfinite(a)]
+    return _map(_point_job, jobs, workers)
 
 
 def _map(fn, items: list, workers: int) -> list:

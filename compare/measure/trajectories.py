@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analytic.sampled_events import events_of
 from analytic.trajectory import Trajectory
 
 from compare.run.jsonable import plain
@@ -26,11 +27,6 @@ from compare.run.keys import backend_version
 
 __all__ = ["Provenance", "TrajectoryComparison", "provenance_of",
            "settings_provenance", "compare_trajectories", "common_grid_values"]
-
-# |theta| [rad] that counts as uplifted when comparing uplift times: the engines'
-# run monitor uses it (contact compliance tilts a resting engine trilith ~1e-6 rad),
-# so both runs are timed at the same angle rather than at the model's exact root.
-UPLIFT_ANGLE = 1e-4
 
 # Grid step of the common time grid [s]: engines sample every ~1 ms and the
 # analytic path writes 1 ms samples; a finer grid only interpolates further.
@@ -152,9 +148,13 @@ class TrajectoryComparison:
     unstable and amplifies any difference), or the end of the common window;
     ``*_all``: over the common window,
     up to the earlier of the two end times / overturn times.  Time errors are
-    ``test - reference`` [s]; impacts are matched in order; uplift is timed in
-    both runs where ``|theta|`` first reaches ``UPLIFT_ANGLE`` (1e-4 rad), the
-    angle at which the engines' monitor declares it.
+    ``test - reference`` [s]; uplift and impacts are read from both runs' samples
+    by the rule every backend shares (:mod:`analytic.sampled_events`: uplift at
+    ``|theta| = 1e-4`` rad, impacts as sign changes of theta faster than 1e-2
+    rad/s, both interpolated), impacts matched in order;
+    ``uplift_time_resolution`` bounds the uplift error by the sum of both
+    runs' resolutions (each the distance to the farther sample around the
+    crossing).
     """
 
     reference: Provenance
@@ -172,6 +172,7 @@ class TrajectoryComparison:
     psi_rms_all: float
     psi_max_all: float
     uplift_time_error: float
+    uplift_time_resolution: float
     impact_time_errors: tuple[float, ...]
     n_impacts_reference: int
     n_impacts_test: int
@@ -231,10 +232,13 @@ def compare_trajectories(reference: Trajectory, test: Trajectory,
     ps_rf, ps_mf = _errors(reference, test, "psi", t_start, t_fi, alpha)
     ps_ra, ps_ma = _errors(reference, test, "psi", t_begin, t_end, alpha)
 
-    up_ref, up_test = _first_past(reference, UPLIFT_ANGLE), _first_past(test, UPLIFT_ANGLE)
-    up_err = (up_test - up_ref) if (up_ref is not None and up_test is not None) else math.nan
-    ref_imp = [e.t for e in reference.impacts if e.t <= t_end]
-    test_imp = [e.t for e in test.impacts if e.t <= t_end]
+    read_ref, read_test = events_of(reference, alpha), events_of(test, alpha)
+    up_ref, up_test = read_ref.uplift, read_test.uplift
+    up_err = up_res = math.nan
+    if up_ref is not None and up_test is not None:
+        up_err, up_res = up_test.t - up_ref.t, up_test.resolution + up_ref.resolution
+    ref_imp = [e.t for e in read_ref.impacts_before(t_end)]
+    test_imp = [e.t for e in read_test.impacts_before(t_end)]
     imp_err = tuple(float(b - a) for a, b in zip(ref_imp, test_imp))
     pk_ref, pk_test = _peak(reference, "theta", t_end), _peak(test, "theta", t_end)
     return TrajectoryComparison(
@@ -242,7 +246,8 @@ def compare_trajectories(reference: Trajectory, test: Trajectory,
         t_start=t_start, t_first_impact=t_fi, t_end=t_end,
         theta_rms_first=th_rf, theta_max_first=th_mf, theta_rms_all=th_ra, theta_max_all=th_ma,
         psi_rms_first=ps_rf, psi_max_first=ps_mf, psi_rms_all=ps_ra, psi_max_all=ps_ma,
-        uplift_time_error=float(up_err), impact_time_errors=imp_err,
+        uplift_time_error=float(up_err), uplift_time_resolution=float(up_res),
+        impact_time_errors=imp_err,
         n_impacts_reference=len(ref_imp), n_impacts_test=len(test_imp),
         peak_theta_reference=pk_ref, peak_theta_test=pk_test,
         peak_theta_rel_error=_rel(pk_test, pk_ref),

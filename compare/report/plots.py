@@ -8,7 +8,8 @@ guessed from overlapping curves:
   figure per case; below, relative error vs Omega with the tolerance band, the
   mode jumps marked and the frequencies where the model is invalid hatched.
 * :func:`convergence_figure`: relative error vs time step for the points that
-  failed (when the campaign measured a step-convergence study).
+  failed (when the campaign measured a convergence study); doubled solver
+  iterations are separate markers, never a point of the step line.
 * :func:`history_figures`: theta/alpha at one of the paper's points, one figure
   per case; below, ``|theta_engine - theta_model| / alpha`` vs time.
 * :func:`restitution_figures`: relative error of every impact against Eq. 20/19.
@@ -34,8 +35,8 @@ import numpy as np  # noqa: E402
 from analytic.threshold_validity import invalid_spans  # noqa: E402
 from compare.report.trust import label  # noqa: E402
 
-__all__ = ["spectra_figures", "convergence_figure", "history_figures", "restitution_figures",
-           "shade_invalid", "color", "marker", "DPI", "WIDTH"]
+__all__ = ["spectra_figures", "convergence_figure", "convergence_axes", "history_figures",
+           "restitution_figures", "shade_invalid", "color", "marker", "DPI", "WIDTH"]
 
 
 def color(name: str) -> str | None:
@@ -160,25 +161,57 @@ def spectra_figures(doc: dict) -> list[tuple[str, str]]:
             if case in doc.get("spectra", {})]
 
 
-def _convergence(point: dict) -> tuple[np.ndarray, np.ndarray] | None:
+def _convergence(point: dict) -> tuple[np.ndarray, np.ndarray, list[tuple]] | None:
+    """A point's convergence rows split by their ``kind``: the step study
+    (``dt``, ``rel_error`` arrays of the 'dt' rows) and the solver-iteration
+    rows ``[(dt, rel_error, iterations)]`` (same step, doubled iterations), which
+    are not a point of the step line."""
     rows = point.get("convergence") or []
-    dts, errs = [], []
+    dts, errs, more = [], [], []
     for r in rows:
         if isinstance(r, dict):
-            dt, err = r.get("dt"), r.get("rel_error")
+            kind, dt, err = r.get("kind", "dt"), r.get("dt"), r.get("rel_error")
         else:
-            dt, err = r[0], r[2] if len(r) > 2 else None
-        if dt is not None and err is not None:
+            kind, dt, err = "dt", r[0], r[2] if len(r) > 2 else None
+        if dt is None or err is None:
+            continue
+        if kind == "iterations":
+            more.append((float(dt), float(err), r.get("iterations")))
+        else:
             dts.append(float(dt))
             errs.append(float(err))
-    return (np.array(dts), np.array(errs)) if dts else None
+    return (np.array(dts), np.array(errs), more) if (dts or more) else None
+
+
+def convergence_axes(ax, series: list[tuple], tol: float) -> None:
+    """Draw ``series`` ``[(engine, case, point, (dt, err, iteration_rows))]`` on
+    ``ax``: the step study as one line per point, the doubled-iteration runs as
+    separate open markers at their step, labelled with the iteration count."""
+    ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    for name, case, p, (dt, err, more) in series:
+        where = f"{label(name)}, Ω = {p['omega']:g} ({_CASES.get(case, case)})"
+        if dt.size:
+            order = np.argsort(dt)
+            ax.semilogx(dt[order], 100.0 * err[order], marker=marker(name),
+                        color=color(name), lw=0.9, ms=4, label=f"{where}: dt, dt/2, dt/4")
+        for dt_i, err_i, iterations in more:
+            count = "" if iterations is None else f" ({iterations})"
+            ax.semilogx([dt_i], [100.0 * err_i], marker="*", ls="none", ms=8,
+                        markerfacecolor="none", color=color(name),
+                        label=f"{where}: doubled solver iterations{count}")
+    ax.set_xlabel("engine time step dt [s]")
+    ax.set_ylabel("engine / model − 1 [%]")
+    # Below the axes: the labels are long and the points may sit anywhere.
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.2))
 
 
 @_styled
 def convergence_figure(doc: dict) -> str | None:
     """Relative threshold error against the engine time step for every point
-    that carries a step-convergence study (a flat line away from zero: the
-    disagreement is not discretisation); None when no point does."""
+    that carries a convergence study (a flat line away from zero: the
+    disagreement is not discretisation), the doubled-iteration runs as separate
+    markers (:func:`convergence_axes`); None when no point carries one."""
     series = []
     for case, spec in doc.get("spectra", {}).items():
         for name, pts in spec.get("engines", {}).items():
@@ -188,18 +221,8 @@ def convergence_figure(doc: dict) -> str | None:
                     series.append((name, case, p, conv))
     if not series:
         return None
-    tol = 100.0 * doc["config"]["tolerances"]["threshold"]
     fig, ax = plt.subplots(figsize=(WIDTH, 3.4))
-    ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
-    ax.axhline(0.0, color="0.5", lw=0.6)
-    for name, case, p, (dt, err) in series:
-        order = np.argsort(dt)
-        ax.semilogx(dt[order], 100.0 * err[order], marker=marker(name),
-                    color=color(name), lw=0.9, ms=4,
-                    label=f"{label(name)}, Ω = {p['omega']:g} ({_CASES.get(case, case)})")
-    ax.set_xlabel("engine time step dt [s]")
-    ax.set_ylabel("engine / model − 1 [%]")
-    ax.legend()
+    convergence_axes(ax, series, 100.0 * doc["config"]["tolerances"]["threshold"])
     fig.tight_layout()
     return _png(fig)
 

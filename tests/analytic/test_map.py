@@ -61,9 +61,9 @@ def test_cli_json_csv_plot(tmp_path, capsys):
     (["map", "--workers", "0"], "--workers"),
     (["map", "--engine", "nope"], "engine"),
     (["map", "--engine", "pymunk", "--max-engine-runs", "3"], "--max-engine-runs"),
-    # two engines share the budget: 2 x 2 x 2 = 8 runs > 7
+    # two engines share the budget: 2 x 2 x (2 cells + 7 threshold runs) = 36 runs > 35
     (["map", "--engine", "pymunk,mujoco", "--engine-omega", "9:10:1", "--engine-amplitude",
-      "5:6:1", "--max-engine-runs", "7"], "8 runs"),
+      "5:6:1", "--max-engine-runs", "35"], "at least 36 runs"),
     (["map", "--plot", "m.txt"], "--plot"),
 ])
 def test_cli_bad_input(argv, needle, capsys):
@@ -83,7 +83,20 @@ def test_cli_engines_beside_the_analytic_map(tmp_path, capsys):
     assert [m["backend"] for m in maps] == ["analytic-fast", "pymunk", "mujoco"]
     for m in maps[1:]:
         assert m["omega"] == [9.0, 11.0] and m["amplitude"] == [4.0, 16.0]
-    rows = csv.read_text().splitlines()[1:]
-    assert len(rows) == 30 + 2 * 4
-    assert {r.split(",")[0] for r in rows} == {"analytic-fast", "pymunk", "mujoco"}
+        # One robust threshold per engine frequency, the EnginePoint of spectrum --engine.
+        assert [p["omega"] for p in m["thresholds"]] == [9.0, 11.0]
+        for p in m["thresholds"]:
+            for key in ("a_engine", "a_survives", "isolated", "rel_error", "rel_resolution",
+                        "cause", "causes", "valid", "cpu_s"):
+                assert key in p, key
+            assert p["a_survives"] < p["a_engine"]
+            assert p["a_engine"] - p["a_survives"] <= 0.005 * p["a_reference"] * (1 + 1e-9)
+        assert m["threshold_cost"]["runs"] >= 7 * 2
+    rows = csv.read_text().splitlines()
+    assert rows[0].split(",")[:4] == ["backend", "omega", "amplitude", "verdict"]
+    cells = [r for r in rows[1:] if "(robust)" not in r]
+    brackets = [r.split(",") for r in rows[1:] if "(robust)" in r]
+    assert len(cells) == 30 + 2 * 4 and len(brackets) == 2 * 2
+    assert {r.split(",")[0] for r in cells} == {"analytic-fast", "pymunk", "mujoco"}
+    assert all(len(r) == len(rows[0].split(",")) for r in brackets)
     assert png.stat().st_size > 0

@@ -21,11 +21,12 @@ ALPHA = 0.2
 
 
 def _traj(t, theta, psi=None, events=(), verdict=None, backend="analytic", settings=None,
-          scene=None):
+          scene=None, theta_dot=None):
     t = np.asarray(t, float)
     theta = np.asarray(theta, float)
     psi = np.zeros_like(t) if psi is None else np.asarray(psi, float)
-    return Trajectory(backend=backend, t=t, theta=theta, theta_dot=np.zeros_like(t),
+    theta_dot = np.zeros_like(t) if theta_dot is None else np.asarray(theta_dot, float)
+    return Trajectory(backend=backend, t=t, theta=theta, theta_dot=theta_dot,
                       psi=psi, psi_dot=np.zeros_like(t), events=tuple(events),
                       verdict=verdict or Verdict("survived"), criterion=OverturnCriterion(),
                       t_max=None, settings=settings or {}, wall_time=0.5, scene=scene)
@@ -65,20 +66,47 @@ def test_repeated_impact_samples_and_first_impact_window():
     t_ref = np.r_[np.linspace(0, 1, 101), np.linspace(1, 2, 101)]
     th_ref = np.r_[np.linspace(0, 0.1, 51), np.linspace(0.1, 0, 51)[1:], -np.linspace(0, 0.05, 101)]
     assert t_ref.size == th_ref.size
+    td_ref = np.r_[np.full(51, 0.2), np.full(50, -0.2), np.full(101, -0.05)]
     ev_ref = [Event("uplift", 0.0), Event("impact", 1.0, -1, -0.2, 0.16)]
     ev_test = [Event("uplift", 0.0), Event("impact", 1.02, -1, -0.2, 0.16)]
-    ref = _traj(t_ref, th_ref, events=ev_ref)
+    ref = _traj(t_ref, th_ref, events=ev_ref, theta_dot=td_ref)
     # The test differs only after the impact.
     th_test = th_ref.copy()
     th_test[101:] *= 1.2
-    test = _traj(t_ref, th_test, events=ev_test, backend="pybullet")
+    test = _traj(t_ref, th_test, events=ev_test, backend="pybullet", theta_dot=1.2 * td_ref)
     c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
     assert c.theta_rms_first == pytest.approx(0.0, abs=1e-15)  # identical before the impact
     assert c.theta_max_all == pytest.approx(0.2 * 0.05 / ALPHA, rel=1e-6)
     assert c.t_first_impact == 1.0
     assert c.uplift_time_error == pytest.approx(0.0, abs=1e-12)  # same samples before the impact
-    assert c.impact_time_errors == pytest.approx((0.02,))
+    # Impacts are read from the samples by the shared rule, not from each
+    # backend's own events: both runs cross theta = 0 at the samples at t = 1.
+    assert c.impact_time_errors == pytest.approx((0.0,), abs=1e-12)
     assert c.n_impacts_reference == c.n_impacts_test == 1
+
+
+def test_impacts_and_uplift_read_by_the_shared_rule_on_both_samplings():
+    # A reference sampled every 1 ms and a test every 8 ms, 3 ms late, of the same
+    # rocking theta = 0.02 sin(2 pi t); the reference also chatters after 2 s at
+    # 5e-3 rad/s, below the rule's 1e-2 rad/s impact speed.
+    w, lag = 2 * math.pi, 3e-3
+    t_ref = np.arange(0.0, 2.5, 1e-3)
+    chatter = np.where(t_ref > 2.0, 1e-4 * np.sin(50 * t_ref), 0.0)
+    th_ref = np.where(t_ref <= 2.0, 0.02 * np.sin(w * t_ref), 0.0) + chatter
+    td_ref = np.where(t_ref <= 2.0, 0.02 * w * np.cos(w * t_ref),
+                      5e-3 * np.cos(50 * t_ref))
+    t_test = np.arange(lag, 2.0, 8e-3)
+    th_test = 0.02 * np.sin(w * (t_test - lag))
+    td_test = 0.02 * w * np.cos(w * (t_test - lag))
+    ref = _traj(t_ref, th_ref, theta_dot=td_ref)
+    test = _traj(t_test, th_test, theta_dot=td_test, backend="pymunk")
+    c = metrics.compare_trajectories(ref, test, alpha=ALPHA)
+    assert c.n_impacts_reference == c.n_impacts_test == 3  # at 0.5, 1.0, 1.5 s
+    # Linear interpolation near a zero of a sine is exact to ~h^2 w^2 / 6 of h.
+    assert c.impact_time_errors == pytest.approx((lag,) * 3, abs=1e-5)
+    # |theta| = 1e-4 rad is reached 0.8 ms after each run's start; the test starts late.
+    assert c.uplift_time_error == pytest.approx(lag, abs=1e-6)
+    assert 0.0 < c.uplift_time_resolution <= 8e-3 + 1e-3
 
 
 def test_window_stops_at_earlier_overturn_and_verdicts():

@@ -1,0 +1,61 @@
+"""An engine's robust threshold at every frequency of its overturn map's grid.
+
+``trilith map --engine`` draws each engine's verdict grid beside the model's map and,
+per frequency column, the engine's robust first-overturning bracket from the one
+measurement every command uses (:func:`compare.measure.engine_spectrum.measure_point`,
+result :class:`~compare.measure.engine_spectrum.EnginePoint`), around the model's
+threshold at that frequency (:func:`analytic.first_overturn.first_overturn_amplitude`,
+the spectrum's search, to its 0.01 m/s^2 default).
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["LEAST_RUNS", "model_thresholds", "map_thresholds", "threshold_cost"]
+
+# The fewest runs a robust threshold point costs: the guard 3 % below the model,
+# the first bracket's two ends, and the four robustness runs (two per end).  A
+# point where the engine disagrees costs more (widening, bisection, isolated
+# overturns; with convergence the search again at dt/2, dt/4 and doubled
+# iterations), so a budget counted with it is a lower bound.
+LEAST_RUNS = 7
+
+
+def _model_point(args):
+    from analytic.first_overturn import first_overturn_amplitude
+    from analytic.spectrum import SpectrumSettings
+    scene, omega, kind = args
+    a, _, mode, _, _ = first_overturn_amplitude(scene, omega, SpectrumSettings(pulse=kind))
+    return float(a), mode
+
+
+def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1):
+    """``[(a_reference, mode)]``: the model's first overturning amplitude [m/s^2]
+    and mode at each of ``omegas`` (NaN, None when nothing overturns)."""
+    from compare.measure.engine_spectrum import _map
+    return _map(_model_point, [(scene, float(w), kind) for w in omegas], workers)
+
+
+def map_thresholds(engine: str, scene, omegas, kind: str = "sine", *, workers: int = 1,
+                   convergence: bool = False, t_max: float | None = None, reference=None):
+    """The engine's :class:`EnginePoint` at each of ``omegas`` (frequencies where
+    the model does not overturn are skipped).
+
+    ``reference``: the model's ``[(a_reference, mode)]`` on ``omegas`` when already
+    computed (:func:`model_thresholds`).  ``t_max`` fixes every run's window with no
+    early stop, as in the map's cells.
+    """
+    from compare.measure.engine_spectrum import engine_points
+    reference = model_thresholds(scene, omegas, kind, workers) if reference is None else reference
+    options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
+    return engine_points(engine, scene, [float(w) for w in omegas],
+                         [a for a, _ in reference], [m for _, m in reference],
+                         case="pendulum" if scene.has_pendulum else "no_pendulum", kind=kind,
+                         workers=workers, convergence=convergence, **options)
+
+
+def threshold_cost(points) -> dict:
+    """Runs and CPU seconds of ``points`` (when computed, reruns included; spent now)."""
+    return {"points": len(points), "runs": sum(p.point.n_runs for p in points),
+            "cpu_s": math.fsum(p.cpu_s for p in points),
+            "cpu_s_spent": math.fsum(p.point.cpu_s_spent for p in points)}

@@ -1,0 +1,28 @@
+"""``trilith simulate`` prints and writes the events of the shared rule with their resolution."""
+from __future__ import annotations
+
+import json
+import re
+
+from compare.cli.main import main
+
+
+def test_simulate_prints_rule_events_with_resolution(capsys):
+    assert main(["simulate", "-A", "25", "-w", "11"]) == 0  # point D: overturns, no impact
+    out = capsys.readouterr().out
+    up = re.search(r"uplift \(\|theta\| = 0.0001 rad\): (\S+) s \+- (\S+) s", out)
+    over = re.search(r"past alpha for good at (\S+) s \+- (\S+) s", out)
+    assert up and over, out
+    # The model's 1 ms samples bound both times to a millisecond.
+    assert 0.0 < float(up.group(2)) <= 1e-3 and float(over.group(2)) <= 1e-3
+    assert "impacts (theta = 0 crossed faster than 0.01 rad/s): 0" in out
+    assert "model's exact events: lift-off 0.0082 s" in out  # Eq. 9's root, kept apart
+
+
+def test_simulate_json_has_rule_times_and_the_verdict_time(capsys):
+    assert main(["simulate", "-A", "25", "-w", "11", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["uplift_time"] - doc["uplift_resolution"] <= 0.0262
+    assert 0.0 <= doc["overturn_time"] < doc["verdict_time"]  # alpha before the topple angle
+    assert doc["sampled_events"]["rule"] == {"uplift_angle": 1e-4, "impact_speed": 1e-2}
+    assert doc["n_impacts"] == doc["sampled_events"]["n_impacts"] == 0
