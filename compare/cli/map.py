@@ -7,6 +7,7 @@ import math
 
 from engines import engine_names
 
+from compare.cli import options as _options
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
                                  add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
@@ -40,6 +41,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--t-max", type=float, default=None, metavar="S",
                         help="fixed window of every engine run [s], no early stop (default: "
                              "each run stops when its verdict is certain)")
+    _options.add_settings_arg(parser)
     parser.add_argument("--max-engine-runs", type=int, default=100, metavar="N",
                         help="refuse engine grids with more runs than this in all")
     add_workers_arg(parser)
@@ -74,9 +76,12 @@ class _EngineRun:
     :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
     no early stop when given, through the run store."""
 
-    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None):
+    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None,
+                 base: dict | None = None):
         self.name, self.scene, self.pulse = name, scene, pulse
-        self.options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
+        self.options = dict(base or {})  # the --settings table, under --t-max
+        if t_max is not None:
+            self.options.update(t_max=t_max, early_stop=False)
 
     def __call__(self, amplitude: float, omega: float):
         from analytic.excitation import Pulse
@@ -172,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
+    loaded = _options.settings_from_args(args, engines)
     from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
     if omegas.size * amps.size > MAX_CELLS:
@@ -180,7 +186,8 @@ def run(args: argparse.Namespace) -> int:
     maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
                          workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
+        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max,
+                                           _options.file_options(loaded, name)), scene,
                                 *eng_grid,
                                 backend=name, pulse=args.pulse, workers=workers))
     from analytic.threshold_validity import curve_validity

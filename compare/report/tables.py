@@ -379,6 +379,9 @@ def timing_rows(doc: dict) -> list[list]:
 def provenance_rows(doc: dict) -> list[list]:
     p = doc.get("provenance") or {}
     rows = [[k, str(p[k])] for k in ("date", "commit", "command") if k in p]
+    if p.get("settings_file"):  # which file set the engine settings table's values
+        f = p["settings_file"]
+        rows.append(["settings file", f"{f['file']} (sha256 {f['sha256']})"])
     rows += [[f"version: {k}", str(v)] for k, v in p.get("versions", {}).items()]
     rows += [[f"machine: {k}", str(v)] for k, v in p.get("machine", {}).items()]
     rows.append(["scene", doc["config"]["scene"]])
