@@ -10,6 +10,7 @@ import pytest
 from compare.cli.main import main
 from compare.run import runs
 
+from tests.support.paths import ROOT
 from tests.system.test_door import no_work  # noqa: F401  (the fixture)
 
 BAD = {
@@ -27,6 +28,8 @@ COMMANDS = {
     "map": ["map", "--engine", "pymunk", "--omega", "8:12:2", "--amplitude", "2:6:2"],
     "report": ["report", "--engine", "pymunk", "--quick"],
     "campaign": ["campaign", "{campaign}"],
+    "fragility": ["fragility", "--records", "sample", "--engine", "pymunk"],
+    "spectrum_record": ["spectrum", "--engine", "pymunk", "--record", "{record}"],
 }
 
 
@@ -41,7 +44,7 @@ def bad_files(tmp_path_factory) -> dict[str, str]:
                                   'engines = ["pymunk"]\npulses = ["sine"]\nomega = [12.0]\n'
                                   'steps = [0]\n')
     out["campaign"] = str(d / "study.toml")
-    out["out"] = str(d / "out")
+    out["record"] = str(ROOT / "scenes" / "records" / "sample.csv")
     return out
 
 
@@ -50,7 +53,7 @@ def bad_files(tmp_path_factory) -> dict[str, str]:
 def test_a_bad_settings_file_is_refused_before_any_run(command, bad, bad_files, no_work,
                                                        capsys, tmp_path):
     argv = [a.format(**bad_files) for a in COMMANDS[command]]
-    if command in ("report", "campaign"):
+    if command in ("report", "campaign", "fragility"):
         argv += ["--out", str(tmp_path / "out")]
     assert main(argv + ["--settings", bad_files[bad]]) == 2
     err = capsys.readouterr().err.splitlines()
