@@ -6,6 +6,11 @@
     [pymunk]
     dt = 0.0005
 
+The calibrated threshold settings of each engine are stored in
+``docs/validation/settings/ENGINE-thresholds.toml`` (:func:`threshold_options`):
+every threshold search starts from them; restitution and time histories keep
+the engine's defaults, which are calibrated for them.
+
 Every key is a field of that engine's ``Settings`` and is validated by it
 (:func:`engines.configure`), so a file is refused as a whole, before any run, with
 the file, the table and the key named.  Data only: nothing in the file is
@@ -13,6 +18,7 @@ evaluated.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import tomllib
@@ -20,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["SettingsFile", "load_settings_file", "read_settings_file", "settings_toml",
-           "RUN_FIELDS"]
+           "stored_settings", "threshold_options", "RUN_FIELDS", "SETTINGS_DIR"]
 
 # Larger files are not settings files (a handful of keys per engine).
 MAX_BYTES = 64 * 1024
@@ -28,6 +34,9 @@ MAX_BYTES = 64 * 1024
 # window and stop rule of a verdict, the overturning criterion of a spectrum): a
 # settings file holding them would silently change what is measured, not how.
 RUN_FIELDS = ("theta0", "psi0", "t_max", "early_stop", "verdict_only", "criterion")
+# The calibrated settings per engine and metric, written by 'trilith calibrate'
+# (the command that regenerates each is the file's first comment).
+SETTINGS_DIR = Path(__file__).resolve().parents[2] / "docs" / "validation" / "settings"
 
 
 @dataclass(frozen=True)
@@ -107,6 +116,21 @@ def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
             raise ValueError(f"{where}: [{name}] {exc}") from None
         out[name] = dict(table)
     return out
+
+
+@functools.lru_cache(maxsize=None)
+def stored_settings(engine: str, metric: str) -> SettingsFile | None:
+    """``SETTINGS_DIR/ENGINE-METRIC.toml`` as read (validated), or None when absent."""
+    path = SETTINGS_DIR / f"{engine}-{metric}.toml"
+    return read_settings_file(path) if path.is_file() else None
+
+
+def threshold_options(engine: str) -> dict:
+    """The options of ``engine``'s calibrated threshold settings (empty when none
+    are stored): the first layer of every threshold search's settings, under a
+    ``--settings`` file and ``--dt``."""
+    stored = stored_settings(engine, "thresholds")
+    return {} if stored is None else stored.options(engine)
 
 
 def settings_toml(engine: str, options: dict, comment: str = "") -> str:

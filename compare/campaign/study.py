@@ -213,14 +213,17 @@ def threshold_jobs(study: Study, references: dict, settings: dict | None = None)
 
 def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
                  options: tuple = ()):
-    """The validation campaign's pulse settings (friction raised for the largest
-    pulse of the bisection): ``options`` (a settings file's table) over the engine's
-    defaults, at time step ``dt`` (0: the table's step, else the calibrated one)."""
-    from compare.campaign.validation import CampaignConfig, _pulse_settings
+    """A threshold search's settings as the validation campaign's (friction raised
+    for the largest pulse of the bisection): the engine's calibrated threshold
+    settings, ``options`` (a settings file's table) over them, at time step ``dt``
+    (0: the table's step, else the calibrated threshold step)."""
+    from compare.campaign.validation import CampaignConfig, engine_options
+    from compare.measure.engine_spectrum import pulse_settings
 
     config = CampaignConfig(engines=(engine,), engine_dt=dt or None,
                             engine_settings={engine: dict(options)} if options else {})
-    return _pulse_settings(engine, config, scene, 2.0 * a_ref, omega)
+    return pulse_settings(engine, scene, 2.0 * a_ref, omega,
+                          **engine_options(engine, config, thresholds=True))
 
 
 def threshold_description(job: tuple) -> dict:

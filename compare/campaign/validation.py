@@ -147,10 +147,14 @@ class CampaignConfig:
         return plain(self)
 
 
-def engine_options(name: str, config: CampaignConfig) -> dict:
-    """The options the campaign sets for backend ``name``: its settings-file table,
-    then ``engine_dt`` over it (engines only)."""
-    options = dict(config.engine_settings.get(name, {}))
+def engine_options(name: str, config: CampaignConfig, thresholds: bool = False) -> dict:
+    """The options the campaign sets for backend ``name``: for a threshold search
+    (``thresholds``) the engine's calibrated threshold settings
+    (:func:`compare.campaign.settings_file.threshold_options`) first, then its
+    settings-file table, then ``engine_dt`` (engines only)."""
+    from compare.campaign.settings_file import threshold_options
+    options = threshold_options(name) if thresholds and name in ENGINES else {}
+    options.update(config.engine_settings.get(name, {}))
     if config.engine_dt is not None and name in ENGINES:
         options["dt"] = config.engine_dt
     return options
@@ -190,7 +194,7 @@ def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
     from compare.measure.engine_spectrum import measure_point
     return measure_point(name, scene, omega, a_ref, mode_ref, case=case,
                          tol=config.tolerances.threshold, rel_tol=config.rel_tol,
-                         convergence=True, **engine_options(name, config))
+                         convergence=True, **engine_options(name, config, thresholds=True))
 
 
 def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
@@ -322,13 +326,15 @@ class CampaignResult:
     timings: dict = field(default_factory=dict)
     errors: list = field(default_factory=list)  # jobs that raised, with the message
     long_runs: list = field(default_factory=list)  # compare.measure.long_runs rows
+    threshold_settings: dict = field(default_factory=dict)  # engine -> its threshold searches'
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
                 "settings": self.settings, "versions": self.versions,
                 "comparisons": self.comparisons, "restitution": self.restitution,
                 "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
-                "errors": self.errors, "long_runs": self.long_runs}
+                "errors": self.errors, "long_runs": self.long_runs,
+                "threshold_settings": self.threshold_settings}
 
 
 def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
@@ -348,6 +354,8 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     result = CampaignResult(
         config=config, scene=scene,
         settings={b: plain(backend_settings(b, config)) for b in backends},
+        threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True)))
+                            for e in config.engines},
         versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)})
 
     # Reference spectra first (in this process: the compiled kernels are then

@@ -300,8 +300,10 @@ def _check_engine_budget(args, names, omegas, loaded=None) -> None:
 
 
 def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
-    """Each engine's spectrum on the model's grid: its calibrated settings, the
-    ``--settings`` file's table over them, ``--dt``/``--t-max`` over both."""
+    """Each engine's spectrum on the model's grid: its calibrated threshold settings
+    (:func:`compare.campaign.settings_file.threshold_options`), the ``--settings``
+    file's table over them, ``--dt``/``--t-max`` over both."""
+    from compare.campaign.settings_file import threshold_options
     from pathlib import Path
 
     from compare.run import atomic
@@ -319,7 +321,8 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
         t0 = time.perf_counter()
         results.append(es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
                                           convergence=args.convergence,
-                                          **{**file_options(loaded, name), **options}))
+                                          **{**threshold_options(name),
+                                             **file_options(loaded, name), **options}))
         walls[name] = time.perf_counter() - t0
     if args.csv:
         with atomic.atomic_path(args.csv) as tmp:
