@@ -262,5 +262,6 @@ def run_threshold(job: tuple) -> dict:
             "bracketed": point.bracketed, "mode_engine": point.mode_engine,
             "n_runs": point.n_runs, "irregular_runs": point.irregular_runs,
             "isolated": len(point.isolated), "cause": point.cause, "valid": point.valid,
-            "cpu_s": point.cpu_s, "cpu_s_spent": point.point.cpu_s_spent,
+            "cpu_s": point.cpu_s, "sim_s": point.point.sim_s,
+            "cpu_s_spent": point.point.cpu_s_spent,
             "from_store": point.point.from_store}
