@@ -21,6 +21,7 @@ from analytic.spectrum import overturning_spectrum
 from compare.campaign.settings_file import threshold_options
 from compare.measure import engine_spectrum as es
 from compare.run import runs
+from compare.run.jsonable import plain
 from engines import configure
 from scenes import load_scene
 
@@ -69,14 +70,14 @@ def main(argv: list[str] | None = None) -> int:
     print(f"CPU ratio {ratio:.3f}x (target <= 0.25x: {'met' if ratio <= 0.25 else 'MISSED'}); "
           f"agree at the defaults but not calibrated: {lost or 'none'} (target none: "
           f"{'met' if not lost else 'MISSED'}); agree only calibrated: {gained or 'none'}")
-    write("threshold_settings", {
+    write("threshold_settings", plain({
         "machine": machine(), "quick": quick, "engine": ENGINE, "calibrated": calibrated,
         "defaults": default_cost, "calibrated_cost": cal_cost, "cpu_ratio": ratio,
         "points": len(default_pts), "agree_defaults": len(agree_default),
         "agree_calibrated": len(agree_cal), "lost": lost, "gained": gained,
         "rel_error": {"defaults": [p.rel_error for p in default_pts],
                       "calibrated": [p.rel_error for p in cal_pts]},
-        "too_wide_at": wide})
+        "too_wide_at": wide}))
     return 1 if wide else 0
 
 
