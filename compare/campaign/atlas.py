@@ -117,13 +117,22 @@ def _bar(total: int, desc: str):
                 leave=False)
 
 
-def _many(fn, jobs: list, workers: int, desc: str) -> list:
+def _many(fn, jobs: list, workers: int, desc: str, deadline: float | None = None) -> list:
+    """``fn`` over ``jobs`` in order, in chunks; once ``deadline`` (``perf_counter``)
+    has passed no new chunk starts and the jobs left are None (not run)."""
+    chunk = max(10, 4 * workers)
+    out: list = [None] * len(jobs)
     bar = _bar(len(jobs), desc)
     try:
-        return list(runs.run_many(fn, jobs, workers=workers,
-                                  on_done=lambda i, r: bar.update(1)))
+        for start in range(0, len(jobs), chunk):
+            if deadline is not None and time.perf_counter() > deadline:
+                break
+            part = jobs[start:start + chunk]
+            out[start:start + len(part)] = runs.run_many(
+                fn, part, workers=workers, on_done=lambda i, r: bar.update(1))
     finally:
         bar.close()
+    return out
 
 
 def _compact(row: dict) -> dict:
@@ -135,12 +144,19 @@ def _compact(row: dict) -> dict:
     return out
 
 
-def run_atlas(config: AtlasConfig, workers: int = 1) -> dict:
-    """Measure the atlas (module docstring); returns the ``atlas.json`` document."""
+def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = None) -> dict:
+    """Measure the atlas (module docstring); returns the ``atlas.json`` document.
+
+    ``budget_s``: wall seconds after which no new chunk of engine jobs starts
+    (the model's references and validity are always complete); the jobs left are
+    counted in ``not_run`` per engine and step, and those points carry no row
+    for that step (nor for any coarser one).
+    """
     from compare.campaign.study import run_reference, run_threshold, threshold_description
     from compare.run.keys import backend_version, digest, project_version
 
     t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
+    deadline = None if budget_s is None else t0 + budget_s
     pairs = atlas_scenes(config)
     ref_jobs = [(n, c, p, w) for n, p in pairs for c in config.cases for w in config.omegas]
     refs = _many(run_reference, ref_jobs, workers, "atlas: model")
@@ -158,32 +174,34 @@ def run_atlas(config: AtlasConfig, workers: int = 1) -> dict:
     # Engines run where the model is valid (or its check had nothing to say).
     todo = {e: [i for i in finite if points[i]["valid"] is not False] for e in config.engines}
     steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
+    not_run: dict = {e: {} for e in config.engines}
     for level, factor in enumerate(config.factors):
-        jobs, owners = [], []
         for e in config.engines:
+            dt = steps[e][level]
             opts = tuple(sorted(config.options(e).items()))
-            for i in todo[e]:
-                pt = points[i]
-                jobs.append((pt["scene"], pt["case"], pt["pulse"], pt["omega"],
-                             pt["a_reference"], pt["mode"], e, steps[e][level],
-                             config.rel_bracket, config.rel_tol, opts))
-                owners.append((e, i))
-        unique: dict[str, int] = {}
-        distinct, index = [], []
-        for job in jobs:
-            key = digest(threshold_description(job))
-            if key not in unique:
-                unique[key] = len(distinct)
-                distinct.append(job)
-            index.append(unique[key])
-        rows = _many(run_threshold, distinct, workers, f"atlas: {factor:g}x step")
-        next_todo = {e: [] for e in config.engines}
-        for (e, i), k in zip(owners, index):
-            row = _compact(rows[k])
-            points[i]["engines"][e].append(row)
-            if row.get("cause") == "agrees":
-                next_todo[e].append(i)
-        todo = next_todo
+            jobs = [(points[i]["scene"], points[i]["case"], points[i]["pulse"],
+                     points[i]["omega"], points[i]["a_reference"], points[i]["mode"], e, dt,
+                     config.rel_bracket, config.rel_tol, opts) for i in todo[e]]
+            unique: dict[str, int] = {}
+            distinct, index = [], []
+            for job in jobs:
+                key = digest(threshold_description(job))
+                if key not in unique:
+                    unique[key] = len(distinct)
+                    distinct.append(job)
+                index.append(unique[key])
+            rows = _many(run_threshold, distinct, workers, f"atlas: {e} {factor:g}x step",
+                         deadline)
+            agreed = []
+            for i, k in zip(todo[e], index):
+                if rows[k] is None:
+                    not_run[e][repr(dt)] = not_run[e].get(repr(dt), 0) + 1
+                    continue
+                row = _compact(rows[k])
+                points[i]["engines"][e].append(row)
+                if row.get("cause") == "agrees":
+                    agreed.append(i)
+            todo[e] = agreed
     return {"schema_version": 1,
             "what": "engine first-overturning amplitude vs the model over the paper's scenes",
             "config": config.describe(),
@@ -191,6 +209,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1) -> dict:
                          "analytic-fast": backend_version("analytic-fast"),
                          **{e: backend_version(e) for e in config.engines}},
             "steps": steps, "points": points, "cost": cost_table(points, config),
+            "budget_s": budget_s,
+            "not_run": {e: n for e, n in not_run.items() if n},
             "wall_s": time.perf_counter() - t0, "parent_cpu_s": time.process_time() - c0,
             "load_average": [load0, os.getloadavg()[0]], "workers": workers}
 

@@ -38,6 +38,9 @@ def add_parser(subparsers) -> None:
                    help="write a standalone HTML page (heat maps, trusted region, cost)")
     p.add_argument("--from", dest="source", default=None, metavar="FILE",
                    help="render a stored atlas JSON (with --html); run nothing")
+    p.add_argument("--time-budget", type=float, default=None, metavar="MIN",
+                   help="wall minutes after which no new chunk of engine jobs starts; the "
+                        "jobs left are recorded as not run (default: no limit)")
     add_settings_arg(p)
     add_workers_arg(p)
     add_store_args(p, scheduler=True)
@@ -79,10 +82,13 @@ def run(args: argparse.Namespace) -> int:
                                      for e, t in loaded.tables.items() if e in engines))
         except ValueError as exc:
             raise ValueError(f"--factors/--engine: {exc}") from None
+        budget = args.time_budget
+        if budget is not None and not (0.0 <= budget <= 1e5):
+            raise ValueError(f"--time-budget must be in [0, 1e5] min, got {budget!r}")
         workers = resolve_workers(args.workers)
         use_store(args)
-        doc = run_atlas(config, workers)
-        doc["not_run"] = [e for e in DEFAULT_ENGINES if e not in engines]
+        doc = run_atlas(config, workers, None if budget is None else 60.0 * budget)
+        doc["engines_not_run"] = [e for e in DEFAULT_ENGINES if e not in engines]
         doc["settings_file"] = None if loaded is None else loaded.describe()
         from compare.run.provenance import command_line
         doc["command"] = command_line(args)

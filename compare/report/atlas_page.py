@@ -56,6 +56,9 @@ def trusted_rows(doc: dict) -> list[list]:
                    f"{pt['omega']:g}: {r.get('cause') or r.get('error', 'error')}"
                    for pt, r in at if r.get("cause") != "agrees"]
             shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
+            skipped = doc.get("not_run", {}).get(engine, {}).get(repr(dt))
+            if skipped:
+                shown = f"{skipped} jobs not run (time budget); " + shown
             out.append([engine, f"{dt:.3g}", f"{len(agree)} / {len(valid)}",
                         f"{100 * len(agree) / len(valid):.0f} %" if valid else "-",
                         f"{100 * max(errs):.2g} %" if errs else "-",
@@ -168,7 +171,9 @@ def atlas_html(doc: dict, level: int = 2) -> str:
     h, sub = f"h{level}", f"h{level + 1}"
     cfg = doc.get("config", {})
     ran = ", ".join(doc.get("steps", {})) or "none"
-    not_run = ", ".join(doc.get("not_run", [])) or "none"
+    not_run = ", ".join(doc.get("engines_not_run", [])) or "none"
+    skipped = "; ".join(f"{e} at dt {dt}: {n} jobs" for e, by in doc.get("not_run", {}).items()
+                        for dt, n in by.items())
     n_invalid = sum(pt["valid"] is False for pt in doc["points"])
     parts = [f"<{h} id='atlas'>Trust atlas</{h}>",
              f"<p>{len(doc['points'])} model points ({len({pt['scene'] for pt in doc['points']})} "
@@ -177,7 +182,9 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              f"of them (no engine run there). Engines run: {html.escape(ran)}; not run: "
              f"{html.escape(not_run)}. Tolerance {100 * _tol(doc):g} %; steps "
              f"{html.escape(str(cfg.get('factors')))} x each engine's calibrated threshold "
-             "step, a coarser one only where the finer one agreed.</p>"]
+             "step, a coarser one only where the finer one agreed."
+             + (f" Not run (time budget of {doc['budget_s'] / 60:.0f} min reached): "
+                f"{html.escape(skipped)}." if skipped else "") + "</p>"]
     for engine in doc.get("steps", {}):
         png = base64.b64encode(heat_map_png(doc, engine)).decode()
         parts.append(f"<{sub}>{html.escape(engine)}</{sub}><img alt='atlas heat map "

@@ -61,9 +61,9 @@ def test_staged_deduplicated_resumable(store, monkeypatch):
         assert rows[0]["dt"] == pytest.approx(dt)
         # The coarser step ran exactly where the calibrated one agreed.
         assert (len(rows) == 2) == (rows[0]["cause"] == "agrees")
-    assert any(len(pt["engines"]["pymunk"]) == 2 for pt in pts)  # Omega 18 agrees at 2e-3 s
         if len(rows) == 2:
             assert rows[1]["dt"] == pytest.approx(5 * dt)
+    assert any(len(pt["engines"]["pymunk"]) == 2 for pt in pts)  # Omega 18 agrees at 2e-3 s
     np_rows = [pt["engines"]["pymunk"] for pt in pts if pt["case"] == "no_pendulum"]
     assert np_rows[0] == np_rows[1]
     costs = {(c["engine"], c["dt"]) for c in doc["cost"]}
@@ -73,6 +73,19 @@ def test_staged_deduplicated_resumable(store, monkeypatch):
     again = run_atlas(config)
     assert runs.STATS.get("computed", 0) == 0
     assert [p["engines"] for p in again["points"]] == [p["engines"] for p in pts]
+
+
+def test_a_time_budget_records_the_jobs_it_did_not_run(store, monkeypatch):
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES[:1], omegas=(12.0,),
+                         factors=(1.0,), cases=("pendulum",))
+
+    def no_engine(job):
+        raise AssertionError("an engine ran after the budget")
+    monkeypatch.setattr("compare.campaign.study.run_threshold", no_engine)
+    doc = run_atlas(config, budget_s=0.0)
+    (pt,) = doc["points"]
+    assert pt["engines"]["pymunk"] == []
+    assert doc["not_run"] == {"pymunk": {repr(base_step("pymunk", config)): 1}}
 
 
 def test_no_engine_runs_where_the_model_is_invalid(store, monkeypatch):
@@ -107,7 +120,7 @@ def _synthetic() -> dict:
                     "model_reason": "" if valid else "columns hop",
                     "engines": {"pymunk": rows}})
     return {"config": {"tol": 0.02, "factors": [1, 2], "omegas": [10.0]},
-            "steps": {"pymunk": [2e-3, 4e-3]}, "points": pts, "not_run": ["pybullet"],
+            "steps": {"pymunk": [2e-3, 4e-3]}, "points": pts, "engines_not_run": ["pybullet"],
             "cost": atlas.cost_table(pts, AtlasConfig(engines=("pymunk",)))}
 
 
