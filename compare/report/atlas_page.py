@@ -116,17 +116,19 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
     import matplotlib.pyplot as plt
     import numpy as np
     from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.ticker import PercentFormatter
 
     tol = _tol(doc)
     lim = 3 * tol
     cases = [c for c in ("pendulum", "no_pendulum")
              if any(pt["case"] == c for pt in doc["points"])]
     n_rows = max(len(_grid(doc, engine, c)[0]) for c in cases)
-    fig, axes = plt.subplots(1, len(cases), figsize=(6.2 * len(cases), 1.2 + 0.24 * n_rows),
-                             squeeze=False)
+    # Stacked: readable on a phone, the Omega axes aligned.
+    fig, axes = plt.subplots(len(cases), 1, figsize=(7.5, len(cases) * (1.1 + 0.22 * n_rows)),
+                             squeeze=False, layout="constrained")
     cmap = plt.get_cmap("RdBu_r").with_extremes(bad="white")
     image = None
-    for ax, case in zip(axes[0], cases):
+    for ax, case in zip(axes[:, 0], cases):
         labels, omegas, err, text, invalid = _grid(doc, engine, case)
         shown = np.clip(err, -lim, lim)
         image = ax.imshow(np.ma.masked_invalid(shown), cmap=cmap, aspect="auto",
@@ -143,15 +145,13 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
         ax.set_yticks(range(len(labels)), labels, fontsize=6.5)
         ax.set_xlabel("Ω [rad/s]")
         ax.set_title(f"{engine}: {case.replace('_', ' ')}", fontsize=9)
-    bar = fig.colorbar(image, ax=axes[0].tolist(), fraction=0.025, pad=0.02)
+    bar = fig.colorbar(image, ax=axes[:, 0].tolist(), fraction=0.04, pad=0.03, aspect=40)
     bar.set_label("A_engine / A_model - 1 (calibrated step)", fontsize=8)
+    bar.ax.yaxis.set_major_formatter(PercentFormatter(xmax=1.0, decimals=0))
+    bar.set_ticks([-lim, -tol, 0.0, tol, lim])
     for y in (-tol, tol):
-        bar.ax.axhline(y, color="black", lw=1.2)
+        bar.ax.axhline(y, color="black", lw=1.5, zorder=5)
     bar.ax.tick_params(labelsize=7)
-    fig.text(0.01, 0.005, "grey: model invalid (no engine run); digits: coarsest step factor "
-                          "that still agrees; letters: cause "
-             + ", ".join(f"{s} {c}" for c, s in CAUSE_SYMBOL.items()) + "; · no overturning",
-             fontsize=6.5)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
@@ -185,14 +185,21 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              "step, a coarser one only where the finer one agreed."
              + (f" Not run (time budget of {doc['budget_s'] / 60:.0f} min reached): "
                 f"{html.escape(skipped)}." if skipped else "") + "</p>"]
+    legend = ("Colour: threshold error at the calibrated step (black lines on the bar: the "
+              "tolerance); grey: the model is invalid (no engine run); a digit: the coarsest "
+              "step factor that still agrees; a letter: the cause of a disagreement ("
+              + ", ".join(f"{s} {c}" for c, s in CAUSE_SYMBOL.items())
+              + "); a dot: the model does not overturn in its search range.")
     for engine in doc.get("steps", {}):
         png = base64.b64encode(heat_map_png(doc, engine)).decode()
         parts.append(f"<{sub}>{html.escape(engine)}</{sub}><img alt='atlas heat map "
-                     f"{html.escape(engine)}' src='data:image/png;base64,{png}'>")
+                     f"{html.escape(engine)}' src='data:image/png;base64,{png}'>"
+                     f"<p class='small'>{html.escape(legend)}</p>")
     parts += [f"<{sub}>Trusted region per engine and step</{sub}>",
               _table(TRUSTED_HEAD, trusted_rows(doc)),
               f"<{sub}>Cost per engine and step</{sub}>", _table(COST_HEAD, cost_rows(doc)),
-              f"<p>Load average {html.escape(str(doc.get('load_average')))}, "
+              "<p>Load average " + " -> ".join(f"{x:.1f}" for x in doc.get("load_average") or [])
+              + ", "
               f"{doc.get('workers', '?')} workers; command: "
               f"<code>{html.escape(str(doc.get('command', '')))}</code></p>"]
     return "\n".join(parts)
