@@ -141,3 +141,12 @@ def test_page_shows_maps_tables_and_what_was_not_run(tmp_path):
     png = text.split("data:image/png;base64,")[1].split("'")[0]
     assert base64.b64decode(png)[:8] == b"\x89PNG\r\n\x1a\n"
     assert json.dumps(_synthetic())  # the document is plain data
+
+
+def test_the_report_section_reads_the_stored_atlas(tmp_path):
+    from compare.report.atlas_page import stored_atlas_section
+    assert "No stored atlas" in stored_atlas_section(tmp_path / "missing.json")
+    path = tmp_path / "atlas.json"
+    path.write_text(json.dumps(_synthetic()))
+    text = stored_atlas_section(path)
+    assert "id='atlas'" in text and text.count("data:image/png;base64,") == 1
