@@ -223,12 +223,12 @@ def write_page(doc: dict, path) -> Path:
 STORED = Path(__file__).resolve().parents[2] / "docs" / "validation" / "atlas.json"
 
 
-def stored_atlas_section(path=STORED) -> str:
+def stored_atlas_section(path=None) -> str:
     """The report's atlas section from the stored atlas (``docs/validation/atlas.json``,
     measured by ``trilith atlas``, not by the report's own campaign); a line saying
     it is missing when there is none."""
     import json
-    p = Path(path)
+    p = Path(path) if path is not None else STORED
     if not p.is_file():
         return ("<h2 id='atlas'>Trust atlas</h2><p>No stored atlas "
                 f"(<code>{html.escape(str(p.name))}</code>); <code>trilith atlas --json "
