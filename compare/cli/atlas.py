@@ -106,6 +106,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print(doc: dict) -> None:
+    """The trusted region per engine and step, one line each."""
     from compare.report.atlas_page import trusted_rows
-    for row in trusted_rows(doc):
-        print("  ".join(str(x) for x in row), file=sys.stdout)
+    print("engine, step [s]: points that agree / valid points (share), worst |error|; "
+          "where not", file=sys.stdout)
+    for engine, dt, agree, share, worst, where in trusted_rows(doc):
+        print(f"{engine}, {dt}: {agree} ({share}), {worst}; {where}", file=sys.stdout)
