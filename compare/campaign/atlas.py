@@ -208,28 +208,34 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
             "versions": {"project": project_version(),
                          "analytic-fast": backend_version("analytic-fast"),
                          **{e: backend_version(e) for e in config.engines}},
-            "steps": steps, "points": points, "cost": cost_table(points, config),
+            "steps": steps, "points": points, "cost": cost_table(points, config.engines),
             "budget_s": budget_s,
             "not_run": {e: n for e, n in not_run.items() if n},
             "wall_s": time.perf_counter() - t0, "parent_cpu_s": time.process_time() - c0,
             "load_average": [load0, os.getloadavg()[0]], "workers": workers}
 
 
-def cost_table(points: list[dict], config: AtlasConfig) -> list[dict]:
-    """Per engine and step: points measured, CPU seconds (when computed), CPU s per
-    threshold point and per simulated second."""
+def cost_table(points: list[dict], engines) -> list[dict]:
+    """Per engine and step: points measured, jobs (identical tricks are one job: the
+    same case, pulse, Omega, model threshold and engine result), CPU seconds of the
+    jobs (when computed), CPU s per job and per simulated second."""
     out = []
-    for e in config.engines:
-        by_dt: dict[float, list] = {}
+    for e in engines:
+        by_dt: dict[float, dict] = {}
         for pt in points:
             for row in pt["engines"].get(e, ()):
-                by_dt.setdefault(row["dt"], []).append(row)
+                job = (pt["case"], pt["pulse"], pt["omega"], pt["a_reference"],
+                       row.get("a_engine"), row.get("n_runs"), row.get("cpu_s"))
+                seen = by_dt.setdefault(row["dt"], {"points": 0, "jobs": {}})
+                seen["points"] += 1
+                seen["jobs"][job] = row
         for dt in sorted(by_dt):
-            rows = [r for r in by_dt[dt] if "error" not in r]
+            rows = [r for r in by_dt[dt]["jobs"].values() if "error" not in r]
             cpu = math.fsum(r["cpu_s"] for r in rows if r.get("cpu_s") is not None)
             sim = math.fsum(r.get("sim_s") or 0.0 for r in rows)
-            out.append({"engine": e, "dt": dt, "points": len(by_dt[dt]),
-                        "errors": len(by_dt[dt]) - len(rows), "cpu_s": cpu,
+            out.append({"engine": e, "dt": dt, "points": by_dt[dt]["points"],
+                        "jobs": len(by_dt[dt]["jobs"]),
+                        "errors": len(by_dt[dt]["jobs"]) - len(rows), "cpu_s": cpu,
                         "cpu_s_per_point": cpu / len(rows) if rows else None,
                         "cpu_s_per_sim_s": cpu / sim if sim > 0 else None})
     return out

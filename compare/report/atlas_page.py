@@ -26,7 +26,7 @@ CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W",
                 "unknown": "?"}
 TRUSTED_HEAD = ["engine", "step [s]", "agree / valid points", "share", "worst |error|",
                 "where not (scene Ω: cause)"]
-COST_HEAD = ["engine", "step [s]", "points", "CPU s per threshold point",
+COST_HEAD = ["engine", "step [s]", "points (jobs)", "CPU s per threshold job",
              "CPU s per simulated s", "CPU s in all"]
 
 
@@ -70,7 +70,8 @@ def trusted_rows(doc: dict) -> list[list]:
 def cost_rows(doc: dict) -> list[list]:
     def num(x, fmt):
         return "-" if x is None else format(x, fmt)
-    return [[c["engine"], f"{c['dt']:.3g}", str(c["points"]), num(c["cpu_s_per_point"], ".3g"),
+    return [[c["engine"], f"{c['dt']:.3g}", f"{c['points']} ({c.get('jobs', '?')})",
+             num(c["cpu_s_per_point"], ".3g"),
              num(c["cpu_s_per_sim_s"], ".3g"), num(c["cpu_s"], ".4g")]
             for c in doc.get("cost", [])]
 
