@@ -61,12 +61,15 @@ def check_budget(study, file, loaded=None) -> None:
 
 
 def _run_cost(engine: str, dt: float, costs: dict) -> float:
-    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: calibrated):
-    the mean measured in the store at that step, else the measured step nearest
-    to it scaled by the step ratio (steps per simulated second), else a prior."""
-    from engines import get_backend
+    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: the calibrated
+    threshold step): the mean measured in the store at that step, else the measured
+    step nearest to it scaled by the step ratio (steps per simulated second), else a
+    prior."""
+    from engines import configure
 
-    dt = dt or getattr(get_backend(engine).Settings(), "dt", 1e-4)
+    from compare.campaign.settings_file import threshold_options
+
+    dt = dt or getattr(configure(engine, **threshold_options(engine)), "dt", 1e-4)
     measured = {}
     for label, (mean, _n) in costs.items():
         name, _, step = label.partition(" dt=")
