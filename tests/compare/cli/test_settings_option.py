@@ -30,6 +30,9 @@ COMMANDS = {
     "campaign": ["campaign", "{campaign}"],
     "fragility": ["fragility", "--records", "sample", "--engine", "pymunk"],
     "spectrum_record": ["spectrum", "--engine", "pymunk", "--record", "{record}"],
+    "record": ["record", "--engine", "pymunk", "--out", "{gif}"],
+    "view": ["view", "--engine", "pymunk"],
+    "atlas": ["atlas", "--engine", "pymunk"],
 }
 
 
@@ -45,6 +48,7 @@ def bad_files(tmp_path_factory) -> dict[str, str]:
                                   'steps = [0]\n')
     out["campaign"] = str(d / "study.toml")
     out["record"] = str(ROOT / "scenes" / "records" / "sample.csv")
+    out["gif"] = str(d / "run.gif")
     return out
 
 
@@ -123,3 +127,11 @@ def test_campaign_jobs_carry_the_file_into_their_keys():
         digest(_job_description((job[0], (*job[1], b))))
     with pytest.raises(ValueError, match="iterations"):
         CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"iterations": 0}})
+
+
+def test_recordings_run_with_the_file_options():
+    from compare.show.record import RecordSettings, backend_settings
+    settings = RecordSettings(engine_options=(("pymunk", (("dt", 1e-3),)),))
+    assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
+    run = backend_settings("pymunk", 2.0, settings.options("pymunk"))
+    assert (run.dt, run.t_max, run.early_stop) == (1e-3, 2.0, False)
