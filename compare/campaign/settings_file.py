@@ -6,6 +6,11 @@
     [pymunk]
     dt = 0.0005
 
+The calibrated threshold settings of each engine are stored in
+``docs/validation/settings/ENGINE-thresholds.toml`` (:func:`threshold_options`):
+every threshold search starts from them; restitution and time histories keep
+the engine's defaults, which are calibrated for them.
+
 Every key is a field of that engine's ``Settings`` and is validated by it
 (:func:`engines.configure`), so a file is refused as a whole, before any run, with
 the file, the table and the key named.  Data only: nothing in the file is
@@ -13,28 +18,63 @@ evaluated.
 """
 from __future__ import annotations
 
+import functools
+import hashlib
 import math
 import tomllib
+from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["load_settings_file", "settings_toml"]
+__all__ = ["SettingsFile", "load_settings_file", "read_settings_file", "settings_toml",
+           "stored_settings", "threshold_options", "RUN_FIELDS", "SETTINGS_DIR"]
 
 # Larger files are not settings files (a handful of keys per engine).
 MAX_BYTES = 64 * 1024
+# Fields each command sets per run (the release tilt of a free-rocking run, the
+# window and stop rule of a verdict, the overturning criterion of a spectrum): a
+# settings file holding them would silently change what is measured, not how.
+RUN_FIELDS = ("theta0", "psi0", "t_max", "early_stop", "verdict_only", "criterion")
+# The calibrated settings per engine and metric, written by 'trilith calibrate'
+# (the command that regenerates each is the file's first comment).
+SETTINGS_DIR = Path(__file__).resolve().parents[2] / "docs" / "validation" / "settings"
+
+
+@dataclass(frozen=True)
+class SettingsFile:
+    """A settings file as read: its path, the SHA-256 of its bytes (which settings
+    produced a number, even after the file is edited) and its tables
+    ``{engine: {field: value}}``, each validated by the engine's ``Settings``."""
+
+    path: str
+    sha256: str
+    tables: dict = field(default_factory=dict)
+
+    def options(self, engine: str) -> dict:
+        """The fields ``engine``'s table sets (empty when the file has no table for it)."""
+        return dict(self.tables.get(engine, {}))
+
+    def describe(self) -> dict:
+        return {"file": self.path, "sha256": self.sha256,
+                "tables": {k: dict(v) for k, v in self.tables.items()}}
 
 
 def load_settings_file(path) -> dict[str, dict]:
     """``{engine: {field: value}}`` from a settings TOML file, each table checked by
-    the engine's ``Settings``.
+    the engine's ``Settings`` (:func:`read_settings_file`)."""
+    return read_settings_file(path).tables
+
+
+def read_settings_file(path) -> SettingsFile:
+    """A settings TOML file, read once, each table checked by the engine's ``Settings``.
 
     Raises
     ------
     ValueError
         Unreadable, not TOML, too large, an unknown engine (naming the known
-        ones), a field the engine does not have (naming its fields) or a value it
-        refuses; the message starts with the file's name.
+        ones), a field the engine does not have (naming its fields), a field set
+        per run (:data:`RUN_FIELDS`) or a value the engine refuses; the message
+        starts with the file's name.
     """
-    import engines
     p = Path(path)
     where = f"settings file {str(p)!r}"
     if not p.is_file():
@@ -50,6 +90,11 @@ def load_settings_file(path) -> dict[str, dict]:
         doc = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise ValueError(f"{where}: not TOML ({str(exc).splitlines()[0]})") from None
+    return SettingsFile(str(p), hashlib.sha256(data).hexdigest(), _checked_tables(doc, where))
+
+
+def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
+    import engines
     known = engines.engine_names()
     out = {}
     for name, table in doc.items():
@@ -59,6 +104,10 @@ def load_settings_file(path) -> dict[str, dict]:
         if not isinstance(table, dict):
             raise ValueError(f"{where}: [{name}] must be a table of settings")
         for key, value in table.items():
+            if key in RUN_FIELDS:
+                raise ValueError(f"{where}: [{name}] {key} is set by each command for its "
+                                 f"runs, not by a settings file (refused: "
+                                 f"{', '.join(RUN_FIELDS)})")
             if isinstance(value, float) and not math.isfinite(value):
                 raise ValueError(f"{where}: [{name}] {key} must be finite, got {value!r}")
         try:
@@ -67,6 +116,21 @@ def load_settings_file(path) -> dict[str, dict]:
             raise ValueError(f"{where}: [{name}] {exc}") from None
         out[name] = dict(table)
     return out
+
+
+@functools.lru_cache(maxsize=None)
+def stored_settings(engine: str, metric: str) -> SettingsFile | None:
+    """``SETTINGS_DIR/ENGINE-METRIC.toml`` as read (validated), or None when absent."""
+    path = SETTINGS_DIR / f"{engine}-{metric}.toml"
+    return read_settings_file(path) if path.is_file() else None
+
+
+def threshold_options(engine: str) -> dict:
+    """The options of ``engine``'s calibrated threshold settings (empty when none
+    are stored): the first layer of every threshold search's settings, under a
+    ``--settings`` file and ``--dt``."""
+    stored = stored_settings(engine, "thresholds")
+    return {} if stored is None else stored.options(engine)
 
 
 def settings_toml(engine: str, options: dict, comment: str = "") -> str:

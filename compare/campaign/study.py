@@ -194,37 +194,47 @@ def run_reference(job: tuple) -> tuple[float, str | None]:
     return float(res[0]), res[2]
 
 
-def threshold_jobs(study: Study, references: dict) -> list[tuple]:
-    """``(scene, case, pulse, omega, a_ref, mode_ref, engine, dt, rel_bracket, rel_tol)``
-    for every reference point that overturns (NaN references have nothing to bracket)."""
+def threshold_jobs(study: Study, references: dict, settings: dict | None = None) -> list[tuple]:
+    """``(scene, case, pulse, omega, a_ref, mode_ref, engine, dt, rel_bracket, rel_tol,
+    options)`` for every reference point that overturns (NaN references have nothing
+    to bracket); ``options`` is the engine's table of ``settings`` (a settings file's
+    ``{engine: {field: value}}``) as sorted pairs."""
     jobs = []
     for (n, c, p, w), (a_ref, mode) in references.items():
         if not math.isfinite(a_ref):
             continue
         for e in study.engines:
+            options = tuple(sorted((settings or {}).get(e, {}).items()))
             for dt in study.steps:
-                jobs.append((n, c, p, w, a_ref, mode, e, dt, study.rel_bracket, study.rel_tol))
+                jobs.append((n, c, p, w, a_ref, mode, e, dt, study.rel_bracket, study.rel_tol,
+                             options))
     return jobs
 
 
-def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float):
-    """The validation campaign's pulse settings (friction raised for the largest
-    pulse of the bisection) at time step ``dt`` (0: calibrated)."""
-    from compare.campaign.validation import CampaignConfig, _pulse_settings
+def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
+                 options: tuple = ()):
+    """A threshold search's settings as the validation campaign's (friction raised
+    for the largest pulse of the bisection): the engine's calibrated threshold
+    settings, ``options`` (a settings file's table) over them, at time step ``dt``
+    (0: the table's step, else the calibrated threshold step)."""
+    from compare.campaign.validation import CampaignConfig, engine_options
+    from compare.measure.engine_spectrum import pulse_settings
 
-    config = CampaignConfig(engines=(engine,), engine_dt=dt or None)
-    return _pulse_settings(engine, config, scene, 2.0 * a_ref, omega)
+    config = CampaignConfig(engines=(engine,), engine_dt=dt or None,
+                            engine_settings={engine: dict(options)} if options else {})
+    return pulse_settings(engine, scene, 2.0 * a_ref, omega,
+                          **engine_options(engine, config, thresholds=True))
 
 
 def threshold_description(job: tuple) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
     from compare.run.keys import backend_version, scene_dict, settings_dict
 
-    n, c, p, w, a_ref, mode, e, dt, rb, rt = job
+    n, c, p, w, a_ref, mode, e, dt, rb, rt, opts = job
     scene = _scene(n, c)
     return {"engine": e, "version": backend_version(e), "scene": scene_dict(scene),
             "pulse": p, "omega": w, "a_ref": a_ref, "mode_ref": mode,
-            "settings": settings_dict(job_settings(e, dt, scene, a_ref, w)),
+            "settings": settings_dict(job_settings(e, dt, scene, a_ref, w, opts)),
             "rel_bracket": rb, "rel_tol": rt}
 
 
@@ -233,15 +243,15 @@ def run_threshold(job: tuple) -> dict:
     from compare.run import runs
     from compare.measure.engine_spectrum import measure_point
 
-    n, c, p, w, a_ref, mode, e, dt, rb, rt = job
+    n, c, p, w, a_ref, mode, e, dt, rb, rt, opts = job
     scene = _scene(n, c)
+    settings = job_settings(e, dt, scene, a_ref, w, opts)
 
     def compute():  # the one threshold measurement; causes without the reruns
-        settings = job_settings(e, dt, scene, a_ref, w)
         return measure_point(e, scene, w, a_ref, mode, case=c, kind=p, rel_tol=rt,
                              rel_bracket=rb, convergence=False, settings=settings)
     row = {"scene": n, "case": c, "pulse": p, "omega": w, "engine": e, "dt": dt or None,
-           "a_reference": a_ref, "mode_reference": mode}
+           "dt_used": settings.dt, "a_reference": a_ref, "mode_reference": mode}
     try:
         point = runs.memo("threshold", threshold_description(job), compute,
                           label=f"threshold {e} dt={dt:g}", code=runs.ALL_CODE)
@@ -252,5 +262,6 @@ def run_threshold(job: tuple) -> dict:
             "bracketed": point.bracketed, "mode_engine": point.mode_engine,
             "n_runs": point.n_runs, "irregular_runs": point.irregular_runs,
             "isolated": len(point.isolated), "cause": point.cause, "valid": point.valid,
-            "cpu_s": point.cpu_s, "cpu_s_spent": point.point.cpu_s_spent,
+            "cpu_s": point.cpu_s, "sim_s": point.point.sim_s,
+            "cpu_s_spent": point.point.cpu_s_spent,
             "from_store": point.point.from_store}

@@ -174,6 +174,11 @@ class ThresholdResult:
     def agrees(self) -> bool:
         return self.cause == "agrees"
 
+    @property
+    def dt(self) -> float | None:
+        """The engine time step [s] the search ran at (its runs' provenance)."""
+        return num((self.raw.get("provenance") or {}).get("dt"))
+
     @classmethod
     def from_dict(cls, d, case: str | None = None) -> "ThresholdResult":
         a_eng, a_ref = num(d.get("a_engine")), num(d.get("a_reference"))

@@ -40,7 +40,7 @@ from compare.measure.reference_spectra import choose_frequencies, reference_spec
 from compare.measure.jump_shift import engine_jump_frequency
 
 __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
-           "free_rocking_restitution"]
+           "engine_options", "free_rocking_restitution"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +98,8 @@ class CampaignConfig:
     rel_bracket: float = 0.03  # frequencies are chosen where the model is monotone 2x this above
     rel_tol: float = 5e-3  # robust bracket width (the one search's, compare.measure.thresholds)
     engine_dt: float | None = None  # override every engine's time step (None: calibrated)
+    engine_settings: dict = field(default_factory=dict)  # {engine: {field: value}}, a settings
+    #   file's tables (compare/campaign/settings_file.py), under engine_dt and each job's own
     long_run_t_max: float = 20.0  # s, fixed window of the long runs (compare/measure/long_runs.py)
     long_runs: bool = True  # the trust table's long-run line (rest, after a pulse)
     workers: int = 2  # the target machine has 2 cores
@@ -120,6 +122,11 @@ class CampaignConfig:
                                                and 0.0 < self.engine_dt <= MAX_ENGINE_DT):
             raise ValueError(f"engine_dt must be in (0, {MAX_ENGINE_DT:g}] s, "
                              f"got {self.engine_dt!r}")
+        for name, options in self.engine_settings.items():
+            if name not in ENGINES:
+                raise ValueError(f"engine_settings: unknown engine {name!r}; allowed: "
+                                 f"{', '.join(ENGINES)}")
+            configure(name, **options)  # refused here, naming the field, not in a worker
         for case in (*self.spectrum_cases, *self.jump_cases):
             if case not in ("pendulum", "no_pendulum"):
                 raise ValueError(f"spectrum_cases: unknown case {case!r}; allowed: pendulum, "
@@ -140,12 +147,23 @@ class CampaignConfig:
         return plain(self)
 
 
-def backend_settings(name: str, config: CampaignConfig, **options):
-    """``name``'s calibrated settings (:func:`engines.configure`) with the
-    campaign's ``engine_dt`` applied to the engines, and ``options``."""
+def engine_options(name: str, config: CampaignConfig, thresholds: bool = False) -> dict:
+    """The options the campaign sets for backend ``name``: for a threshold search
+    (``thresholds``) the engine's calibrated threshold settings
+    (:func:`compare.campaign.settings_file.threshold_options`) first, then its
+    settings-file table, then ``engine_dt`` (engines only)."""
+    from compare.campaign.settings_file import threshold_options
+    options = threshold_options(name) if thresholds and name in ENGINES else {}
+    options.update(config.engine_settings.get(name, {}))
     if config.engine_dt is not None and name in ENGINES:
-        options.setdefault("dt", config.engine_dt)
-    return configure(name, **options)
+        options["dt"] = config.engine_dt
+    return options
+
+
+def backend_settings(name: str, config: CampaignConfig, **options):
+    """``name``'s calibrated settings (:func:`engines.configure`) with
+    :func:`engine_options` applied, then ``options``."""
+    return configure(name, **{**engine_options(name, config), **options})
 
 
 # ----------------------------------------------------------------------- jobs
@@ -168,17 +186,15 @@ def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omeg
     """Calibrated settings (with the campaign's ``engine_dt``) and the friction raised
     for the largest pulse of the job (:func:`compare.measure.engine_spectrum.pulse_settings`)."""
     from compare.measure.engine_spectrum import pulse_settings
-    options = {"dt": config.engine_dt} if config.engine_dt is not None else {}
-    return pulse_settings(name, scene, a_max, omega, **options)
+    return pulse_settings(name, scene, a_max, omega, **engine_options(name, config))
 
 
 def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
     """The one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`)."""
     from compare.measure.engine_spectrum import measure_point
-    options = {"dt": config.engine_dt} if config.engine_dt is not None else {}
     return measure_point(name, scene, omega, a_ref, mode_ref, case=case,
                          tol=config.tolerances.threshold, rel_tol=config.rel_tol,
-                         convergence=True, **options)
+                         convergence=True, **engine_options(name, config, thresholds=True))
 
 
 def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
@@ -310,13 +326,15 @@ class CampaignResult:
     timings: dict = field(default_factory=dict)
     errors: list = field(default_factory=list)  # jobs that raised, with the message
     long_runs: list = field(default_factory=list)  # compare.measure.long_runs rows
+    threshold_settings: dict = field(default_factory=dict)  # engine -> its threshold searches'
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
                 "settings": self.settings, "versions": self.versions,
                 "comparisons": self.comparisons, "restitution": self.restitution,
                 "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
-                "errors": self.errors, "long_runs": self.long_runs}
+                "errors": self.errors, "long_runs": self.long_runs,
+                "threshold_settings": self.threshold_settings}
 
 
 def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
@@ -336,6 +354,8 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     result = CampaignResult(
         config=config, scene=scene,
         settings={b: plain(backend_settings(b, config)) for b in backends},
+        threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True)))
+                            for e in config.engines},
         versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)})
 
     # Reference spectra first (in this process: the compiled kernels are then

@@ -159,12 +159,20 @@ def run(args: argparse.Namespace) -> int:
             info(f"no candidate met the tolerance: {args.settings_out} not written")
         else:
             atomic.write_text(args.settings_out, settings_toml(engine, rec.options, (
-                f"trilith calibrate --engine {engine} --metric {args.metric} "
-                f"--scene {scene.name}\nworst error {rec.worst_error:.3g} "
+                f"{_command(args, engine, scene.name)}\nworst error {rec.worst_error:.3g} "
                 f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the validation "
                 f"set")))
             info(f"wrote {args.settings_out}")
     return 0 if rec is not None else 1
+
+
+def _command(args, engine: str, scene: str) -> str:
+    """The calibrate command that regenerates a settings file (what it varied)."""
+    words = [f"trilith calibrate --engine {engine} --metric {args.metric} --scene {scene}"]
+    words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance")
+              if getattr(args, k) is not None]
+    words += [f"--vary {v}" for v in args.vary]
+    return " ".join(words)
 
 
 def _label(options: dict) -> str:

@@ -16,7 +16,8 @@ import sys
 import time
 from pathlib import Path
 
-from compare.cli.options import add_store_args, check_output_path, check_run_budget, use_store
+from compare.cli.options import (add_settings_arg, add_store_args, check_output_path,
+                                 check_run_budget, settings_from_args, use_store)
 
 # Cost of one engine run [s] before the store has measured any (median of the
 # Fig. 5 threshold runs at the calibrated step on the 2-core target machine).
@@ -36,33 +37,39 @@ def add_parser(subparsers) -> None:
                    help="local processes, >= 1 [the file's, else 2]")
     p.add_argument("--estimate", action="store_true",
                    help="print the number of jobs and the expected time; run nothing")
+    add_settings_arg(p)
     add_store_args(p, scheduler=True)
 
 
-def check_budget(study, file) -> None:
+def check_budget(study, file, loaded=None) -> None:
     """Refuse a file whose engine runs would exceed the run budget: the longest
-    run of each (engine, step) is at the lowest Omega (the longest pulse)."""
+    run of each (engine, step) is at the lowest Omega (the longest pulse); step 0
+    is the ``--settings`` file's step (else the calibrated one)."""
     import dataclasses
 
     from analytic.excitation import Pulse
-    from engines import get_backend
+    from engines import configure
+
+    from compare.cli.options import file_options
 
     pulse = Pulse(1.0, min(study.omegas))
     for engine in study.engines:
-        settings = get_backend(engine).Settings()
+        settings = configure(engine, **file_options(loaded, engine))
         for dt in study.steps:
-            if dt:
-                check_run_budget(engine, dataclasses.replace(settings, dt=dt), pulse,
-                                 option=f"{file}: campaign.steps")
+            check_run_budget(engine, dataclasses.replace(settings, dt=dt or settings.dt),
+                             pulse, option=f"{file}: campaign.steps")
 
 
 def _run_cost(engine: str, dt: float, costs: dict) -> float:
-    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: calibrated):
-    the mean measured in the store at that step, else the measured step nearest
-    to it scaled by the step ratio (steps per simulated second), else a prior."""
-    from engines import get_backend
+    """Expected cost [s] of one run of ``engine`` at step ``dt`` (0: the calibrated
+    threshold step): the mean measured in the store at that step, else the measured
+    step nearest to it scaled by the step ratio (steps per simulated second), else a
+    prior."""
+    from engines import configure
 
-    dt = dt or getattr(get_backend(engine).Settings(), "dt", 1e-4)
+    from compare.campaign.settings_file import threshold_options
+
+    dt = dt or getattr(configure(engine, **threshold_options(engine)), "dt", 1e-4)
     measured = {}
     for label, (mean, _n) in costs.items():
         name, _, step = label.partition(" dt=")
@@ -81,7 +88,8 @@ def _estimates(jobs, store) -> list[float]:
     from compare.campaign.study import JOB_RUNS
 
     costs = store.mean_costs("run") if store is not None else {}
-    return [JOB_RUNS * _run_cost(job[6], job[7], costs) for job in jobs]
+    return [JOB_RUNS * _run_cost(job[6], job[7] or dict(job[10]).get("dt", 0.0), costs)
+            for job in jobs]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -97,7 +105,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out or f"campaign-{study.name}")
     if not args.estimate:  # --estimate writes nothing: it leaves the output alone
         check_output_path(out, "--out", directory=True, replace=True)
-    check_budget(study, args.file)
+    loaded = settings_from_args(args, study.engines)
+    check_budget(study, args.file, loaded)
     store = use_store(args)
     t0 = time.perf_counter()
     # --estimate writes nothing: it leaves the output location (and its lock) alone.
@@ -105,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
         ref_jobs = reference_jobs(study)
         references = dict(zip(ref_jobs, runs.run_many(run_reference, ref_jobs,
                                                        workers=workers)))
-        jobs = threshold_jobs(study, references)
+        jobs = threshold_jobs(study, references, None if loaded is None else loaded.tables)
         unique, index = distinct(jobs)
         est = _estimates(unique, store)
         print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
@@ -123,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
             {"scene": n, "case": c, "pulse": p, "omega": w, "a_reference": a, "mode": m}
             for (n, c, p, w), (a, m) in references.items()], "rows": rows,
             "summary": summarise(rows), "versions": _versions(study),
+            "settings_file": None if loaded is None else loaded.describe(),
             "wall_time": time.perf_counter() - t0}
         with atomic.report_dir(out, lock=False) as tmp:
             write_campaign(doc, tmp)

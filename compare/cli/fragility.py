@@ -16,9 +16,10 @@ import time
 
 from analytic.excitation import G_STANDARD
 from analytic.ida import IM_UNITS, IDASettings
-from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
-                                 check_output_path, info, parse_engine_list, resolve_workers,
-                                 scene_from_args, use_store)
+from compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
+                                 add_workers_arg, check_output_path, file_options, info,
+                                 parse_engine_list, resolve_workers, scene_from_args,
+                                 settings_from_args, use_store)
 
 IM_TEXT = {"pga": "PGA", "pgv": "PGV", "scale": "scale factor"}
 
@@ -34,6 +35,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_ida_args(parser)
     parser.add_argument("--engine", default="none", metavar="NAME[,NAME...]",
                         help=f"engines beside the model: {', '.join(ENGINES)}, or none")
+    add_settings_arg(parser)
     parser.add_argument("--out", default="fragility", metavar="DIR",
                         help="writes fragility.json, fragility.csv and fragility.png")
     add_workers_arg(parser)
@@ -61,15 +63,16 @@ def _im_range(args) -> tuple[float, float]:
 
 
 def ida_job(item):
-    """One record, one backend: its :class:`analytic.ida.IDAResult` as plain data,
-    through the run store (each run stored, the whole search memoised)."""
+    """One record, one backend (with ``options``, a ``--settings`` table): its
+    :class:`analytic.ida.IDAResult` as plain data, through the run store (each run
+    stored, the whole search memoised)."""
     import engines
 
     from analytic.ida import first_overturn_intensity
     from compare.run import runs
     from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, st = item
-    extra = {"sample_dt": 0.01} if backend == "analytic" else {}
+    backend, scene, record, st, options = item
+    extra = {"sample_dt": 0.01} if backend == "analytic" else dict(options)
 
     def settings_for(motion):
         return engines.configure(backend, t_max=motion.end_time + st.tail, **extra)
@@ -93,14 +96,16 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     engines_ = parse_engine_list(args.engine, none_ok=True)
     st = ida_settings(args)
+    loaded = settings_from_args(args, engines_)
     workers = resolve_workers(args.workers)
     out = check_output_path(args.out, "--out", directory=True)
     suite = load_suite(args.records)
     store = use_store(args)
     backends = ("analytic",) + engines_
-    items = [(b, scene, r, st) for b in backends for r in suite]
+    items = [(b, scene, r, st, file_options(loaded, b)) for b in backends for r in suite]
     results = _run_all(items, workers, args.scheduler)
     doc = _summarise(scene, suite, backends, st, results)
+    doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
     _print(doc, st)
     if store is not None:
@@ -256,9 +261,11 @@ def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int
     from compare.cli.options import print_json, scaled_record
     from scenes.ground_motion import load_record
     st = ida_settings(args)
+    loaded = settings_from_args(args, backends[1:])
     record = scaled_record(load_record(args.record, option="--record"), args)
     use_store(args)
-    results = _run_all([(b, scene, record, st) for b in backends], workers, args.scheduler)
+    results = _run_all([(b, scene, record, st, file_options(loaded, b)) for b in backends],
+                       workers, args.scheduler)
     if args.json:
         print_json({"command": "spectrum", "record": record.describe(), "ida": st.describe(),
                     "backends": dict(zip(backends, results))})

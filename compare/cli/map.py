@@ -7,6 +7,7 @@ import math
 
 from engines import engine_names
 
+from compare.cli import options as _options
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
                                  add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
@@ -41,6 +42,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--t-max", type=float, default=None, metavar="S",
                         help="fixed window of every engine run [s], no early stop (default: "
                              "each run stops when its verdict is certain)")
+    _options.add_settings_arg(parser)
     parser.add_argument("--max-engine-runs", type=int, default=200, metavar="N",
                         help="refuse engine work of more runs than this in all: every grid "
                              f"cell, and at least {LEAST_RUNS} runs per robust threshold "
@@ -84,9 +86,12 @@ class _EngineRun:
     :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
     no early stop when given, through the run store."""
 
-    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None):
+    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None,
+                 base: dict | None = None):
         self.name, self.scene, self.pulse = name, scene, pulse
-        self.options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
+        self.options = dict(base or {})  # the --settings table, under --t-max
+        if t_max is not None:
+            self.options.update(t_max=t_max, early_stop=False)
 
     def __call__(self, amplitude: float, omega: float):
         from analytic.excitation import Pulse
@@ -233,6 +238,7 @@ def run(args: argparse.Namespace) -> int:
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
+    loaded = _options.settings_from_args(args, engines)
     from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
     if omegas.size * amps.size > MAX_CELLS:
@@ -241,17 +247,21 @@ def run(args: argparse.Namespace) -> int:
     maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
                          workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
+        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max,
+                                           _options.file_options(loaded, name)), scene,
                                 *eng_grid,
                                 backend=name, pulse=args.pulse, workers=workers))
     thresholds = {}
     if engines:
+        from compare.campaign.settings_file import threshold_options
         from compare.measure.map_thresholds import map_thresholds, model_thresholds
         reference = model_thresholds(scene, eng_grid[0], args.pulse, workers)
-        for name in engines:
+        for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
             thresholds[name] = map_thresholds(name, scene, eng_grid[0], args.pulse,
                                               workers=workers, convergence=args.convergence,
-                                              t_max=args.t_max, reference=reference)
+                                              t_max=args.t_max, reference=reference,
+                                              **{**threshold_options(name),
+                                                 **_options.file_options(loaded, name)})
     from analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}

@@ -430,3 +430,45 @@ def use_store(args: argparse.Namespace):
         args.cache if getattr(args, "cache", None) else default_cache_dir())
     runs.activate(store)
     return store
+
+
+# --- engine settings files ---
+def add_settings_arg(parser: argparse.ArgumentParser) -> None:
+    """``--settings FILE``: engine settings as ``trilith calibrate --settings-out``
+    writes them; read with :func:`settings_from_args`."""
+    parser.add_argument("--settings", metavar="FILE", default=None,
+                        help="engine settings file (TOML, one [engine] table per engine, as "
+                             "'trilith calibrate --settings-out' writes): every run of those "
+                             "engines uses them (docs/calibrate.md)")
+
+
+def settings_from_args(args: argparse.Namespace, engines: tuple[str, ...]):
+    """The ``--settings`` file (a :class:`compare.campaign.settings_file.SettingsFile`)
+    or None.  Refused whole before any run: a bad key or value (naming the table,
+    the key and its allowed range), an unknown engine table, or a file with no
+    table for any of ``engines`` (the engines this command runs), which would
+    silently change nothing."""
+    path = getattr(args, "settings", None)
+    if path is None:
+        return None
+    from compare.campaign.settings_file import read_settings_file
+    try:
+        loaded = read_settings_file(path)
+    except ValueError as exc:
+        raise ValueError(f"--settings: {exc}") from None
+    if not any(name in loaded.tables for name in engines):
+        raise ValueError(f"--settings: {path!r} has no table for "
+                         f"{', '.join(engines) or 'an engine (this run is analytic)'}; "
+                         f"its tables: {', '.join(loaded.tables) or 'none'}")
+    return loaded
+
+
+def file_options(loaded, engine: str) -> dict:
+    """The options ``--settings`` sets for ``engine`` (empty without a file)."""
+    return {} if loaded is None else loaded.options(engine)
+
+
+def settings_line(loaded, engine: str) -> str:
+    """One line saying which ``--settings`` values ``engine`` ran with."""
+    shown = ", ".join(f"{k} = {v}" for k, v in loaded.options(engine).items())
+    return f"{engine} settings from {loaded.path} (sha256 {loaded.sha256[:12]}): {shown or 'none'}"

@@ -11,6 +11,7 @@ from compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, 
 
 from compare.cli.options import (add_pulse_args, add_record_arg, add_scene_args, check_output_path,
                       check_run_budget, excitation_from_args, scene_from_args)
+from compare.cli.options import add_settings_arg, file_options, settings_from_args
 
 
 def add_watch_args(parser: argparse.ArgumentParser) -> None:
@@ -31,23 +32,27 @@ def add_watch_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fps", type=float, default=30.0, help="frames per second")
     parser.add_argument("--duration", type=float, default=None, metavar="S",
                         help="seconds to show (default: ten pulse periods, the paper's t_max)")
+    add_settings_arg(parser)
 
 
 def watch_inputs(args: argparse.Namespace) -> tuple:
     """``(scene, excitation, settings)``, all checked, and the run budget of each
     backend over the recorded span."""
-    from engines import get_backend
+    from engines import configure, engine_names
 
-    settings = RecordSettings(fps=args.fps, duration=args.duration,
-                              panel_width=getattr(args, "width", 480),
-                              panel_height=getattr(args, "height", 360))
     scene = scene_from_args(args)
     excitation = excitation_from_args(args, default=(DEFAULT_AMPLITUDE, DEFAULT_OMEGA))
     names = resolve_engines(args.engine)
+    loaded = settings_from_args(args, tuple(n for n in names if n in engine_names()))
+    settings = RecordSettings(fps=args.fps, duration=args.duration,
+                              panel_width=getattr(args, "width", 480),
+                              panel_height=getattr(args, "height", 360),
+                              engine_options=tuple((n, tuple(file_options(loaded, n).items()))
+                                                   for n in names if file_options(loaded, n)))
     duration = args.duration if args.duration is not None else default_duration(excitation)
     for name in names:
-        check_run_budget(name, get_backend(name).Settings(), excitation, option="--duration",
-                         length=duration)
+        check_run_budget(name, configure(name, **settings.options(name)), excitation,
+                         option="--duration", length=duration)
     return scene, excitation, settings
 
 

@@ -20,8 +20,9 @@ from analytic.options import MAX_ENGINE_DT
 from engines import engine_names
 from scenes import load_scene
 
-from compare.cli.options import (add_engine_list_arg, add_workers_arg, check_output_path, detail,
-                      format_quantity, parse_engine_list, resolve_workers)
+from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_workers_arg,
+                                 check_output_path, detail, format_quantity, parse_engine_list,
+                                 resolve_workers, settings_from_args)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
 # contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
@@ -43,6 +44,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--dt", type=float, default=None, metavar="S",
                    help=f"override every engine's time step [s], in (0, {MAX_ENGINE_DT:g}] "
                         f"(default: each engine's calibrated step)")
+    add_settings_arg(p)
     p.add_argument("--strict", action="store_true",
                    help="exit with code 1 when a verdict fails (for CI)")
     add_store_args(p, scheduler=True)
@@ -55,19 +57,15 @@ def parse_engines(text: str) -> tuple[str, ...]:
 def _check_budget(config) -> None:
     """Refuse before any work an engine run over the run budget: the longest pulse
     of the campaign (its lowest threshold frequency, or a labelled point's)."""
-    import dataclasses
-
     from analytic.excitation import Pulse
-    from engines import get_backend
     from scenes import POINTS
 
+    from compare.campaign.validation import backend_settings
     from compare.cli.options import check_run_budget
 
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
     for name in config.engines:
-        settings = get_backend(name).Settings()
-        if config.engine_dt is not None:
-            settings = dataclasses.replace(settings, dt=config.engine_dt)
+        settings = backend_settings(name, config)
         check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
 
 
@@ -80,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dt is not None and not (math.isfinite(args.dt)
                                     and 0.0 < args.dt <= MAX_ENGINE_DT):
         raise ValueError(f"--dt must be in (0, {MAX_ENGINE_DT:g}] s, got {args.dt!r}")
+    loaded = settings_from_args(args, engines)
     out = check_output_path(args.out, "--out", directory=True, replace=True)
 
     from compare.run import atomic
@@ -89,12 +88,16 @@ def run(args: argparse.Namespace) -> int:
     from compare.run.provenance import collect
     from compare.report.html import write_report
 
-    changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt)
+    changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt,
+                   engine_settings={} if loaded is None else
+                   {k: v for k, v in loaded.tables.items() if k in engines})
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     _check_budget(config)
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started
+    if loaded is not None:
+        provenance["settings_file"] = {"file": loaded.path, "sha256": loaded.sha256}
     with atomic.output_lock(out):  # a second report into the same --out: clear error
         result = run_campaign(config)
         provenance["versions"].update(result.versions)

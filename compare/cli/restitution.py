@@ -6,8 +6,9 @@ import math
 
 from engines import engine_names
 
-from compare.cli.options import (add_scene_args, add_store_args, detail, envelope, info,
-                                 print_json, scene_from_args, sig, use_store)
+from compare.cli.options import (add_scene_args, add_settings_arg, add_store_args, detail,
+                                 envelope, file_options, info, print_json, scene_from_args,
+                                 settings_from_args, settings_line, sig, use_store)
 from compare.run.jsonable import plain
 
 # Half the static overturning angle: large, clean impacts far from toppling.
@@ -25,6 +26,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--engine", default="pymunk", metavar="NAME",
                         help="backend with free-rocking settings (theta0): "
                              + ", ".join(("analytic",) + engine_names()))
+    add_settings_arg(parser)
     parser.add_argument("--theta0", type=float, default=None, metavar="RAD",
                         help="initial tilt [rad], 0 < |theta0| < alpha; sign = side "
                              f"(default: {DEFAULT_THETA0_FRACTION:g} alpha)")
@@ -45,8 +47,10 @@ def run(args: argparse.Namespace) -> int:
     n = args.n_impacts if args.n_impacts is not None else DEFAULT_N_IMPACTS
     if not 1 <= n <= MAX_N_IMPACTS:
         raise ValueError(f"--n-impacts must be in [1, {MAX_N_IMPACTS}], got {n}")
+    loaded = settings_from_args(args, (args.engine,))
     use_store(args)
-    result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0)
+    result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0,
+                                 **file_options(loaded, args.engine))
     if args.json:
         body = result.to_dict()
         diagnostics = dict(body.get("diagnostics") or {})
@@ -55,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
             timings["engine_wall_time"] = diagnostics.pop("wall_time")
         body["diagnostics"] = diagnostics
         inputs = {"scene": scene.to_dict(), "excitation": {"type": "still"},
-                  "engine": args.engine, "theta0": theta0, "psi0": args.psi0, "n_impacts": n}
+                  "engine": args.engine, "theta0": theta0, "psi0": args.psi0, "n_impacts": n,
+                  "settings_file": None if loaded is None else loaded.describe()}
         body = {"engine": body.pop("engine"), "engine_version": body.pop("version"), **body}
         print_json(plain(envelope("restitution", inputs, body, timings)))
         return 0
@@ -71,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"max |rel. error| = {100 * worst:.3g} %" if math.isfinite(worst) else
           "no impacts measured")
     detail(f"wall time {result.wall_time:.3f} s")
+    if loaded is not None:
+        info(settings_line(loaded, args.engine))
     if not result.complete:
         info(f"warning: only {result.n_impacts} of {result.n_requested} impacts measured")
     return 0

@@ -8,9 +8,10 @@ from analytic.contact_forces import violations
 
 from compare.cli.units import acceleration_text, frequency_text, velocity_text
 from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
-                                 add_scene_args, check_output_path, check_run_budget, detail,
-                                 envelope, excitation_from_args, info, print_json, scene_from_args,
-                                 sig)
+                                 add_scene_args, add_settings_arg, check_output_path,
+                                 check_run_budget, detail, envelope, excitation_from_args,
+                                 file_options, info, print_json, scene_from_args,
+                                 settings_from_args, settings_line, sig)
 from compare.run.jsonable import plain
 
 
@@ -26,6 +27,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_pulse_args(parser, required=False)
     add_record_arg(parser)
     add_engine_arg(parser)
+    add_settings_arg(parser)
     parser.add_argument("--criterion", choices=("topple", "alpha"), default=None,
                         help="overturned at |theta| = 1.5 rad (topple) or at alpha "
                              "(default: the backend's, topple)")
@@ -41,13 +43,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
-def _settings(name: str, criterion: str | None, t_max: float | None):
-    """Backend ``name``'s calibrated settings with ``--criterion``/``--t-max`` applied
-    (``--t-max`` fixes the run's window: no early stop, in every backend)."""
+def _settings(name: str, criterion: str | None, t_max: float | None, base: dict | None = None):
+    """Backend ``name``'s calibrated settings with ``base`` (a ``--settings`` table)
+    and ``--criterion``/``--t-max`` applied (``--t-max`` fixes the run's window: no
+    early stop, in every backend)."""
     from engines import configure
     if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
-    options = {}
+    options = dict(base or {})
     if criterion is not None:  # configure keeps the backend's topple angle
         options["criterion"] = criterion
     if t_max is not None:  # the same fixed window in every backend: no early stop
@@ -100,7 +103,9 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     excitation = excitation_from_args(args)
     backend = get_backend(args.engine)
-    settings = _settings(args.engine, args.criterion, args.t_max)
+    loaded = settings_from_args(args, (args.engine,))
+    settings = _settings(args.engine, args.criterion, args.t_max,
+                         file_options(loaded, args.engine))
     check_run_budget(args.engine, settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
@@ -117,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
         summary = traj.summary()
         timings = summary.pop("timings")
         inputs = {"scene": scene.to_dict(), "excitation": excitation.describe(),
-                  "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max}
+                  "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max,
+                  "settings_file": None if loaded is None else loaded.describe()}
         body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
         print_json(plain(envelope("simulate", inputs, body, timings)))
         return 0
@@ -141,6 +147,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"model's exact events: lift-off {'none' if exact is None else f'{exact:.4f} s'}, "
               f"{traj.n_impacts} impacts (down to its rest speed)")
     detail(f"engine {backend.version()}, wall time {traj.wall_time:.3f} s")
+    if loaded is not None:
+        info(settings_line(loaded, args.engine))
     if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
         info(f"warning: the analytic model is not valid along this run: "
              f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")

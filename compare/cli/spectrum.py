@@ -12,8 +12,9 @@ from compare.cli import options as _common
 from compare.cli.fragility import add_ida_args, record_spectrum
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
                                  add_workers_arg, check_output_path, parse_engine_list, envelope,
-                                 info, parse_omega_range, print_json, resolve_workers,
-                                 scene_from_args, use_store)
+                                 file_options, info, parse_omega_range, print_json,
+                                 resolve_workers, scene_from_args, settings_from_args,
+                                 settings_line, use_store)
 from compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
@@ -51,6 +52,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--dt", type=float, default=None, metavar="S",
                         help=f"engine time step [s], in (0, {MAX_ENGINE_DT:g}] (default: each "
                              "engine's calibrated step)")
+    _common.add_settings_arg(parser)
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
                              "solver iterations to classify the cause")
@@ -192,12 +194,13 @@ def run(args: argparse.Namespace) -> int:
     # A bar only for a person watching (TTY); it shows up after 1 s of work.
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
-    _check_engine_budget(args, engines_wanted, omegas)
+    loaded = settings_from_args(args, engines_wanted)
+    _check_engine_budget(args, engines_wanted, omegas, loaded)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
                                 map_fn=_map_fn(scene, settings, workers))
     if engines_wanted:
-        return _run_engines(args, scene, spec, engines_wanted, workers)
+        return _run_engines(args, scene, spec, engines_wanted, workers, loaded)
     from analytic.threshold_validity import spectrum_validity
     validity = spectrum_validity(spec, workers=workers)
     if args.csv is not None:
@@ -277,18 +280,18 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     return names
 
 
-def _check_engine_budget(args, names, omegas) -> None:
+def _check_engine_budget(args, names, omegas, loaded=None) -> None:
     """Refuse before any work an engine run over the run budget: the longest is at
     the lowest Omega, at the finest step (``--convergence`` reruns at dt/4)."""
     import dataclasses
 
     from analytic.excitation import Pulse
-    from engines import get_backend
+    from engines import configure
 
     from compare.cli.options import check_run_budget
 
     for name in names:
-        settings = get_backend(name).Settings()
+        settings = configure(name, **file_options(loaded, name))
         dt = args.dt if args.dt is not None else settings.dt
         finest = dt / 4 if args.convergence else dt
         option = "--dt" + (" (with --convergence: dt/4)" if args.convergence else "")
@@ -296,7 +299,11 @@ def _check_engine_budget(args, names, omegas) -> None:
                          Pulse(1.0, float(min(omegas)), args.pulse), option=option)
 
 
-def _run_engines(args, scene, spec, names, workers: int) -> int:
+def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
+    """Each engine's spectrum on the model's grid: its calibrated threshold settings
+    (:func:`compare.campaign.settings_file.threshold_options`), the ``--settings``
+    file's table over them, ``--dt``/``--t-max`` over both."""
+    from compare.campaign.settings_file import threshold_options
     from pathlib import Path
 
     from compare.run import atomic
@@ -313,7 +320,9 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
     for name in names:
         t0 = time.perf_counter()
         results.append(es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
-                                          convergence=args.convergence, **options))
+                                          convergence=args.convergence,
+                                          **{**threshold_options(name),
+                                             **file_options(loaded, name), **options}))
         walls[name] = time.perf_counter() - t0
     if args.csv:
         with atomic.atomic_path(args.csv) as tmp:
@@ -330,7 +339,8 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
-                  "convergence": args.convergence}
+                  "convergence": args.convergence,
+                  "settings_file": None if loaded is None else loaded.describe()}
         body = {"engine": list(names),
                 "engine_version": {"analytic": version(), **{r.engine: r.version for r in results}},
                 "analytic": analytic, "engines": {r.engine: r.to_dict() for r in results}}
@@ -338,6 +348,8 @@ def _run_engines(args, scene, spec, names, workers: int) -> int:
         return 0
     for r in results:
         cost = r.cost()
+        if loaded is not None:
+            print(settings_line(loaded, r.engine))
         print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, robust bracket "
               f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %; {cost['runs']} runs, "
               f"{cost['cpu_s']:.1f} CPU s when computed ({cost['cpu_s_spent']:.1f} spent now, "

@@ -20,7 +20,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    scene, excitation, _ = watch_inputs(args)
+    scene, excitation, settings = watch_inputs(args)
     view(scene, excitation, args.engine, fps=args.fps, duration=args.duration,
-         scene_arg=args.scene)
+         scene_arg=args.scene, engine_options=settings.engine_options)
     return 0

@@ -37,17 +37,20 @@ def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1):
 
 
 def map_thresholds(engine: str, scene, omegas, kind: str = "sine", *, workers: int = 1,
-                   convergence: bool = False, t_max: float | None = None, reference=None):
+                   convergence: bool = False, t_max: float | None = None, reference=None,
+                   **options):
     """The engine's :class:`EnginePoint` at each of ``omegas`` (frequencies where
     the model does not overturn are skipped).
 
     ``reference``: the model's ``[(a_reference, mode)]`` on ``omegas`` when already
     computed (:func:`model_thresholds`).  ``t_max`` fixes every run's window with no
-    early stop, as in the map's cells.
+    early stop, as in the map's cells.  ``options``: engine settings
+    (:func:`engines.configure`) the search runs with.
     """
     from compare.measure.engine_spectrum import engine_points
     reference = model_thresholds(scene, omegas, kind, workers) if reference is None else reference
-    options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
+    if t_max is not None:
+        options = {**options, "t_max": t_max, "early_stop": False}
     return engine_points(engine, scene, [float(w) for w in omegas],
                          [a for a, _ in reference], [m for _, m in reference],
                          case="pendulum" if scene.has_pendulum else "no_pendulum", kind=kind,

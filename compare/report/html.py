@@ -190,6 +190,8 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              "<h2>Run times</h2>", tables.table(tables.HEADERS["timings"], tables.timing_rows(doc))]
     if doc["errors"]:
         body += ["<h2>Runs that raised</h2>", tables.table(tables.HEADERS["errors"], tables.error_rows(doc))]
+    from compare.report.atlas_page import stored_atlas_section
+    body.append(stored_atlas_section())
     s_head, s_rows = tables.settings_rows(doc)
     body += ["<h2>Engine settings</h2>", tables.table(s_head, s_rows),
              "<h2>Provenance</h2>", tables.table(tables.HEADERS["provenance"], tables.provenance_rows(doc)),

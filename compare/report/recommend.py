@@ -31,8 +31,11 @@ __all__ = ["recommendations"]
 _DT_MEETS = re.compile(r"dt <= ([0-9.eE+-]+) s (?:meets|would meet)")
 
 
-def _dt(row: dict) -> str:
-    dt = row.get("settings", {}).get("dt")
+def _dt(row: dict, thresholds: bool = False) -> str:
+    """The step an engine ran at: its threshold searches' (``thresholds``) or its
+    default one."""
+    dt = row.get("threshold_dt") if thresholds else None
+    dt = dt if dt is not None else row.get("settings", {}).get("dt")
     return "its default step" if dt is None else f"dt = {fmt_sci(dt)} s"
 
 
@@ -44,7 +47,7 @@ def _thresholds(trust: dict) -> str | None:
             continue
         blamed = [p for p in t["failing"] if p.get("cause") != "model"]
         if not blamed:
-            good.append((label(e), _dt(row)))
+            good.append((label(e), _dt(row, thresholds=True)))
             continue
         steps = [_DT_MEETS.search(p.get("cause_detail") or "") for p in blamed]
         if all(p.get("cause") == "discretisation" for p in blamed) and all(steps):

@@ -216,7 +216,7 @@ def threshold_points(doc: dict) -> list[dict]:
                     "mode_model": p.mode_reference, "mode_engine": p.mode_engine,
                     "model_valid": valid, "model_reason": reason,
                     "cause": p.cause, "cause_detail": p.cause_detail, "n_runs": p.n_runs,
-                    "cpu_s": p.cpu_s, "from_store": p.from_store})
+                    "dt_s": p.dt, "cpu_s": p.cpu_s, "from_store": p.from_store})
     return out
 
 
@@ -256,7 +256,8 @@ def threshold_rows(doc: dict) -> list[list]:
                      _cell(units.rel_error(p["rel_error"], p["rel_resolution"]), ok),
                      f"{p['mode_model'] or '—'} / {p['mode_engine'] or '—'}",
                      _valid_cell(p["model_valid"], p["model_reason"]),
-                     str(p["n_runs"]),
+                     f"{p['n_runs']}" + ("" if p["dt_s"] is None
+                                         else f" at dt {fmt_sci(p['dt_s'])} s"),
                      _cell(cause_phrase(p["cause"]), None,
                            "" if p["cause"] == "agrees" else (p["cause_detail"] or "")),
                      fmt_seconds(p["cpu_s"]) + (" (store)" if p["from_store"] else "")])
@@ -314,6 +315,13 @@ def settings_rows(doc: dict) -> tuple[list[str], list[list]]:
     keys = list(dict.fromkeys(k for e in engines for k in flat[e]))
     rows = [[k.replace("_", " ")] + [_setting(flat[e].get(k, "—")) for e in engines]
             for k in keys]
+    # Threshold searches start from each engine's calibrated threshold settings:
+    # the values that differ from the table above, one row each.
+    thr = {e: _flatten(doc.get("threshold_settings", {}).get(e, {})) for e in engines}
+    for k in dict.fromkeys(k for e in engines for k in thr[e]):
+        if any(k in thr[e] and thr[e][k] != flat[e].get(k) for e in engines):
+            rows.append([f"{k.replace('_', ' ')} (threshold searches)"]
+                        + [_setting(thr[e].get(k, "—")) for e in engines])
     return ["setting"] + [label(e) for e in engines], rows
 
 
@@ -379,6 +387,9 @@ def timing_rows(doc: dict) -> list[list]:
 def provenance_rows(doc: dict) -> list[list]:
     p = doc.get("provenance") or {}
     rows = [[k, str(p[k])] for k in ("date", "commit", "command") if k in p]
+    if p.get("settings_file"):  # which file set the engine settings table's values
+        f = p["settings_file"]
+        rows.append(["settings file", f"{f['file']} (sha256 {f['sha256']})"])
     rows += [[f"version: {k}", str(v)] for k, v in p.get("versions", {}).items()]
     rows += [[f"machine: {k}", str(v)] for k, v in p.get("machine", {}).items()]
     rows.append(["scene", doc["config"]["scene"]])

@@ -272,6 +272,8 @@ def trust_table(doc: dict) -> dict[str, dict]:
         row["thresholds"] = threshold_agreement(_points(doc, engine), tol)
         row["cost"] = engine_cost(doc, engine)
         row["settings"] = key_settings(doc, engine)
+        if engine in (doc.get("threshold_settings") or {}):  # their own step
+            row["threshold_dt"] = doc["threshold_settings"][engine].get("dt")
         mine = [v for v in doc.get("verdicts", []) if v.get("backend") == engine]
         row["verdicts"] = {"passed": sum(bool(v.get("passed")) for v in mine),
                            "total": len(mine)}

@@ -63,12 +63,18 @@ class RecordSettings:
         (the paper's ``t_max``, Sec. 5.1).
     panel_width, panel_height : pixels of one backend's panel, even numbers in
         [64, 4096]; default 480 x 360 keeps a 10 s GIF around a few MB.
+    engine_options : per engine, options over its calibrated settings (``--settings``).
     """
 
     fps: float = 30.0
     duration: float | None = None
     panel_width: int = 480
     panel_height: int = 360
+    engine_options: tuple = ()  # (engine, ((field, value), ...)): a settings file's tables
+
+    def options(self, engine: str) -> dict:
+        """The settings-file options of ``engine`` (empty when none)."""
+        return dict(dict(self.engine_options).get(engine, ()))
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.fps) and 0.0 < self.fps <= 120.0):
@@ -149,7 +155,7 @@ def load_backend(name: str):
     return get_backend(name)
 
 
-def backend_settings(name: str, duration: float):
+def backend_settings(name: str, duration: float, options: dict | None = None):
     """Backend ``name``'s calibrated settings, run for the whole recorded span.
 
     ``early_stop=False``: a run would otherwise stop as soon as survival is
@@ -158,12 +164,15 @@ def backend_settings(name: str, duration: float):
     overturns).
     """
     from engines import configure
-    return configure(name, t_max=duration, early_stop=False)
+    return configure(name, **(options or {}), t_max=duration, early_stop=False)
 
 
-def run_backend(name: str, scene: Scene, excitation, duration: float) -> Trajectory:
-    """Simulate ``scene`` in backend ``name`` up to ``duration`` seconds."""
-    return load_backend(name).simulate(scene, excitation, backend_settings(name, duration))
+def run_backend(name: str, scene: Scene, excitation, duration: float,
+                options: dict | None = None) -> Trajectory:
+    """Simulate ``scene`` in backend ``name`` (``options`` over its calibrated
+    settings) up to ``duration`` seconds."""
+    return load_backend(name).simulate(scene, excitation,
+                                       backend_settings(name, duration, options))
 
 
 def shown_duration(trajectories: dict[str, Trajectory], duration: float,
@@ -349,7 +358,8 @@ def record(scene: Scene, excitation, engine: str, out: str | Path,
     if trajectories is None:
         for name in names:  # fail on a missing backend before any long run
             load_backend(name)
-        trajectories = {name: run_backend(name, scene, excitation, duration) for name in names}
+        trajectories = {name: run_backend(name, scene, excitation, duration,
+                                          settings.options(name)) for name in names}
     duration = shown_duration(trajectories, duration)
     times = frame_times(duration, settings.fps)
     dpi = 100

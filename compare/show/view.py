@@ -60,7 +60,7 @@ def record_hint(scene_name: str, engine: str, excitation) -> str:
     return f"trilith record --scene {scene_name} --engine {engine} {what} --out run.gif"
 
 
-def _pybullet_gui(scene: Scene, excitation, duration: float) -> bool:
+def _pybullet_gui(scene: Scene, excitation, duration: float, options: dict | None = None) -> bool:
     """Run PyBullet in its own GUI window if it declares the ``'gui'`` capability;
     return whether it did."""
     from engines import supports
@@ -68,25 +68,29 @@ def _pybullet_gui(scene: Scene, excitation, duration: float) -> bool:
 
     if not supports("pybullet", "gui"):
         return False
-    load_backend("pybullet").view(scene, excitation, backend_settings("pybullet", duration),
+    load_backend("pybullet").view(scene, excitation,
+                                  backend_settings("pybullet", duration, options),
                                   duration=duration)
     return True
 
 
 def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
-         duration: float | None = None, scene_arg: str | None = None) -> dict:
+         duration: float | None = None, scene_arg: str | None = None,
+         engine_options: tuple = ()) -> dict:
     """Show a run in a window: PyBullet's GUI if available, else a matplotlib
     animation drawn from the backend's Trajectory (several panels for ``'all'``).
 
     Returns the trajectories shown (backend -> Trajectory); empty when PyBullet's
     own GUI was used.  Raises ``ValueError`` when there is no display, with the
     equivalent ``trilith record`` command (``scene_arg``: the ``--scene`` value
-    to quote in it, by default ``scene.name``).
+    to quote in it, by default ``scene.name``); ``engine_options`` as
+    :class:`compare.show.record.RecordSettings`'s.
     """
     from compare.show.record import (RecordSettings, Panels, default_duration, frame_times,
                                load_backend, resolve_engines, run_backend, shown_duration)
 
-    settings = RecordSettings(fps=fps, duration=duration)  # validates fps/duration
+    settings = RecordSettings(fps=fps, duration=duration,  # validates fps/duration
+                              engine_options=engine_options)
     names = resolve_engines(engine)
     problem = display_problem()
     if problem is None:
@@ -104,10 +108,12 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     for name in names:
         load_backend(name)
     span = settings.duration if settings.duration is not None else default_duration(excitation)
-    if names == ("pybullet",) and _pybullet_gui(scene, excitation, span):
+    if names == ("pybullet",) and _pybullet_gui(scene, excitation, span,
+                                                settings.options("pybullet")):
         return {}
     frame_times(span, settings.fps)  # validates the frame count before any run
-    trajectories = {name: run_backend(name, scene, excitation, span) for name in names}
+    trajectories = {name: run_backend(name, scene, excitation, span, settings.options(name))
+                    for name in names}
     times = frame_times(shown_duration(trajectories, span), settings.fps)
 
     import matplotlib.pyplot as plt

@@ -53,7 +53,12 @@ def test_report_files_and_keys(tiny_report):
     assert set(summary["trust"]) == {"pymunk"}
     # Provenance travels with every number.
     thr = summary["spectra"]["no_pendulum"]["engines"]["pymunk"][0]
-    assert thr["provenance"]["dt"] == pytest.approx(1e-4)
+    # Threshold searches run at the calibrated threshold step; restitution and
+    # histories at the engine's default.
+    from compare.campaign.settings_file import threshold_options
+    assert thr["provenance"]["dt"] == pytest.approx(threshold_options("pymunk")["dt"])
+    assert summary["threshold_settings"]["pymunk"]["dt"] == threshold_options("pymunk")["dt"]
+    assert summary["settings"]["pymunk"]["dt"] == pytest.approx(1e-4)
     assert thr["provenance"]["version"].startswith("pymunk")
 
 

@@ -1,0 +1,241 @@
+"""The trust atlas: where each engine's first-overturning amplitude agrees with the
+model's, over every scene of the paper, and at which time step.
+
+Points: the scenes of Figs. 8, 9 and 11 under one-sine pulses (Eq. 22) and the
+Fig. 5 scene under one-cosine pulses (Eq. 23, Fig. 10), with and without the
+pendulum, Omega = 4..28 rad/s by 2.  At each point the model's threshold
+(:func:`compare.campaign.study.run_reference`) and the model's validity on that
+run (:func:`analytic.threshold_validity.point_validity`); then per engine the
+one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`
+through :func:`compare.campaign.study.run_threshold`) at the engine's calibrated
+threshold step (:func:`compare.campaign.settings_file.threshold_options`) and at
+2x, 5x and 10x that step.
+
+Nothing is simulated that a verdict does not need: a point where the model is
+invalid is recorded as such and no engine runs there (no engine is to blame);
+identical tricks (the no-pendulum frames of the Fig. 8 scenes differ only in the
+pendulum) are one job (the store key leaves the scene's name out); a coarser
+step runs only where the finer one agreed.  Every job goes through the run
+store, so a killed atlas resumes.
+"""
+from __future__ import annotations
+
+import fnmatch
+import math
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from compare.run import runs
+
+__all__ = ["AtlasConfig", "ATLAS_SCENES", "atlas_scenes", "run_atlas", "base_step"]
+
+# (scene name or glob, pulse): the paper's Figs. 8, 9, 11 (one-sine) and Fig. 10
+# (the Fig. 5 trilith under a one-cosine pulse).
+ATLAS_SCENES = (("fig8_*", "sine"), ("fig9_*", "sine"), ("fig11_*", "sine"),
+                ("fig5", "cosine"))
+FIGURE = {"fig8": "Fig. 8", "fig9": "Fig. 9", "fig11": "Fig. 11", "fig5": "Fig. 10"}
+
+
+@dataclass(frozen=True)
+class AtlasConfig:
+    """What the atlas measures (module docstring)."""
+
+    engines: tuple[str, ...] = ("pymunk", "mujoco", "pybullet")
+    scenes: tuple = ATLAS_SCENES
+    omegas: tuple[float, ...] = tuple(float(w) for w in np.arange(4.0, 28.5, 2.0))
+    factors: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0)  # x the calibrated threshold step
+    cases: tuple[str, ...] = ("pendulum", "no_pendulum")
+    rel_bracket: float = 0.03  # as the campaigns: engines within ~1-2 % of the model
+    rel_tol: float = 4e-3  # final bracket / A_model: a fifth of the tolerance
+    tol: float = 0.02  # agreement tolerance (the report's)
+    settings: tuple = ()  # (engine, ((field, value), ...)): a settings file's tables
+
+    def __post_init__(self) -> None:
+        from engines import ENGINES
+        for e in self.engines:
+            if e not in ENGINES:
+                raise ValueError(f"engines: unknown engine {e!r}; allowed: {', '.join(ENGINES)}")
+        if not self.factors or any(not (math.isfinite(f) and 1.0 <= f <= 50.0)
+                                   for f in self.factors):
+            raise ValueError(f"factors must be step multiples in [1, 50], got {self.factors!r}")
+        if list(self.factors) != sorted(set(self.factors)):
+            raise ValueError(f"factors must increase, got {self.factors!r}")
+
+    def options(self, engine: str) -> dict:
+        return dict(dict(self.settings).get(engine, ()))
+
+    def describe(self) -> dict:
+        return {"engines": list(self.engines), "scenes": [list(s) for s in self.scenes],
+                "omegas": list(self.omegas), "factors": list(self.factors),
+                "cases": list(self.cases), "rel_bracket": self.rel_bracket,
+                "rel_tol": self.rel_tol, "tol": self.tol,
+                "settings": {e: dict(o) for e, o in self.settings}}
+
+
+def atlas_scenes(config: AtlasConfig) -> list[tuple[str, str]]:
+    """``(scene name, pulse)`` of every atlas scene, globs resolved."""
+    from scenes import scene_names
+    out = []
+    for pattern, pulse in config.scenes:
+        hits = [n for n in scene_names() if fnmatch.fnmatchcase(n, pattern)]
+        if not hits:
+            raise ValueError(f"scenes: {pattern!r} matches no scene")
+        out += [(n, pulse) for n in hits if (n, pulse) not in out]
+    return out
+
+
+def base_step(engine: str, config: AtlasConfig) -> float:
+    """The engine's calibrated threshold step [s] (a settings file's over it)."""
+    from engines import configure
+
+    from compare.campaign.settings_file import threshold_options
+    return float(configure(engine, **{**threshold_options(engine),
+                                      **config.options(engine)}).dt)
+
+
+def _validity(job: tuple) -> dict:
+    """The model's validity on its run at the threshold, through the store."""
+    from analytic.threshold_validity import point_validity
+
+    from compare.campaign.study import _scene
+    from compare.run.keys import scene_dict
+    name, case, pulse, omega, a_ref = job
+    scene = _scene(name, case)
+    return runs.memo("point-validity", {"scene": scene_dict(scene), "omega": float(omega),
+                                        "amplitude": float(a_ref), "pulse": pulse},
+                     lambda: point_validity(scene, a_ref, omega, pulse))
+
+
+def _bar(total: int, desc: str):
+    import sys
+
+    from tqdm import tqdm
+    return tqdm(total=total, desc=desc, unit="pt", disable=not sys.stderr.isatty(),
+                leave=False)
+
+
+def _many(fn, jobs: list, workers: int, desc: str, deadline: float | None = None) -> list:
+    """``fn`` over ``jobs`` in order, in chunks; once ``deadline`` (``perf_counter``)
+    has passed no new chunk starts and the jobs left are None (not run)."""
+    chunk = max(10, 4 * workers)
+    out: list = [None] * len(jobs)
+    bar = _bar(len(jobs), desc)
+    try:
+        for start in range(0, len(jobs), chunk):
+            if deadline is not None and time.perf_counter() > deadline:
+                break
+            part = jobs[start:start + chunk]
+            out[start:start + len(part)] = runs.run_many(
+                fn, part, workers=workers, on_done=lambda i, r: bar.update(1))
+    finally:
+        bar.close()
+    return out
+
+
+def _compact(row: dict) -> dict:
+    """The numbers a map and a table need from a threshold job's row."""
+    keep = ("dt_used", "a_engine", "rel_error", "rel_resolution", "cause", "valid", "n_runs",
+            "isolated", "cpu_s", "sim_s", "from_store", "error")
+    out = {k: row[k] for k in keep if k in row}
+    out["dt"] = out.pop("dt_used", row.get("dt"))
+    return out
+
+
+def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = None) -> dict:
+    """Measure the atlas (module docstring); returns the ``atlas.json`` document.
+
+    ``budget_s``: wall seconds after which no new chunk of engine jobs starts
+    (the model's references and validity are always complete); the jobs left are
+    counted in ``not_run`` per engine and step, and those points carry no row
+    for that step (nor for any coarser one).
+    """
+    from compare.campaign.study import run_reference, run_threshold, threshold_description
+    from compare.run.keys import backend_version, digest, project_version
+
+    t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
+    deadline = None if budget_s is None else t0 + budget_s
+    pairs = atlas_scenes(config)
+    ref_jobs = [(n, c, p, w) for n, p in pairs for c in config.cases for w in config.omegas]
+    refs = _many(run_reference, ref_jobs, workers, "atlas: model")
+    finite = [i for i, (a, _) in enumerate(refs) if math.isfinite(a)]
+    checks = _many(_validity, [(*ref_jobs[i], refs[i][0]) for i in finite], workers,
+                   "atlas: validity")
+    points = []
+    for (n, c, p, w), (a_ref, mode) in zip(ref_jobs, refs):
+        points.append({"scene": n, "case": c, "pulse": p, "omega": w,
+                       "a_reference": a_ref if math.isfinite(a_ref) else None, "mode": mode,
+                       "valid": None, "model_reason": "no overturning (nothing to bracket)",
+                       "engines": {e: [] for e in config.engines}})
+    for i, v in zip(finite, checks):
+        points[i].update(valid=v["model_valid"], model_reason=v["model_reason"])
+    # Engines run where the model is valid (or its check had nothing to say).
+    todo = {e: [i for i in finite if points[i]["valid"] is not False] for e in config.engines}
+    steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
+    not_run: dict = {e: {} for e in config.engines}
+    for level, factor in enumerate(config.factors):
+        for e in config.engines:
+            dt = steps[e][level]
+            opts = tuple(sorted(config.options(e).items()))
+            jobs = [(points[i]["scene"], points[i]["case"], points[i]["pulse"],
+                     points[i]["omega"], points[i]["a_reference"], points[i]["mode"], e, dt,
+                     config.rel_bracket, config.rel_tol, opts) for i in todo[e]]
+            unique: dict[str, int] = {}
+            distinct, index = [], []
+            for job in jobs:
+                key = digest(threshold_description(job))
+                if key not in unique:
+                    unique[key] = len(distinct)
+                    distinct.append(job)
+                index.append(unique[key])
+            rows = _many(run_threshold, distinct, workers, f"atlas: {e} {factor:g}x step",
+                         deadline)
+            agreed = []
+            for i, k in zip(todo[e], index):
+                if rows[k] is None:
+                    not_run[e][repr(dt)] = not_run[e].get(repr(dt), 0) + 1
+                    continue
+                row = _compact(rows[k])
+                points[i]["engines"][e].append(row)
+                if row.get("cause") == "agrees":
+                    agreed.append(i)
+            todo[e] = agreed
+    return {"schema_version": 1,
+            "what": "engine first-overturning amplitude vs the model over the paper's scenes",
+            "config": config.describe(),
+            "versions": {"project": project_version(),
+                         "analytic-fast": backend_version("analytic-fast"),
+                         **{e: backend_version(e) for e in config.engines}},
+            "steps": steps, "points": points, "cost": cost_table(points, config.engines),
+            "budget_s": budget_s,
+            "not_run": {e: n for e, n in not_run.items() if n},
+            "wall_s": time.perf_counter() - t0, "parent_cpu_s": time.process_time() - c0,
+            "load_average": [load0, os.getloadavg()[0]], "workers": workers}
+
+
+def cost_table(points: list[dict], engines) -> list[dict]:
+    """Per engine and step: points measured, jobs (identical tricks are one job: the
+    same case, pulse, Omega, model threshold and engine result), CPU seconds of the
+    jobs (when computed), CPU s per job and per simulated second."""
+    out = []
+    for e in engines:
+        by_dt: dict[float, dict] = {}
+        for pt in points:
+            for row in pt["engines"].get(e, ()):
+                job = (pt["case"], pt["pulse"], pt["omega"], pt["a_reference"],
+                       row.get("a_engine"), row.get("n_runs"), row.get("cpu_s"))
+                seen = by_dt.setdefault(row["dt"], {"points": 0, "jobs": {}})
+                seen["points"] += 1
+                seen["jobs"][job] = row
+        for dt in sorted(by_dt):
+            rows = [r for r in by_dt[dt]["jobs"].values() if "error" not in r]
+            cpu = math.fsum(r["cpu_s"] for r in rows if r.get("cpu_s") is not None)
+            sim = math.fsum(r.get("sim_s") or 0.0 for r in rows)
+            out.append({"engine": e, "dt": dt, "points": by_dt[dt]["points"],
+                        "jobs": len(by_dt[dt]["jobs"]),
+                        "errors": len(by_dt[dt]["jobs"]) - len(rows), "cpu_s": cpu,
+                        "cpu_s_per_point": cpu / len(rows) if rows else None,
+                        "cpu_s_per_sim_s": cpu / sim if sim > 0 else None})
+    return out

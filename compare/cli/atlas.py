@@ -1,0 +1,114 @@
+"""``trilith atlas``: the trust atlas over the paper's scenes (``compare/campaign/atlas.py``).
+
+``trilith atlas [--engine pymunk,mujoco,pybullet] [--json atlas.json] [--html atlas.html]``
+measures every engine's first-overturning amplitude against the model's on the
+scenes of Figs. 8-11, Omega 4..28 rad/s by 2, at each engine's calibrated
+threshold step and 2x, 5x, 10x coarser, through the run store (killed, it
+resumes).  ``--from FILE`` renders a stored atlas without running anything.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_store_args,
+                                 add_workers_arg, check_output_path, info,
+                                 parse_engine_list, parse_omega_range, resolve_workers,
+                                 settings_from_args, use_store)
+
+DEFAULT_ENGINES = ("pymunk", "mujoco", "pybullet")
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser("atlas", help="the trust atlas: engines vs the model over the "
+                                            "paper's scenes and coarser steps",
+                              description=__doc__,
+                              formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_engine_list_arg(p, DEFAULT_ENGINES)
+    p.add_argument("--omega", default="4:28:2", metavar="START:STOP:STEP",
+                   help="pulse frequencies [rad/s] (default: 4:28:2)")
+    p.add_argument("--factors", default="1,2,5,10", metavar="F[,F...]",
+                   help="time steps as multiples of each engine's calibrated threshold "
+                        "step, increasing, in [1, 50]; a coarser one runs only where the "
+                        "finer one agreed (default: 1,2,5,10)")
+    p.add_argument("--json", default=None, metavar="FILE",
+                   help="write the atlas as JSON (docs/validation/atlas.json is the stored one)")
+    p.add_argument("--html", default=None, metavar="FILE",
+                   help="write a standalone HTML page (heat maps, trusted region, cost)")
+    p.add_argument("--from", dest="source", default=None, metavar="FILE",
+                   help="render a stored atlas JSON (with --html); run nothing")
+    p.add_argument("--time-budget", type=float, default=None, metavar="MIN",
+                   help="wall minutes after which no new chunk of engine jobs starts; the "
+                        "jobs left are recorded as not run (default: no limit)")
+    add_settings_arg(p)
+    add_workers_arg(p)
+    add_store_args(p, scheduler=True)
+
+
+def _factors(text: str) -> tuple[float, ...]:
+    try:
+        return tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise ValueError(f"--factors: {text!r} is not a comma-separated list of numbers") from None
+
+
+def run(args: argparse.Namespace) -> int:
+    from compare.campaign.atlas import AtlasConfig, run_atlas
+    from compare.run import atomic
+
+    if args.json is not None:
+        check_output_path(args.json, "--json", suffixes=(".json",))
+    if args.html is not None:
+        check_output_path(args.html, "--html", suffixes=(".html",))
+    if args.source is not None:
+        if args.html is None:
+            raise ValueError("--from renders a stored atlas: give --html FILE")
+        try:
+            doc = json.loads(open(args.source, encoding="utf-8").read())
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"--from {args.source!r}: not a readable atlas JSON ({exc})") from None
+        if not isinstance(doc, dict) or "points" not in doc:
+            raise ValueError(f"--from {args.source!r}: not an atlas (no 'points')")
+    else:
+        engines = parse_engine_list(args.engine)
+        omegas = parse_omega_range(args.omega, "--omega")
+        loaded = settings_from_args(args, engines)
+        try:
+            config = AtlasConfig(engines=engines, omegas=tuple(float(w) for w in omegas),
+                                 factors=_factors(args.factors),
+                                 settings=() if loaded is None else tuple(
+                                     (e, tuple(sorted(t.items())))
+                                     for e, t in loaded.tables.items() if e in engines))
+        except ValueError as exc:
+            raise ValueError(f"--factors/--engine: {exc}") from None
+        budget = args.time_budget
+        if budget is not None and not (0.0 <= budget <= 1e5):
+            raise ValueError(f"--time-budget must be in [0, 1e5] min, got {budget!r}")
+        workers = resolve_workers(args.workers)
+        use_store(args)
+        doc = run_atlas(config, workers, None if budget is None else 60.0 * budget)
+        doc["engines_not_run"] = [e for e in DEFAULT_ENGINES if e not in engines]
+        doc["settings_file"] = None if loaded is None else loaded.describe()
+        from compare.run.provenance import command_line
+        doc["command"] = command_line(args)
+        if args.json is not None:
+            from compare.run.jsonable import plain
+            atomic.write_text(args.json, json.dumps(plain(doc), separators=(",", ":"),
+                                                    allow_nan=False) + "\n")
+            info(f"wrote {args.json}")
+    if args.html is not None:
+        from compare.report.atlas_page import write_page
+        write_page(doc, args.html)
+        info(f"wrote {args.html}")
+    _print(doc)
+    return 0
+
+
+def _print(doc: dict) -> None:
+    """The trusted region per engine and step, one line each."""
+    from compare.report.atlas_page import trusted_rows
+    print("engine, step [s]: points that agree / valid points (share), worst |error|; "
+          "where not", file=sys.stdout)
+    for engine, dt, agree, share, worst, where in trusted_rows(doc):
+        print(f"{engine}, {dt}: {agree} ({share}), {worst}; {where}", file=sys.stdout)

@@ -1,0 +1,239 @@
+"""The trust atlas shown to a person: heat maps, the trusted region per engine and
+step, the cost (``trilith atlas --html``, and a section of the report).
+
+A heat map per engine: rows are scenes (with and without the pendulum side by
+side), columns the pulse frequencies; colour is the engine's threshold error at
+its calibrated threshold step, on a diverging map centred on 0 (blue: the engine
+overturns below the model), clipped at 3x the tolerance, with the tolerance
+marked on the colour bar; a letter names the primary cause where the engine
+disagrees; grey cells are points where the model itself is invalid (no engine
+run there).  A number in an agreeing cell is the coarsest step factor that still
+agrees.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+from pathlib import Path
+
+__all__ = ["CAUSE_SYMBOL", "trusted_rows", "cost_rows", "heat_map_png", "atlas_html",
+           "write_page"]
+
+CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
+                "discretisation": "D", "iterations": "I", "contact": "K", "sensitivity": "S",
+                "unknown": "?"}
+TRUSTED_HEAD = ["engine", "step [s]", "agree / valid points", "share", "worst |error|",
+                "where not (scene Ω: cause)"]
+COST_HEAD = ["engine", "step [s]", "points (jobs)", "CPU s per threshold job",
+             "CPU s per simulated s", "CPU s in all"]
+
+
+def _tol(doc: dict) -> float:
+    return float(doc.get("config", {}).get("tol", 0.02))
+
+
+def _rows_of(doc: dict, engine: str) -> list[tuple[dict, list]]:
+    return [(pt, pt["engines"].get(engine, [])) for pt in doc["points"]]
+
+
+def trusted_rows(doc: dict) -> list[list]:
+    """Per engine and step: points that agree (at that step and every finer one)
+    over the points where the model is valid and overturns; the worst error
+    measured at that step; the disagreeing points with their cause."""
+    tol = _tol(doc)
+    out = []
+    for engine, steps in doc.get("steps", {}).items():
+        valid = [(pt, rows) for pt, rows in _rows_of(doc, engine)
+                 if pt["a_reference"] is not None and pt["valid"] is not False]
+        for level, dt in enumerate(steps):
+            at = [(pt, rows[level]) for pt, rows in valid if len(rows) > level]
+            agree = [r for _, r in at if r.get("cause") == "agrees"]
+            errs = [abs(r["rel_error"]) for _, r in at if r.get("rel_error") is not None
+                    and math.isfinite(r["rel_error"])]
+            bad = [f"{pt['scene']}{'' if pt['case'] == 'pendulum' else ' np'} "
+                   f"{pt['omega']:g}: {r.get('cause') or r.get('error', 'error')}"
+                   for pt, r in at if r.get("cause") != "agrees"]
+            shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
+            skipped = doc.get("not_run", {}).get(engine, {}).get(repr(dt))
+            if skipped:
+                shown = f"{skipped} jobs not run (time budget); " + shown
+            out.append([engine, f"{dt:.3g}", f"{len(agree)} / {len(valid)}",
+                        f"{100 * len(agree) / len(valid):.0f} %" if valid else "-",
+                        f"{100 * max(errs):.2g} %" if errs else "-",
+                        shown or ("none" if at else f"not run (finer step disagreed or "
+                                                    f"within {100 * tol:g} % nowhere)")])
+    return out
+
+
+def cost_rows(doc: dict) -> list[list]:
+    def num(x, fmt):
+        return "-" if x is None else format(x, fmt)
+    return [[c["engine"], f"{c['dt']:.3g}", f"{c['points']} ({c.get('jobs', '?')})",
+             num(c["cpu_s_per_point"], ".3g"),
+             num(c["cpu_s_per_sim_s"], ".3g"), num(c["cpu_s"], ".4g")]
+            for c in doc.get("cost", [])]
+
+
+def _grid(doc: dict, engine: str, case: str):
+    """Rows (scene labels), omegas, error matrix, symbols, invalid mask."""
+    import numpy as np
+    omegas = sorted({pt["omega"] for pt in doc["points"]})
+    labels = list(dict.fromkeys(f"{pt['scene']} ({pt['pulse']})" for pt in doc["points"]
+                                if pt["case"] == case))
+    err = np.full((len(labels), len(omegas)), np.nan)
+    invalid = np.zeros_like(err, dtype=bool)
+    text = [["" for _ in omegas] for _ in labels]
+    factors = doc.get("config", {}).get("factors", [1])
+    for pt in doc["points"]:
+        if pt["case"] != case:
+            continue
+        i, j = labels.index(f"{pt['scene']} ({pt['pulse']})"), omegas.index(pt["omega"])
+        if pt["valid"] is False:
+            invalid[i, j] = True
+            continue
+        rows = pt["engines"].get(engine, [])
+        if pt["a_reference"] is None:
+            text[i][j] = "·"  # no overturning in the model's range
+            continue
+        if not rows:
+            continue
+        first = rows[0]
+        if first.get("rel_error") is not None:
+            err[i, j] = first["rel_error"]
+        if first.get("cause") != "agrees":
+            text[i][j] = CAUSE_SYMBOL.get(first.get("cause"), "E")
+        else:
+            agreeing = [f for f, r in zip(factors, rows) if r.get("cause") == "agrees"]
+            text[i][j] = f"{agreeing[-1]:g}"
+    return labels, omegas, err, text, invalid
+
+
+def heat_map_png(doc: dict, engine: str) -> bytes:
+    """The engine's heat map (module docstring) as PNG bytes."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.ticker import PercentFormatter
+
+    tol = _tol(doc)
+    lim = 3 * tol
+    cases = [c for c in ("pendulum", "no_pendulum")
+             if any(pt["case"] == c for pt in doc["points"])]
+    n_rows = max(len(_grid(doc, engine, c)[0]) for c in cases)
+    # Stacked: readable on a phone, the Omega axes aligned.
+    fig, axes = plt.subplots(len(cases), 1, figsize=(7.5, len(cases) * (1.1 + 0.22 * n_rows)),
+                             squeeze=False, layout="constrained")
+    cmap = plt.get_cmap("RdBu_r").with_extremes(bad="white")
+    image = None
+    for ax, case in zip(axes[:, 0], cases):
+        labels, omegas, err, text, invalid = _grid(doc, engine, case)
+        shown = np.clip(err, -lim, lim)
+        image = ax.imshow(np.ma.masked_invalid(shown), cmap=cmap, aspect="auto",
+                          norm=TwoSlopeNorm(0.0, -lim, lim), interpolation="nearest")
+        grey = np.ma.masked_where(~invalid, np.ones_like(err))
+        ax.imshow(grey, cmap="Greys", vmin=0, vmax=3, aspect="auto", interpolation="nearest")
+        for i in range(len(labels)):
+            for j in range(len(omegas)):
+                if text[i][j]:
+                    bad = not text[i][j][0].isdigit()
+                    ax.text(j, i, text[i][j], ha="center", va="center", fontsize=6.5,
+                            color="black", fontweight="bold" if bad else "normal")
+        ax.set_xticks(range(len(omegas)), [f"{w:g}" for w in omegas], fontsize=7)
+        ax.set_yticks(range(len(labels)), labels, fontsize=6.5)
+        ax.set_xlabel("Ω [rad/s]")
+        ax.set_title(f"{engine}: {case.replace('_', ' ')}", fontsize=9)
+    bar = fig.colorbar(image, ax=axes[:, 0].tolist(), fraction=0.04, pad=0.03, aspect=40)
+    bar.set_label("A_engine / A_model - 1 (calibrated step)", fontsize=8)
+    bar.ax.yaxis.set_major_formatter(PercentFormatter(xmax=1.0, decimals=0))
+    bar.set_ticks([-lim, -tol, 0.0, tol, lim])
+    for y in (-tol, tol):
+        bar.ax.axhline(y, color="black", lw=1.5, zorder=5)
+    bar.ax.tick_params(labelsize=7)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _table(head: list[str], rows: list[list]) -> str:
+    h = "".join(f"<th>{html.escape(c)}</th>" for c in head)
+    b = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
+                for r in rows)
+    return f"<div class='scroll'><table><tr>{h}</tr>{b}</table></div>"
+
+
+def atlas_html(doc: dict, level: int = 2) -> str:
+    """The atlas as an HTML fragment (headings at ``level``): what was run, the heat
+    maps, the trusted region and the cost."""
+    h, sub = f"h{level}", f"h{level + 1}"
+    cfg = doc.get("config", {})
+    ran = ", ".join(doc.get("steps", {})) or "none"
+    not_run = ", ".join(doc.get("engines_not_run", [])) or "none"
+    skipped = "; ".join(f"{e} at dt {dt}: {n} jobs" for e, by in doc.get("not_run", {}).items()
+                        for dt, n in by.items())
+    n_invalid = sum(pt["valid"] is False for pt in doc["points"])
+    parts = [f"<{h} id='atlas'>Trust atlas</{h}>",
+             f"<p>{len(doc['points'])} model points ({len({pt['scene'] for pt in doc['points']})} "
+             f"scenes of Figs. 8-11, both curves, Ω {min(cfg.get('omegas', [0])):g}-"
+             f"{max(cfg.get('omegas', [0])):g} rad/s); the model is invalid at {n_invalid} "
+             f"of them (no engine run there). Engines run: {html.escape(ran)}; not run: "
+             f"{html.escape(not_run)}. Tolerance {100 * _tol(doc):g} %; steps "
+             f"{html.escape(str(cfg.get('factors')))} x each engine's calibrated threshold "
+             "step, a coarser one only where the finer one agreed."
+             + (f" Not run (time budget of {doc['budget_s'] / 60:.0f} min reached): "
+                f"{html.escape(skipped)}." if skipped else "") + "</p>"]
+    legend = ("Colour: threshold error at the calibrated step (black lines on the bar: the "
+              "tolerance); grey: the model is invalid (no engine run); a digit: the coarsest "
+              "step factor that still agrees; a letter: the cause of a disagreement ("
+              + ", ".join(f"{s} {c}" for c, s in CAUSE_SYMBOL.items())
+              + "); a dot: the model does not overturn in its search range.")
+    for engine in doc.get("steps", {}):
+        png = base64.b64encode(heat_map_png(doc, engine)).decode()
+        parts.append(f"<{sub}>{html.escape(engine)}</{sub}><img alt='atlas heat map "
+                     f"{html.escape(engine)}' src='data:image/png;base64,{png}'>"
+                     f"<p class='small'>{html.escape(legend)}</p>")
+    parts += [f"<{sub}>Trusted region per engine and step</{sub}>",
+              _table(TRUSTED_HEAD, trusted_rows(doc)),
+              f"<{sub}>Cost per engine and step</{sub}>", _table(COST_HEAD, cost_rows(doc)),
+              "<p>Load average " + " -> ".join(f"{x:.1f}" for x in doc.get("load_average") or [])
+              + ", "
+              f"{doc.get('workers', '?')} workers; command: "
+              f"<code>{html.escape(str(doc.get('command', '')))}</code></p>"]
+    return "\n".join(parts)
+
+
+STYLE = ("body{font-family:sans-serif;margin:1em;max-width:1300px}img{max-width:100%;"
+         "height:auto}table{border-collapse:collapse;font-size:12px}td,th{border:1px solid "
+         "#ccc;padding:2px 6px;text-align:left;vertical-align:top}.scroll{overflow-x:auto}")
+
+
+def write_page(doc: dict, path) -> Path:
+    """A standalone page of :func:`atlas_html`, written atomically."""
+    from compare.run import atomic
+    page = ("<!DOCTYPE html><html><head><meta charset='utf-8'><meta name='viewport' "
+            "content='width=device-width, initial-scale=1'><title>trust atlas</title>"
+            f"<style>{STYLE}</style></head><body>{atlas_html(doc, 1)}</body></html>\n")
+    atomic.write_text(path, page)
+    return Path(path)
+
+
+STORED = Path(__file__).resolve().parents[2] / "docs" / "validation" / "atlas.json"
+
+
+def stored_atlas_section(path=None) -> str:
+    """The report's atlas section from the stored atlas (``docs/validation/atlas.json``,
+    measured by ``trilith atlas``, not by the report's own campaign); a line saying
+    it is missing when there is none."""
+    import json
+    p = Path(path) if path is not None else STORED
+    if not p.is_file():
+        return ("<h2 id='atlas'>Trust atlas</h2><p>No stored atlas "
+                f"(<code>{html.escape(str(p.name))}</code>); <code>trilith atlas --json "
+                "docs/validation/atlas.json</code> measures it (docs/atlas.md).</p>")
+    doc = json.loads(p.read_text(encoding="utf-8"))
+    return ("<p class='small'>From the stored atlas <code>docs/validation/atlas.json</code> "
+            "(measured separately from this report's campaign).</p>" + atlas_html(doc, 2))

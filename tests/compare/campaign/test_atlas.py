@@ -1,0 +1,153 @@
+"""The trust atlas: staged steps, no engine run where the model is invalid, one
+job for identical frames, resumable through the store; the page renders it."""
+from __future__ import annotations
+
+import base64
+import json
+
+import pytest
+
+from compare.campaign import atlas
+from compare.campaign.atlas import AtlasConfig, atlas_scenes, base_step, run_atlas
+from compare.run import runs
+from compare.run.store import RunStore
+
+# Two Fig. 8 scenes of one lam: their no-pendulum frames are one trilith.
+SCENES = (("fig8_lam5_gamma0.1", "sine"), ("fig8_lam5_gamma0.3", "sine"))
+
+
+@pytest.fixture
+def store(tmp_path):
+    previous = runs.activate(RunStore(tmp_path / "store"))
+    yield
+    runs.activate(previous)
+
+
+def test_scenes_resolve_to_the_papers_figures():
+    names = atlas_scenes(AtlasConfig())
+    assert ("fig5", "cosine") in names  # Fig. 10
+    assert sum(n.startswith("fig8_") for n, _ in names) == 9
+    assert sum(n.startswith("fig9_") for n, _ in names) == 12
+    assert sum(n.startswith("fig11_") for n, _ in names) == 4
+
+
+@pytest.mark.parametrize("bad", [dict(factors=(2.0, 1.0)), dict(factors=(0.5,)),
+                                 dict(engines=("bullet",))])
+def test_bad_configs_are_refused(bad):
+    with pytest.raises(ValueError):
+        AtlasConfig(**bad)
+
+
+@pytest.mark.slow
+def test_staged_deduplicated_resumable(store, monkeypatch):
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES, omegas=(18.0,),
+                         factors=(1.0, 5.0), cases=("no_pendulum",))
+    jobs = []
+    real = atlas.runs.run_many
+
+    def counting(fn, items, **kw):
+        items = list(items)
+        if fn.__name__ == "run_threshold":
+            jobs.append(len(items))
+        return real(fn, items, **kw)
+    monkeypatch.setattr(atlas.runs, "run_many", counting)
+    doc = run_atlas(config)
+    pts = doc["points"]
+    assert len(pts) == 2  # 2 scenes x 1 case x 1 Omega
+    assert jobs[0] == 1  # the two no-pendulum frames are one job
+    dt = base_step("pymunk", config)
+    for pt in pts:
+        rows = pt["engines"]["pymunk"]
+        assert rows[0]["dt"] == pytest.approx(dt)
+        # The coarser step ran exactly where the calibrated one agreed.
+        assert (len(rows) == 2) == (rows[0]["cause"] == "agrees")
+        if len(rows) == 2:
+            assert rows[1]["dt"] == pytest.approx(5 * dt)
+    assert any(len(pt["engines"]["pymunk"]) == 2 for pt in pts)  # Omega 18 agrees at 2e-3 s
+    np_rows = [pt["engines"]["pymunk"] for pt in pts if pt["case"] == "no_pendulum"]
+    assert np_rows[0] == np_rows[1]
+    (first,) = [c for c in doc["cost"] if c["dt"] == pytest.approx(dt)]
+    assert (first["points"], first["jobs"]) == (2, 1)  # one trick, counted once
+    assert first["cpu_s"] == pytest.approx(pts[0]["engines"]["pymunk"][0]["cpu_s"])
+    # Resumed: every result from the store, the same numbers.
+    runs.STATS.clear()
+    again = run_atlas(config)
+    assert runs.STATS.get("computed", 0) == 0
+    assert [p["engines"] for p in again["points"]] == [p["engines"] for p in pts]
+
+
+def test_a_time_budget_records_the_jobs_it_did_not_run(store, monkeypatch):
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES[:1], omegas=(12.0,),
+                         factors=(1.0,), cases=("pendulum",))
+
+    def no_engine(job):
+        raise AssertionError("an engine ran after the budget")
+    monkeypatch.setattr("compare.campaign.study.run_threshold", no_engine)
+    doc = run_atlas(config, budget_s=0.0)
+    (pt,) = doc["points"]
+    assert pt["engines"]["pymunk"] == []
+    assert doc["not_run"] == {"pymunk": {repr(base_step("pymunk", config)): 1}}
+
+
+def test_no_engine_runs_where_the_model_is_invalid(store, monkeypatch):
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES[:1], omegas=(12.0,),
+                         factors=(1.0,), cases=("pendulum",))
+    monkeypatch.setattr(atlas, "_validity", lambda job: {"model_valid": False,
+                                                         "model_reason": "lintel lifts"})
+
+    def no_engine(job):
+        raise AssertionError("an engine ran where the model is invalid")
+    monkeypatch.setattr("compare.campaign.study.run_threshold", no_engine)
+    doc = run_atlas(config)
+    (pt,) = doc["points"]
+    assert pt["valid"] is False and pt["model_reason"] == "lintel lifts"
+    assert pt["engines"]["pymunk"] == []
+
+
+def _synthetic() -> dict:
+    pts = []
+    for scene, valid, rows in (("fig8_a", True, [{"dt": 2e-3, "rel_error": 0.004,
+                                                  "cause": "agrees", "cpu_s": 0.3,
+                                                  "sim_s": 5.0},
+                                                 {"dt": 4e-3, "rel_error": 0.03,
+                                                  "cause": "window", "cpu_s": 0.2,
+                                                  "sim_s": 5.0}]),
+                               ("fig8_b", False, []),
+                               ("fig9_c", True, [{"dt": 2e-3, "rel_error": -0.05,
+                                                  "cause": "unknown", "cpu_s": 0.4,
+                                                  "sim_s": 4.0}])):
+        pts.append({"scene": scene, "case": "pendulum", "pulse": "sine", "omega": 10.0,
+                    "a_reference": 10.0, "mode": "no-impact", "valid": valid,
+                    "model_reason": "" if valid else "columns hop",
+                    "engines": {"pymunk": rows}})
+    return {"config": {"tol": 0.02, "factors": [1, 2], "omegas": [10.0]},
+            "steps": {"pymunk": [2e-3, 4e-3]}, "points": pts, "engines_not_run": ["pybullet"],
+            "cost": atlas.cost_table(pts, ("pymunk",))}
+
+
+def test_trusted_region_counts_only_valid_points():
+    from compare.report.atlas_page import trusted_rows
+    rows = trusted_rows(_synthetic())
+    assert rows[0][:5] == ["pymunk", "0.002", "1 / 2", "50 %", "5 %"]
+    assert "fig9_c 10: unknown" in rows[0][5]
+    assert rows[1][:4] == ["pymunk", "0.004", "0 / 2", "0 %"]
+    assert "fig8_a 10: window" in rows[1][5]
+
+
+def test_page_shows_maps_tables_and_what_was_not_run(tmp_path):
+    from compare.report.atlas_page import write_page
+    path = write_page(_synthetic(), tmp_path / "atlas.html")
+    text = path.read_text()
+    assert "not run: pybullet" in text and "Trusted region per engine and step" in text
+    png = text.split("data:image/png;base64,")[1].split("'")[0]
+    assert base64.b64decode(png)[:8] == b"\x89PNG\r\n\x1a\n"
+    assert json.dumps(_synthetic())  # the document is plain data
+
+
+def test_the_report_section_reads_the_stored_atlas(tmp_path):
+    from compare.report.atlas_page import stored_atlas_section
+    assert "No stored atlas" in stored_atlas_section(tmp_path / "missing.json")
+    path = tmp_path / "atlas.json"
+    path.write_text(json.dumps(_synthetic()))
+    text = stored_atlas_section(path)
+    assert "id='atlas'" in text and text.count("data:image/png;base64,") == 1

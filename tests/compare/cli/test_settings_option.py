@@ -1,0 +1,137 @@
+"""``--settings FILE``: refused whole at the door, applied to the runs, and part of
+every store key (a changed setting never serves a stored result)."""
+from __future__ import annotations
+
+import hashlib
+import json
+
+import pytest
+
+from compare.cli.main import main
+from compare.run import runs
+
+from tests.support.paths import ROOT
+from tests.system.test_door import no_work  # noqa: F401  (the fixture)
+
+BAD = {
+    "dt": ("[pymunk]\ndt = 0.5\n", "dt must be"),
+    "key": ("[pymunk]\nstep = 1e-3\n", "no option 'step'"),
+    "engine": ("[bullet]\ndt = 1e-3\n", "unknown engine table [bullet]"),
+    "run_field": ("[pymunk]\ntheta0 = 0.1\n", "theta0 is set by each command"),
+    "not_toml": ("[pymunk\n", "not TOML"),
+    "other_engine": ("[mujoco]\ndt = 1e-3\n", "no table for pymunk"),
+}
+COMMANDS = {
+    "simulate": ["simulate", "--engine", "pymunk", "-A", "3", "-w", "12"],
+    "restitution": ["restitution", "--engine", "pymunk"],
+    "spectrum": ["spectrum", "--engine", "pymunk", "--omega", "12"],
+    "map": ["map", "--engine", "pymunk", "--omega", "8:12:2", "--amplitude", "2:6:2"],
+    "report": ["report", "--engine", "pymunk", "--quick"],
+    "campaign": ["campaign", "{campaign}"],
+    "fragility": ["fragility", "--records", "sample", "--engine", "pymunk"],
+    "spectrum_record": ["spectrum", "--engine", "pymunk", "--record", "{record}"],
+    "record": ["record", "--engine", "pymunk", "--out", "{gif}"],
+    "view": ["view", "--engine", "pymunk"],
+    "atlas": ["atlas", "--engine", "pymunk"],
+}
+
+
+@pytest.fixture(scope="module")
+def bad_files(tmp_path_factory) -> dict[str, str]:
+    d = tmp_path_factory.mktemp("settings")
+    out = {}
+    for name, (text, _) in BAD.items():
+        (d / f"{name}.toml").write_text(text)
+        out[name] = str(d / f"{name}.toml")
+    (d / "study.toml").write_text('[campaign]\nname = "s"\nscenes = ["fig5"]\n'
+                                  'engines = ["pymunk"]\npulses = ["sine"]\nomega = [12.0]\n'
+                                  'steps = [0]\n')
+    out["campaign"] = str(d / "study.toml")
+    out["record"] = str(ROOT / "scenes" / "records" / "sample.csv")
+    out["gif"] = str(d / "run.gif")
+    return out
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+@pytest.mark.parametrize("bad", sorted(BAD))
+def test_a_bad_settings_file_is_refused_before_any_run(command, bad, bad_files, no_work,
+                                                       capsys, tmp_path):
+    argv = [a.format(**bad_files) for a in COMMANDS[command]]
+    if command in ("report", "campaign", "fragility"):
+        argv += ["--out", str(tmp_path / "out")]
+    assert main(argv + ["--settings", bad_files[bad]]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("error: --settings: "), err
+    assert BAD[bad][1] in err[0], err[0]
+
+
+def test_an_analytic_run_refuses_a_settings_file(bad_files, no_work, capsys):
+    assert main(["simulate", "-A", "3", "-w", "12", "--settings", bad_files["other_engine"]]) == 2
+    assert "no table for analytic" in capsys.readouterr().err
+
+
+def _simulate_json(argv, capsys) -> dict:
+    assert main(argv + ["--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_the_file_changes_the_run_and_is_named_by_its_hash(tmp_path, capsys):
+    path = tmp_path / "coarse.toml"
+    path.write_text("# a coarser step\n[pymunk]\ndt = 0.001\niterations = 30\n")
+    argv = ["simulate", "--engine", "pymunk", "-A", "3", "-w", "12"]
+    default = _simulate_json(argv, capsys)
+    coarse = _simulate_json(argv + ["--settings", str(path)], capsys)
+    assert default["settings"]["dt"] == 1e-4 and coarse["settings"]["dt"] == 1e-3
+    assert coarse["settings"]["iterations"] == 30
+    described = coarse["inputs"]["settings_file"]
+    assert described["sha256"] == hashlib.sha256(path.read_bytes()).hexdigest()
+    assert described["tables"] == {"pymunk": {"dt": 0.001, "iterations": 30}}
+    # Ten times fewer steps over the same run: the engine really stepped at 1e-3 s.
+    assert coarse["diagnostics"]["steps"] * 5 < default["diagnostics"]["steps"]
+
+
+def test_a_changed_setting_is_a_new_store_key(tmp_path, capsys):
+    path = tmp_path / "coarse.toml"
+    path.write_text("[pymunk]\ndt = 0.001\n")
+    argv = ["restitution", "--engine", "pymunk", "--n-impacts", "1", "--json",
+            "--cache", str(tmp_path / "store")]
+
+    def measured(extra):
+        assert main(argv + extra) == 0
+        doc = json.loads(capsys.readouterr().out)
+        return doc["impacts"][0]["measured"], {k: runs.STATS.get(k, 0)
+                                               for k in ("hits", "computed")}
+    default, first = measured([])
+    coarse, second = measured(["--settings", str(path)])
+    assert second["hits"] == 0 and second["computed"] >= 1  # not served the 1e-4 s run
+    assert coarse != default
+    again, third = measured(["--settings", str(path)])
+    assert third["hits"] >= 1 and third["computed"] == 0 and again == coarse
+
+
+def test_campaign_jobs_carry_the_file_into_their_keys():
+    from compare.campaign.study import Study, threshold_description, threshold_jobs
+    from compare.campaign.validation import CampaignConfig, _job_description
+    from compare.run.keys import digest
+
+    study = Study("s", ("fig5",), ("pymunk",), ("sine",), (12.0,), (0.0,))
+    refs = {("fig5", "pendulum", "sine", 12.0): (20.0, "no-impact")}
+    plain_job, = threshold_jobs(study, refs)
+    filed_job, = threshold_jobs(study, refs, {"pymunk": {"dt": 1e-3}})
+    assert threshold_description(filed_job)["settings"]["dt"] == 1e-3
+    assert digest(threshold_description(plain_job)) != digest(threshold_description(filed_job))
+    a = CampaignConfig(engines=("pymunk",))
+    b = CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"dt": 1e-3}})
+    job = ("restitution", ("pymunk", None))
+    assert digest(_job_description((job[0], (*job[1], a)))) != \
+        digest(_job_description((job[0], (*job[1], b))))
+    with pytest.raises(ValueError, match="iterations"):
+        CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"iterations": 0}})
+
+
+def test_recordings_run_with_the_file_options():
+    from compare.show.record import RecordSettings, backend_settings
+    settings = RecordSettings(engine_options=(("pymunk", (("dt", 1e-3),)),))
+    assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
+    run = backend_settings("pymunk", 2.0, settings.options("pymunk"))
+    assert (run.dt, run.t_max, run.early_stop) == (1e-3, 2.0, False)
