@@ -74,17 +74,17 @@ class _EngineRun:
     :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
     no early stop when given, through the run store."""
 
-    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None):
+    def __init__(self, name: str, scene, pulse, t_max: float | None = None):
         self.name, self.scene, self.pulse = name, scene, pulse
         self.options = {} if t_max is None else {"t_max": t_max, "early_stop": False}
 
     def __call__(self, amplitude: float, omega: float):
-        from analytic.excitation import Pulse
+        from analytic.pulses import pulse_of
         from compare.measure.engine_spectrum import pulse_settings
         from compare.run import runs
         settings = pulse_settings(self.name, self.scene, amplitude, omega, self.pulse,
                                   verdict_only=True, **self.options)
-        return runs.simulate(self.name, self.scene, Pulse(amplitude, omega, self.pulse),
+        return runs.simulate(self.name, self.scene, pulse_of(self.pulse, amplitude, omega),
                              settings).verdict
 
 
@@ -168,23 +168,28 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.csv, "--csv")
     if args.plot:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    from compare.cli.pulse_shape import shape_from_args
+    shape = shape_from_args(args)
     engines, eng_grid = (), None
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
-    from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
+    from analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
-    if omegas.size * amps.size > MAX_CELLS:
+    settings = SpectrumSettings(pulse=shape)
+    top = MAX_CELLS if settings.compiled else MAX_ACCURATE_CELLS
+    if omegas.size * amps.size > top:
+        why = "" if settings.compiled else (f" for a {shape} pulse (the accurate model, "
+                                            "~20 ms a cell)")
         raise ValueError(f"--omega x --amplitude gives {omegas.size * amps.size} cells, "
-                         f"more than {MAX_CELLS}")
-    maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
-                         workers=workers)]
+                         f"more than {top}{why}")
+    maps = [analytic_map(scene, omegas, amps, settings, workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max), scene,
+        maps.append(verdict_map(_EngineRun(name, scene, settings.pulse, args.t_max), scene,
                                 *eng_grid,
-                                backend=name, pulse=args.pulse, workers=workers))
+                                backend=name, pulse=settings.pulse, workers=workers))
     from analytic.threshold_validity import curve_validity
-    validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)
+    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
 
     def valid_text(w):
