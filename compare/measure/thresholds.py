@@ -105,16 +105,17 @@ def overturns(backend: str, scene, omega: float, amplitude: float, settings=None
 
 
 def overturns_under(backend: str, scene, motion, settings=None,
-                    value: float = math.nan) -> Probe:
+                    value: float = math.nan, verdict_only: bool = True) -> Probe:
     """One run of ``backend`` under any ground motion: its :class:`Probe`, whose
     ``amplitude`` is ``value`` (the scale the search moves).
 
     'collapsed', 'unstable' and 'undecided' runs do not count as overturned.
-    The run stops as soon as the verdict is certain (``verdict_only``).
+    With ``verdict_only`` (default) the run stops as soon as the verdict is
+    certain; without it an overturn counts only once the columns have fallen.
     """
     from engines import configure
     from compare.run import runs
-    settings = configure(backend, settings, verdict_only=True)
+    settings = configure(backend, settings, verdict_only=verdict_only)
     hits = runs.STATS["hits"]
     traj = runs.simulate(backend, scene, motion, settings)
     cpu = traj.diagnostics.get("cpu_time", math.nan)
@@ -300,7 +301,11 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         ``motion(value) -> excitation``: search the scale ``value`` of any ground
         motion instead of the pulse's amplitude (e.g. a record scaled to a PGA,
         :func:`analytic.ida.scale_to`); ``a_reference`` is then the model's
-        value, ``omega`` only a label (NaN allowed) and ``kind`` ignored.
+        value, ``omega`` only a label (NaN allowed) and ``kind`` ignored.  With a
+        fixed window (``settings.t_max``) an overturn counts only when the
+        columns fall inside it, as in the model's IDA
+        (:func:`analytic.ida.model_verdict`): the engines' monitor calls an
+        overturn certain before the fall, which may end after the window.
 
     Returns
     -------
@@ -325,7 +330,8 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
             return overturns(backend, scene, omega, a, run, kind)
     else:
         def probe(a, run):
-            return overturns_under(backend, scene, motion(a), run, a)
+            return overturns_under(backend, scene, motion(a), run, a,
+                                   verdict_only=run is None or run.t_max is None)
     a_ref = _check_positive("a_reference", a_reference)
     if "rel_tol" in changes and "rel_bracket" not in changes:
         changes["rel_bracket"] = 0.45 * changes["rel_tol"]

@@ -1,0 +1,77 @@
+"""An engine's first overturning intensity of a ground motion, by the one robust
+threshold search.
+
+The model's intensity comes from the window-aware IDA
+(:func:`analytic.ida.first_overturn_intensity`).  An engine's is the robust
+bracket of :func:`compare.measure.thresholds.engine_threshold` with the motion
+scaled to each probed intensity (``motion=``): the same perturbation set as the
+pulse spectra (neighbours at ``1 +/- 1e-4`` of the intensity, an initial tilt of
+1e-6 rad one step further out), isolated overturns kept apart and never taken as
+the threshold.  The bracket is centred on the model's intensity (on ``im_hi``
+when the model never overturned up to it) and widened by doubling where the
+engine disagrees.
+
+Both backends run the same fixed window, ``t_max = end_time + tail``; every run
+goes through the run store.
+
+The result's ``im_overturn`` is the engine's robust overturning end; a record
+censored at ``im_hi`` when the engine robustly survives there (no robust
+overturn at or below ``im_hi``); ``bracketed`` False when the search found no
+robust bracket at all (a collapse above the model, or too many isolated
+overturns): such a record is listed, never given an intensity.
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["engine_intensity"]
+
+
+def engine_intensity(backend: str, scene, motion, st, im_model: float | None) -> dict:
+    """The robust first overturning intensity of ``backend`` under ``motion``.
+
+    Parameters
+    ----------
+    backend : str
+        An engine name.
+    scene : Scene
+    motion : SampledRecord or any motion with ``scaled``, ``pga``, ``pgv``
+    st : analytic.ida.IDASettings
+        The intensity measure, ``im_hi`` (censoring) and ``tail`` (the window).
+    im_model : float or None
+        The model's first overturning intensity (None: censored at ``im_hi``).
+
+    Returns
+    -------
+    dict
+        ``label``, ``im``, ``im_overturn`` / ``im_safe`` (None when censored or
+        not bracketed), ``censored``, ``bracketed``, ``isolated`` (overturns not
+        reproduced by their perturbed neighbours), ``flips``, ``n_runs``,
+        ``cpu_s`` (CPU seconds of the runs when computed), ``im_reference``.
+    """
+    import engines
+    from analytic.ida import scale_to
+    from compare.measure.thresholds import engine_threshold
+
+    settings = engines.configure(backend, t_max=motion.end_time + st.tail)
+    centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
+    p = engine_threshold(backend, scene, math.nan, centre, settings,
+                         motion=lambda v: scale_to(motion, st.im, v))
+    over = p.bracketed and p.a_engine <= st.im_hi
+    censored = p.bracketed and not over or (not p.bracketed and _survives_all(p, st.im_hi))
+    return {"label": getattr(motion, "label", type(motion).__name__), "im": st.im,
+            "im_overturn": p.a_engine if over else None,
+            "im_safe": p.a_survives if over else None,
+            "censored": bool(censored), "bracketed": bool(p.bracketed),
+            "isolated": list(p.isolated), "flips": [f.to_dict() for f in p.flips],
+            "n_runs": p.n_runs, "cpu_s": p.cpu_s, "im_reference": centre,
+            "islands": []}
+
+
+def _survives_all(p, im_hi: float) -> bool:
+    """No bracket, but every nominal run up to ``im_hi`` and beyond survived: the
+    engine never overturned in the searched range (censored, as the model's
+    records that never overturn)."""
+    nominal = [q for q in p.probes if not q.perturbation]
+    return bool(nominal) and all(q.status == "survived" for q in nominal) and max(
+        q.amplitude for q in nominal) >= im_hi
