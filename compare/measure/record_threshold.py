@@ -19,6 +19,16 @@ censored at ``im_hi`` when the engine robustly survives there (no robust
 overturn at or below ``im_hi``); ``bracketed`` False when the search found no
 robust bracket at all (a collapse above the model, or too many isolated
 overturns): such a record is listed, never given an intensity.
+
+Creep and drift over a whole record (``long_run``): the nominal run at the
+engine's highest robust survival (``im_safe``, or the highest intensity run when
+censored) lasts the whole window, so its diagnostics
+(:mod:`engines.diagnostics`) tell what the engine accumulates over the record:
+``pivot_sliding_max`` [m] (a pivot creeping along the ground),
+``lintel_rotation_max`` [rad] (the lintel drifting off the columns' rigid
+motion), ``penetration_max`` [m], and the residual tilt ``|theta|`` at the
+window's end [rad] beside the model's at the same intensity.  The run is the
+search's own, served by the run store.
 """
 from __future__ import annotations
 
@@ -59,13 +69,44 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None) ->
                          motion=lambda v: scale_to(motion, st.im, v))
     over = p.bracketed and p.a_engine <= st.im_hi
     censored = p.bracketed and not over or (not p.bracketed and _survives_all(p, st.im_hi))
+    long_run = _long_run(backend, scene, motion, st, settings, p, over)
     return {"label": getattr(motion, "label", type(motion).__name__), "im": st.im,
             "im_overturn": p.a_engine if over else None,
             "im_safe": p.a_survives if over else None,
             "censored": bool(censored), "bracketed": bool(p.bracketed),
             "isolated": list(p.isolated), "flips": [f.to_dict() for f in p.flips],
             "n_runs": p.n_runs, "cpu_s": p.cpu_s, "im_reference": centre,
-            "islands": []}
+            "islands": [], "long_run": long_run}
+
+
+def _long_run(backend, scene, motion, st, settings, p, over: bool) -> dict | None:
+    """The diagnostics of the nominal run at the highest robust survival (module
+    docstring), beside the model's residual tilt at the same intensity."""
+    import engines
+    from analytic.ida import scale_to
+    from analytic.simulate import Settings, simulate
+    from compare.run import runs
+
+    alive = [q.amplitude for q in p.probes if not q.perturbation and q.status == "survived"
+             and (not over or q.amplitude <= p.a_survives)]
+    if not alive:
+        return None
+    value = max(alive)
+    scaled = scale_to(motion, st.im, value)
+    tr = runs.simulate(backend, scene, scaled, engines.configure(backend, settings,
+                                                                 verdict_only=False))
+    model = simulate(scene, scaled, Settings(t_max=settings.t_max, sample_dt=0.01))
+    d = tr.diagnostics
+    sim_s = float(tr.t[-1]) if len(tr.t) else 0.0
+    cpu = d.get("cpu_time")
+    return {"im_value": value, "status": tr.verdict.status, "t_end": sim_s,
+            "pivot_sliding_max": d.get("pivot_sliding_max"),
+            "lintel_rotation_max": d.get("lintel_rotation_max"),
+            "penetration_max": d.get("penetration_max"),
+            "residual_tilt": float(abs(tr.theta[-1])) if len(tr.theta) else None,
+            "model_status": model.verdict.status,
+            "model_residual_tilt": float(abs(model.theta[-1])) if len(model.theta) else None,
+            "cpu_s": cpu, "cpu_per_sim_s": cpu / sim_s if cpu and sim_s > 0 else None}
 
 
 def _survives_all(p, im_hi: float) -> bool:
