@@ -8,7 +8,7 @@ import math
 from engines import engine_names
 
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
-                                 add_workers_arg, check_output_path, parse_engine_list,
+                                 add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
 from compare.run.jsonable import plain
@@ -46,6 +46,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the cells as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
+    from compare.cli.record_map import add_record_map_args
+    add_record_map_args(parser)
+    add_store_args(parser)
     return parser
 
 
@@ -106,7 +109,8 @@ def _hatch_invalid(ax, first, validity) -> None:
                         label="model invalid at the first overturning" if k == 0 else None)
 
 
-def plot_maps(maps, path, validity=None) -> None:
+def plot_maps(maps, path, validity=None, xlabel=r"$\Omega$ [rad/s]",
+              ylabel=r"$A_s$ [m/s$^2$]", subject="pulse") -> None:
     """One panel per map: cells coloured by label, the analytic first-overturning
     curve (black line) on every panel and, above it, the frequencies where the
     model is invalid on that curve's run hatched (``validity``: one
@@ -139,10 +143,11 @@ def plot_maps(maps, path, validity=None) -> None:
         handles = [Patch(facecolor=cols[i], edgecolor="k", label=m.labels[i]) for i in present]
         ax.legend(handles=handles + ax.get_legend_handles_labels()[0], fontsize=7,
                   loc="upper left")
-        ax.set_xlabel(r"$\Omega$ [rad/s]")
-        ax.set_ylabel(r"$A_s$ [m/s$^2$]")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
         sc = m.scene
-        ax.set_title(f"{m.backend}: {m.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
+        ax.set_title(f"{m.backend}: {f'{m.pulse} {subject}'.strip()}, lam={sc.lam:g}, "
+                     f"b={sc.b:g} m, "
                      f"gamma={sc.gamma:g}", fontsize=9)
     used = axes.ravel()[:len(maps)]
     for get, set_ in (("get_xlim", "set_xlim"), ("get_ylim", "set_ylim")):
@@ -171,6 +176,10 @@ def run(args: argparse.Namespace) -> int:
     from compare.cli.pulse_shape import shape_from_args
     shape = shape_from_args(args)
     engines, eng_grid = (), None
+    if args.record is not None:
+        from compare.cli.record_map import record_map
+        return record_map(args, scene, workers,
+                          parse_engine_list(args.engine) if args.engine is not None else ())
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
