@@ -14,7 +14,7 @@ The file::
     name = "paper"
     scenes = ["fig8_*", "fig9_*", "fig11_*"]    # names or globs over scenes/data
     engines = ["pybullet", "pymunk"]            # or ["all"]
-    pulses = ["sine"]                           # sine, cosine
+    pulses = ["sine"]                           # sine, cosine, ricker, ricker-anti, mp
     omega = "4:28:4"                            # START:STOP:STEP or a list [rad/s]
     steps = [1e-4, 5e-4]                        # engine time steps [s]; 0 = calibrated
     cases = ["pendulum", "no_pendulum"]         # optional (default both)
@@ -93,7 +93,7 @@ def load_study(path) -> Study:
     it picks the default output folder ``campaign-<name>`` in the working
     directory, which a file must not be able to point elsewhere.
     """
-    from analytic.excitation import PULSE_KINDS
+    from analytic.pulses import PULSE_FAMILY
     from compare.campaign.grids import parse_omega_range
 
     path = Path(path)
@@ -128,8 +128,8 @@ def load_study(path) -> Study:
                              f"{', '.join(ENGINES)} or all")
     pulses = [str(p) for p in _list(table, "pulses", where)] if "pulses" in table else ["sine"]
     for p in pulses:
-        if p not in PULSE_KINDS:
-            raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_KINDS)}")
+        if p not in PULSE_FAMILY:
+            raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_FAMILY)}")
     omega = table.get("omega")
     if isinstance(omega, list):
         text = ",".join(repr(_number(w, where, "omega")) for w in omega)

@@ -260,6 +260,13 @@ def _print(doc: dict, st: IDASettings) -> None:
                   "neighbours; in fragility.json, never a threshold)")
         if loose:
             print(f"  no robust bracket (left out of the fit): {', '.join(loose)}")
+        for r in body["records"]:
+            lr = r.get("long_run")
+            if lr:
+                print(f"  {r['label']} at {lr['im_value']:.4g} {unit} ({lr['t_end']:.3g} s "
+                      f"{lr['status']}): pivot slid {lr['pivot_sliding_max']:.3g} m, lintel "
+                      f"turned {lr['lintel_rotation_max']:.3g} rad, residual tilt "
+                      f"{lr['residual_tilt']:.3g} rad (model {lr['model_residual_tilt']:.3g})")
         ag = body.get("agreement")
         if ag:
             ratio = "n/a" if ag["median_ratio"] is None else f"{ag['median_ratio']:.3f}"
