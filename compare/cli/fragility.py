@@ -97,14 +97,15 @@ def robust_job(item):
     from compare.measure.record_threshold import engine_intensity
     from compare.run import runs
     from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, st, im_model = item
+    backend, scene, record, st, im_model, *rest = item
+    options = rest[0] if rest else {}  # e.g. {"dt": ...}: a campaign's time step
     what = {"backend": backend, "scene": scene_dict(scene),
             "record": digest(excitation_dict(record)), "ida": st.describe(),
             "im_model": im_model,
-            "settings": settings_dict(engines.configure(backend,
-                                                        t_max=record.end_time + st.tail))}
+            "settings": settings_dict(engines.configure(backend, t_max=record.end_time
+                                                        + st.tail, **options))}
     return runs.memo("robust-ida", what, lambda: engine_intensity(backend, scene, record, st,
-                                                                  im_model),
+                                                                  im_model, options),
                      label=f"robust ida {backend} {record.label}", code=runs.ALL_CODE)
 
 

@@ -37,7 +37,8 @@ import math
 __all__ = ["engine_intensity"]
 
 
-def engine_intensity(backend: str, scene, motion, st, im_model: float | None) -> dict:
+def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
+                     options: dict | None = None) -> dict:
     """The robust first overturning intensity of ``backend`` under ``motion``.
 
     Parameters
@@ -50,6 +51,8 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None) ->
         The intensity measure, ``im_hi`` (censoring) and ``tail`` (the window).
     im_model : float or None
         The model's first overturning intensity (None: censored at ``im_hi``).
+    options : dict, optional
+        Engine settings beside the window (:func:`engines.configure`, e.g. ``dt``).
 
     Returns
     -------
@@ -63,7 +66,7 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None) ->
     from analytic.ida import scale_to
     from compare.measure.thresholds import engine_threshold
 
-    settings = engines.configure(backend, t_max=motion.end_time + st.tail)
+    settings = engines.configure(backend, t_max=motion.end_time + st.tail, **(options or {}))
     centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
     p = engine_threshold(backend, scene, math.nan, centre, settings,
                          motion=lambda v: scale_to(motion, st.im, v))
