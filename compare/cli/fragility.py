@@ -160,15 +160,16 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
     n = len(suite)  # results come in the order of the items: backend-major
     per = {b: results[i * n:(i + 1) * n] for i, b in enumerate(backends)}
     # A record with no robust bracket has no intensity: listed, left out of the fit.
-    fits = {b: fragility([math.inf if r["censored"] else r["im_overturn"] for r in per[b]
-                          if r.get("bracketed", True)], censored_at=st.im_hi)
-            for b in backends}
+    usable = {b: [math.inf if r["censored"] else r["im_overturn"] for r in per[b]
+                  if r.get("bracketed", True)] for b in backends}
+    fits = {b: fragility(v, censored_at=st.im_hi) if v else None for b, v in usable.items()}
     ref = fits["analytic"]
     return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
             "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
                          "duration": r.end_time, "n_samples": len(r.times)} for r in suite],
-            "backends": {b: {"fit": fits[b].describe(), "records": per[b],
-                             **({} if b == "analytic" else
+            "backends": {b: {"fit": None if fits[b] is None else fits[b].describe(),
+                             "records": per[b],
+                             **({} if b == "analytic" or fits[b] is None else
                                 {"agreement": agreement(ref, fits[b])})}
                          for b in backends},
             "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
@@ -208,6 +209,8 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
     colours = {"analytic": "k", "pybullet": "C0", "pymunk": "C1", "mujoco": "C2"}
     for b, body in doc["backends"].items():
         fit, c = body["fit"], colours.get(b, None)
+        if fit is None:  # no record with a robust bracket: nothing to draw
+            continue
         ims = np.array([math.inf if v is None else v for v in fit["im"]])
         x, f = empirical_curve(ims)
         if x.size:
@@ -244,7 +247,7 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
 def _print(doc: dict, st: IDASettings) -> None:
     unit = IM_UNITS[st.im]
     for b, body in doc["backends"].items():
-        fit = body["fit"]
+        fit = body["fit"] or {"median": None, "n": 0, "n_censored": 0}
         med = fit["median"]
         shown = "no fit (fewer than 2 overturns)" if med is None else (
             f"median {med:.4g} {unit}" + (f" ({med / G_STANDARD:.3g} g)" if st.im == "pga" else "")
@@ -261,6 +264,13 @@ def _print(doc: dict, st: IDASettings) -> None:
                   "neighbours; in fragility.json, never a threshold)")
         if loose:
             print(f"  no robust bracket (left out of the fit): {', '.join(loose)}")
+        for r in body["records"]:
+            if r.get("collapsed"):
+                print(f"  {r['label']}: the frame collapsed (not an overturn) at "
+                      f"{', '.join(f'{a:.4g}' for a in r['collapsed'])} {unit}")
+            if r.get("bracket") and r["censored"]:
+                print(f"  {r['label']}: overturns above the range, between "
+                      f"{r['bracket'][0]:.4g} and {r['bracket'][1]:.4g} {unit}")
         for r in body["records"]:
             lr = r.get("long_run")
             if lr:

@@ -22,13 +22,14 @@ overturns): such a record is listed, never given an intensity.
 
 Creep and drift over a whole record (``long_run``): the nominal run at the
 engine's highest robust survival (``im_safe``, or the highest intensity run when
-censored) lasts the whole window, so its diagnostics
+censored) is rerun over the whole window (no early stop: the model and the
+engines alike run to ``end_time + tail``, so the tilt left is a residual, not
+the rocking at the instant the verdict became certain), and its diagnostics
 (:mod:`engines.diagnostics`) tell what the engine accumulates over the record:
 ``pivot_sliding_max`` [m] (a pivot creeping along the ground),
 ``lintel_rotation_max`` [rad] (the lintel drifting off the columns' rigid
 motion), ``penetration_max`` [m], and the residual tilt ``|theta|`` at the
-window's end [rad] beside the model's at the same intensity.  The run is the
-search's own, served by the run store.
+window's end [rad] beside the model's at the same intensity.
 """
 from __future__ import annotations
 
@@ -58,7 +59,9 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
     -------
     dict
         ``label``, ``im``, ``im_overturn`` / ``im_safe`` (None when censored or
-        not bracketed), ``censored``, ``bracketed``, ``isolated`` (overturns not
+        not bracketed), ``censored``, ``bracketed``, ``bracket`` (``[survives,
+        overturns]`` even above ``im_hi``), ``collapsed`` (intensities whose
+        nominal run ended 'collapsed': the frame broke), ``isolated`` (overturns not
         reproduced by their perturbed neighbours), ``flips``, ``n_runs``,
         ``cpu_s`` (CPU seconds of the runs when computed), ``im_reference``.
     """
@@ -77,6 +80,9 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
             "im_overturn": p.a_engine if over else None,
             "im_safe": p.a_survives if over else None,
             "censored": bool(censored), "bracketed": bool(p.bracketed),
+            "bracket": [p.a_survives, p.a_engine] if p.bracketed else None,
+            "collapsed": [q.amplitude for q in p.probes
+                          if q.status == "collapsed" and not q.perturbation],
             "isolated": list(p.isolated), "flips": [f.to_dict() for f in p.flips],
             "n_runs": p.n_runs, "cpu_s": p.cpu_s, "im_reference": centre,
             "islands": [], "long_run": long_run}
@@ -96,9 +102,10 @@ def _long_run(backend, scene, motion, st, settings, p, over: bool) -> dict | Non
         return None
     value = max(alive)
     scaled = scale_to(motion, st.im, value)
-    tr = runs.simulate(backend, scene, scaled, engines.configure(backend, settings,
-                                                                 verdict_only=False))
-    model = simulate(scene, scaled, Settings(t_max=settings.t_max, sample_dt=0.01))
+    tr = runs.simulate(backend, scene, scaled, engines.configure(
+        backend, settings, verdict_only=False, early_stop=False))
+    model = simulate(scene, scaled, Settings(t_max=settings.t_max, sample_dt=0.01,
+                                             early_stop=False))
     d = tr.diagnostics
     sim_s = float(tr.t[-1]) if len(tr.t) else 0.0
     cpu = d.get("cpu_time")
