@@ -76,6 +76,8 @@ def shaped_pulse(shape: PulseShape, amplitude: float, omega: float, option: str,
     if not (math.isfinite(amplitude) and abs(amplitude) <= MAX_ACCELERATION):
         raise ValueError(f"{amplitude_option} must be finite with |A| <= "
                          f"{MAX_ACCELERATION:g} m/s^2, got {amplitude!r}")
+    if shape.kind in ("sine", "cosine"):  # Pulse's own message names omega
+        return shape.at(amplitude, omega)
     try:
         return shape.at(amplitude, omega)
     except ValueError as exc:
