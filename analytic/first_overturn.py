@@ -55,6 +55,7 @@ from .equations import overturn_energy_barrier
 from .excitation import OMEGA_RANGE, PULSE_KINDS
 from .fast_settings import Settings as FastSettings
 from .parameters import Scene
+from .pulses import PULSE_FAMILY, PulseShape
 from .trajectory import OverturnCriterion
 
 __all__ = ["SpectrumSettings", "first_overturn_amplitude", "METHODS", "SEARCH_RTOL",
@@ -81,8 +82,10 @@ def search_run_settings(**options) -> FastSettings:
 class SpectrumSettings:
     """How a spectrum is searched (see the module docstring)."""
 
-    # One-sine (Eq. 22) or one-cosine (Eq. 23) pulse.
-    pulse: str = "sine"
+    # One-sine (Eq. 22) or one-cosine (Eq. 23) pulse (compiled search), or another
+    # shape of analytic.pulses.PULSE_FAMILY or a PulseShape (accurate model,
+    # analytic.shape_threshold); its amplitude is the peak ground acceleration.
+    pulse: str | PulseShape = "sine"
     # Bisection resolution [m/s^2]: finer than the paper's plots can show.
     tol: float = 0.01
     # Coarse scan step floor [m/s^2] and relative step.
@@ -107,8 +110,12 @@ class SpectrumSettings:
     fast: FastSettings = field(default_factory=search_run_settings)
 
     def __post_init__(self) -> None:
-        if self.pulse not in PULSE_KINDS:
-            raise ValueError(f"pulse must be one of {PULSE_KINDS}, got {self.pulse!r}")
+        if not (isinstance(self.pulse, PulseShape) or isinstance(self.pulse, str)
+                and self.pulse in PULSE_FAMILY):
+            raise ValueError(f"pulse must be one of {PULSE_FAMILY} or a PulseShape, "
+                             f"got {self.pulse!r}")
+        if isinstance(self.pulse, PulseShape) and self.pulse.kind in PULSE_KINDS:
+            object.__setattr__(self, "pulse", self.pulse.kind)
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {self.method!r}")
         for name, lo, hi in (("tol", 1e-6, 10.0), ("scan_step", 1e-4, 100.0),
@@ -127,6 +134,11 @@ class SpectrumSettings:
             raise ValueError(f"tol ({self.tol:g}) must not exceed scan_step ({self.scan_step:g})")
         if not isinstance(self.fast, FastSettings):
             raise ValueError("fast must be analytic.fast.Settings")
+
+    @property
+    def compiled(self) -> bool:
+        """True when the compiled search covers the pulse (one-sine, one-cosine)."""
+        return isinstance(self.pulse, str) and self.pulse in PULSE_KINDS
 
     @property
     def criterion(self) -> OverturnCriterion:
@@ -198,6 +210,9 @@ def first_overturn_amplitude(scene: Scene, omega: float, ss: SpectrumSettings
             math.isfinite(omega) and OMEGA_RANGE[0] <= omega <= OMEGA_RANGE[1]):
         raise ValueError(f"omega must be in [{OMEGA_RANGE[0]:g}, {OMEGA_RANGE[1]:g}] rad/s, "
                          f"got {omega!r}")
+    if not ss.compiled:
+        from .shape_threshold import first_overturn_pga
+        return first_overturn_pga(scene, omega, ss)
     run = _Runner(scene, omega, ss)
     a0 = _a_start(scene, ss)
     over, ni0, quiet0 = run([a0])

@@ -26,10 +26,13 @@ from ._workers import fork_pool
 from .parameters import Scene
 from .spectrum import SpectrumSettings, first_overturn_amplitude
 
-__all__ = ["OverturnMap", "analytic_map", "verdict_map", "verdict_label", "BASE_LABELS"]
+__all__ = ["OverturnMap", "analytic_map", "verdict_map", "verdict_label", "BASE_LABELS",
+           "MAX_ACCURATE_CELLS"]
 
 BASE_LABELS = ("survived", "overturned (no-impact)", "overturned (after-impact)")
 MAX_CELLS = 2_000_000  # ~100 s of compiled runs: beyond, a typo rather than a wish
+# Accurate-model maps (Ricker, M-P): ~20 ms a cell, so ~100 CPU s at most.
+MAX_ACCURATE_CELLS = 5_000
 
 
 def verdict_label(status: str, mode: str | None) -> str:
@@ -95,11 +98,29 @@ _JOB: dict = {}
 
 def _analytic_column(omega: float) -> tuple[np.ndarray, float]:
     scene, ss, amps, with_first = _JOB["scene"], _JOB["ss"], _JOB["amps"], _JOB["first"]
-    st, _rs, _tv, ni, _e = _k.verdicts(amps, *fast.kernel_args(scene, omega, ss.pulse, ss.fast))
-    col = np.select([st == _k.ST_OVERTURNED, st == _k.ST_SURVIVED, st == _k.ST_UNSTABLE],
-                    [np.where(ni > 0, 2, 1), 0, 3], 4)
+    if ss.compiled:
+        st, _rs, _tv, ni, _e = _k.verdicts(amps, *fast.kernel_args(scene, omega, ss.pulse,
+                                                                   ss.fast))
+        col = np.select([st == _k.ST_OVERTURNED, st == _k.ST_SURVIVED, st == _k.ST_UNSTABLE],
+                        [np.where(ni > 0, 2, 1), 0, 3], 4)
+    else:
+        col = np.array([_accurate_cell(scene, ss, float(a), omega) for a in amps], dtype=int)
     first = first_overturn_amplitude(scene, omega, ss)[0] if with_first else math.nan
     return col, first
+
+
+def _accurate_cell(scene: Scene, ss: SpectrumSettings, amplitude: float, omega: float) -> int:
+    """The label index of one cell run by the accurate model (the shapes the
+    kernels do not cover), with the same criterion and window."""
+    from .events import Settings
+    from .pulses import pulse_of
+    from .simulate import simulate
+    v = simulate(scene, pulse_of(ss.pulse, amplitude, omega),
+                 Settings(criterion=ss.criterion, t_max=ss.t_max, verdict_only=True,
+                          sample_dt=None)).verdict
+    if v.status == "overturned":
+        return 2 if v.mode == "after-impact" else 1
+    return {"survived": 0, "unstable": 3}.get(v.status, 4)
 
 
 def _verdict_cell(ij: tuple[int, int]) -> tuple[str, str | None]:
@@ -116,7 +137,9 @@ def _pool_map(fn, items, workers: int) -> list:
 
 def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | None = None,
                  workers: int = 1, first_curve: bool = True) -> OverturnMap:
-    """The compiled analytic model's overturn map of ``scene``.
+    """The compiled analytic model's overturn map of ``scene`` (the accurate
+    model's for the pulse shapes the kernels do not cover: Ricker, M-P; ~20 ms
+    a cell, :data:`MAX_ACCURATE_CELLS` at most).
 
     Parameters
     ----------
@@ -146,9 +169,13 @@ def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | 
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     w, a = _check_grid(omegas, amplitudes)
+    if not ss.compiled and w.size * a.size > MAX_ACCURATE_CELLS:
+        raise ValueError(f"a {ss.pulse} map of {w.size * a.size} cells runs the accurate model "
+                         f"(~20 ms a cell); at most {MAX_ACCURATE_CELLS} cells")
     ss = replace(ss, a_max=float(min(ss.a_max, a.max())))
     t0 = time.perf_counter()
-    fast.warm_up(record=False)
+    if ss.compiled:
+        fast.warm_up(record=False)
     _JOB.update(scene=scene, ss=ss, amps=a, first=first_curve)
     try:
         cols = _pool_map(_analytic_column, [float(x) for x in w], workers)
@@ -157,7 +184,8 @@ def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | 
     labels = BASE_LABELS + ("unstable", "undecided")  # the kernel's other statuses
     cells = np.stack([c for c, _ in cols], axis=1)
     return OverturnMap(omega=w, amplitude=a, cells=cells, labels=labels,
-                       first=np.array([f for _, f in cols]), backend=fast.NAME,
+                       first=np.array([f for _, f in cols]),
+                       backend=fast.NAME if ss.compiled else "analytic",
                        pulse=ss.pulse, scene=scene, wall_time=time.perf_counter() - t0)
 
 

@@ -29,7 +29,6 @@ import numpy as np
 from ._workers import fork_pool
 from .clearance import check_clearance
 from .contact_forces import violations
-from .excitation import Pulse
 from .parameters import Scene
 
 __all__ = ["point_validity", "curve_validity", "spectrum_validity", "invalid_spans",
@@ -59,9 +58,10 @@ def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "si
     """
     if amplitude is None or not math.isfinite(amplitude):
         return {k: None for k in VALIDITY_FIELDS[:-1]} | {"model_reason": ""}
+    from .pulses import pulse_of
     from .simulate import simulate  # simulate imports the contact checks
 
-    tr = simulate(scene, Pulse(float(amplitude), float(omega), kind))
+    tr = simulate(scene, pulse_of(kind, float(amplitude), float(omega)))
     d = tr.diagnostics
     if "model_valid" not in d:  # non-finite samples: nothing to judge
         return {k: None for k in VALIDITY_FIELDS[:-1]} | {

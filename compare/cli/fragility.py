@@ -1,9 +1,11 @@
 """``trilith fragility``: incremental dynamic analysis over a suite of records and
 the fragility curves P(overturn | IM) of the model and of each engine.
 
-For each record and backend: the lowest intensity that overturns
-(:mod:`analytic.ida`, window-aware, with the survival islands above it); then per
-backend the empirical curve and a lognormal fit with a bootstrap band
+For each record: the model's lowest intensity that overturns (:mod:`analytic.ida`,
+window-aware, with the survival islands above it), then each engine's robust
+bracket around it (:mod:`compare.measure.record_threshold`: the perturbation set
+of the pulse thresholds, isolated overturns reported apart); then per backend the
+empirical curve and a lognormal fit with a bootstrap band
 (:mod:`compare.measure.fragility`), and each engine's agreement with the model.
 Every run goes through the run store (a killed command resumes); records run in
 parallel (``--workers``) or on a Dask cluster (``--scheduler``).
@@ -71,7 +73,8 @@ def ida_job(item):
     from analytic.ida import first_overturn_intensity
     from compare.run import runs
     from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, st, options = item
+    backend, scene, record, st, *rest = item
+    options = rest[0] if rest else {}
     extra = {"sample_dt": 0.01} if backend == "analytic" else dict(options)
 
     def settings_for(motion):
@@ -89,8 +92,40 @@ def ida_job(item):
     return runs.memo("ida", what, compute, label=f"ida {backend} {record.label}")
 
 
+def robust_job(item):
+    """One record, one engine: its robust first overturning intensity around the
+    model's (:func:`compare.measure.record_threshold.engine_intensity`), through
+    the run store (each run stored, the whole search memoised)."""
+    import engines
+
+    from compare.measure.record_threshold import engine_intensity
+    from compare.run import runs
+    from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
+    backend, scene, record, st, im_model, *rest = item
+    options = rest[0] if rest else {}  # e.g. {"dt": ...}: a campaign's time step
+    what = {"backend": backend, "scene": scene_dict(scene),
+            "record": digest(excitation_dict(record)), "ida": st.describe(),
+            "im_model": im_model,
+            "settings": settings_dict(engines.configure(backend, t_max=record.end_time
+                                                        + st.tail, **options))}
+    return runs.memo("robust-ida", what, lambda: engine_intensity(backend, scene, record, st,
+                                                                  im_model, options),
+                     label=f"robust ida {backend} {record.label}", code=runs.ALL_CODE)
+
+
+def intensities(scene, suite, backends, st: IDASettings, workers: int, scheduler,
+                loaded=None) -> list:
+    """The model's IDA of every record, then each engine's robust bracket around
+    it (with its ``--settings`` table from ``loaded``); backend-major, in the order
+    of ``suite``."""
+    model = _run_all([("analytic", scene, r, st) for r in suite], workers, scheduler)
+    engines_ = [b for b in backends if b != "analytic"]
+    items = [(b, scene, r, st, None if m["censored"] else m["im_overturn"],
+              file_options(loaded, b)) for b in engines_ for r, m in zip(suite, model)]
+    return model + (_run_all(items, workers, scheduler, robust_job) if items else [])
+
+
 def run(args: argparse.Namespace) -> int:
-    from engines import ENGINES
     from scenes.ground_motion import load_suite
 
     scene = scene_from_args(args)
@@ -102,8 +137,7 @@ def run(args: argparse.Namespace) -> int:
     suite = load_suite(args.records)
     store = use_store(args)
     backends = ("analytic",) + engines_
-    items = [(b, scene, r, st, file_options(loaded, b)) for b in backends for r in suite]
-    results = _run_all(items, workers, args.scheduler)
+    results = intensities(scene, suite, backends, st, workers, args.scheduler, loaded)
     doc = _summarise(scene, suite, backends, st, results)
     doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
@@ -114,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_all(items, workers: int, scheduler):
+def _run_all(items, workers: int, scheduler, job=None):
     import sys
 
     from tqdm import tqdm
@@ -123,7 +157,7 @@ def _run_all(items, workers: int, scheduler):
     bar = tqdm(total=len(items), unit="record", desc="fragility",
                disable=not sys.stderr.isatty())
     try:
-        return list(run_many(ida_job, items, workers=workers, scheduler=scheduler,
+        return list(run_many(job or ida_job, items, workers=workers, scheduler=scheduler,
                              on_done=lambda i, r: bar.update(1)))
     finally:
         bar.close()
@@ -133,14 +167,17 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
     from compare.measure.fragility import agreement, fragility
     n = len(suite)  # results come in the order of the items: backend-major
     per = {b: results[i * n:(i + 1) * n] for i, b in enumerate(backends)}
-    fits = {b: fragility([math.inf if r["censored"] else r["im_overturn"] for r in per[b]],
-                         censored_at=st.im_hi) for b in backends}
+    # A record with no robust bracket has no intensity: listed, left out of the fit.
+    usable = {b: [math.inf if r["censored"] else r["im_overturn"] for r in per[b]
+                  if r.get("bracketed", True)] for b in backends}
+    fits = {b: fragility(v, censored_at=st.im_hi) if v else None for b, v in usable.items()}
     ref = fits["analytic"]
     return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
             "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
                          "duration": r.end_time, "n_samples": len(r.times)} for r in suite],
-            "backends": {b: {"fit": fits[b].describe(), "records": per[b],
-                             **({} if b == "analytic" else
+            "backends": {b: {"fit": None if fits[b] is None else fits[b].describe(),
+                             "records": per[b],
+                             **({} if b == "analytic" or fits[b] is None else
                                 {"agreement": agreement(ref, fits[b])})}
                          for b in backends},
             "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
@@ -152,7 +189,8 @@ def _write(out, doc: dict, st: IDASettings) -> None:
     from compare.run.atomic import write_text
     from compare.run.jsonable import plain
     write_text(out / "fragility.json", json.dumps(plain(doc), indent=1, allow_nan=False))
-    rows = ["backend,record,im,unit,im_overturn,im_safe,censored,islands,n_runs"]
+    rows = ["backend,record,im,unit,im_overturn,im_safe,censored,islands,n_runs,robust_bracket,"
+            "n_isolated"]
     for b, body in doc["backends"].items():
         for r in body["records"]:
             islands = ";".join(f"{a:.6g}-{c:.6g}" for a, c in r["islands"])
@@ -160,7 +198,8 @@ def _write(out, doc: dict, st: IDASettings) -> None:
                 b, r["label"], st.im, IM_UNITS[st.im] or "-",
                 "" if r["im_overturn"] is None else f"{r['im_overturn']:.6g}",
                 "" if r["im_safe"] is None else f"{r['im_safe']:.6g}",
-                r["censored"], islands, r["n_runs"])))
+                r["censored"], islands, r["n_runs"],
+                "" if b == "analytic" else r["bracketed"], len(r.get("isolated", ())))))
     write_text(out / "fragility.csv", "\n".join(rows) + "\n")
     _plot(out / "fragility.png", doc, st)
 
@@ -178,6 +217,8 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
     colours = {"analytic": "k", "pybullet": "C0", "pymunk": "C1", "mujoco": "C2"}
     for b, body in doc["backends"].items():
         fit, c = body["fit"], colours.get(b, None)
+        if fit is None:  # no record with a robust bracket: nothing to draw
+            continue
         ims = np.array([math.inf if v is None else v for v in fit["im"]])
         x, f = empirical_curve(ims)
         if x.size:
@@ -214,7 +255,7 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
 def _print(doc: dict, st: IDASettings) -> None:
     unit = IM_UNITS[st.im]
     for b, body in doc["backends"].items():
-        fit = body["fit"]
+        fit = body["fit"] or {"median": None, "n": 0, "n_censored": 0}
         med = fit["median"]
         shown = "no fit (fewer than 2 overturns)" if med is None else (
             f"median {med:.4g} {unit}" + (f" ({med / G_STANDARD:.3g} g)" if st.im == "pga" else "")
@@ -224,6 +265,27 @@ def _print(doc: dict, st: IDASettings) -> None:
         islands = sum(len(r["islands"]) for r in body["records"])
         if islands:
             print(f"  {islands} survival islands above a first overturn (see fragility.csv)")
+        isolated = sum(len(r.get("isolated", ())) for r in body["records"])
+        loose = [r["label"] for r in body["records"] if not r.get("bracketed", True)]
+        if isolated:
+            print(f"  {isolated} isolated overturns (not reproduced by their perturbed "
+                  "neighbours; in fragility.json, never a threshold)")
+        if loose:
+            print(f"  no robust bracket (left out of the fit): {', '.join(loose)}")
+        for r in body["records"]:
+            if r.get("collapsed"):
+                print(f"  {r['label']}: the frame collapsed (not an overturn) at "
+                      f"{', '.join(f'{a:.4g}' for a in r['collapsed'])} {unit}")
+            if r.get("bracket") and r["censored"]:
+                print(f"  {r['label']}: overturns above the range, between "
+                      f"{r['bracket'][0]:.4g} and {r['bracket'][1]:.4g} {unit}")
+        for r in body["records"]:
+            lr = r.get("long_run")
+            if lr:
+                print(f"  {r['label']} at {lr['im_value']:.4g} {unit} ({lr['t_end']:.3g} s "
+                      f"{lr['status']}): pivot slid {lr['pivot_sliding_max']:.3g} m, lintel "
+                      f"turned {lr['lintel_rotation_max']:.3g} rad, residual tilt "
+                      f"{lr['residual_tilt']:.3g} rad (model {lr['model_residual_tilt']:.3g})")
         ag = body.get("agreement")
         if ag:
             ratio = "n/a" if ag["median_ratio"] is None else f"{ag['median_ratio']:.3f}"

@@ -9,7 +9,7 @@ from engines import engine_names
 
 from compare.cli import options as _options
 from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
-                                 add_workers_arg, check_output_path, parse_engine_list,
+                                 add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
 from compare.measure.map_thresholds import LEAST_RUNS
@@ -56,6 +56,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--csv", metavar="FILE",
                         help="write the cells and the engines' robust thresholds as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
+    from compare.cli.record_map import add_record_map_args
+    add_record_map_args(parser)
+    add_store_args(parser)
     return parser
 
 
@@ -86,7 +89,7 @@ class _EngineRun:
     :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
     no early stop when given, through the run store."""
 
-    def __init__(self, name: str, scene, pulse: str, t_max: float | None = None,
+    def __init__(self, name: str, scene, pulse, t_max: float | None = None,
                  base: dict | None = None):
         self.name, self.scene, self.pulse = name, scene, pulse
         self.options = dict(base or {})  # the --settings table, under --t-max
@@ -94,12 +97,12 @@ class _EngineRun:
             self.options.update(t_max=t_max, early_stop=False)
 
     def __call__(self, amplitude: float, omega: float):
-        from analytic.excitation import Pulse
+        from analytic.pulses import pulse_of
         from compare.measure.engine_spectrum import pulse_settings
         from compare.run import runs
         settings = pulse_settings(self.name, self.scene, amplitude, omega, self.pulse,
                                   verdict_only=True, **self.options)
-        return runs.simulate(self.name, self.scene, Pulse(amplitude, omega, self.pulse),
+        return runs.simulate(self.name, self.scene, pulse_of(self.pulse, amplitude, omega),
                              settings).verdict
 
 
@@ -139,7 +142,8 @@ def _draw_thresholds(ax, points, colour) -> None:
                         color=colour, xytext=(3, -9), textcoords="offset points")
 
 
-def plot_maps(maps, path, validity=None, thresholds=None) -> None:
+def plot_maps(maps, path, validity=None, thresholds=None, xlabel=r"$\Omega$ [rad/s]",
+              ylabel=r"$A_s$ [m/s$^2$]", subject="pulse") -> None:
     """One panel per map: cells coloured by label, the analytic first-overturning
     curve (black line) on every panel and, above it, the frequencies where the
     model is invalid on that curve's run hatched (``validity``: one
@@ -177,10 +181,11 @@ def plot_maps(maps, path, validity=None, thresholds=None) -> None:
         handles = [Patch(facecolor=cols[i], edgecolor="k", label=m.labels[i]) for i in present]
         ax.legend(handles=handles + ax.get_legend_handles_labels()[0], fontsize=7,
                   loc="upper left")
-        ax.set_xlabel(r"$\Omega$ [rad/s]")
-        ax.set_ylabel(r"$A_s$ [m/s$^2$]")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
         sc = m.scene
-        ax.set_title(f"{m.backend}: {m.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
+        ax.set_title(f"{m.backend}: {f'{m.pulse} {subject}'.strip()}, lam={sc.lam:g}, "
+                     f"b={sc.b:g} m, "
                      f"gamma={sc.gamma:g}", fontsize=9)
     used = axes.ravel()[:len(maps)]
     for get, set_ in (("get_xlim", "set_xlim"), ("get_ylim", "set_ylim")):
@@ -234,36 +239,45 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.csv, "--csv")
     if args.plot:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    from compare.cli.pulse_shape import shape_from_args
+    shape = shape_from_args(args)
     engines, eng_grid = (), None
+    if args.record is not None:
+        from compare.cli.record_map import record_map
+        return record_map(args, scene, workers,
+                          parse_engine_list(args.engine) if args.engine is not None else ())
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
     loaded = _options.settings_from_args(args, engines)
-    from analytic.overturn_map import MAX_CELLS, analytic_map, verdict_map
+    from analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
     from analytic.spectrum import SpectrumSettings
-    if omegas.size * amps.size > MAX_CELLS:
+    settings = SpectrumSettings(pulse=shape)
+    top = MAX_CELLS if settings.compiled else MAX_ACCURATE_CELLS
+    if omegas.size * amps.size > top:
+        why = "" if settings.compiled else (f" for a {shape} pulse (the accurate model, "
+                                            "~20 ms a cell)")
         raise ValueError(f"--omega x --amplitude gives {omegas.size * amps.size} cells, "
-                         f"more than {MAX_CELLS}")
-    maps = [analytic_map(scene, omegas, amps, SpectrumSettings(pulse=args.pulse),
-                         workers=workers)]
+                         f"more than {top}{why}")
+    maps = [analytic_map(scene, omegas, amps, settings, workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, args.pulse, args.t_max,
+        maps.append(verdict_map(_EngineRun(name, scene, settings.pulse, args.t_max,
                                            _options.file_options(loaded, name)), scene,
                                 *eng_grid,
-                                backend=name, pulse=args.pulse, workers=workers))
+                                backend=name, pulse=settings.pulse, workers=workers))
     thresholds = {}
     if engines:
         from compare.campaign.settings_file import threshold_options
         from compare.measure.map_thresholds import map_thresholds, model_thresholds
-        reference = model_thresholds(scene, eng_grid[0], args.pulse, workers)
+        reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers)
         for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
-            thresholds[name] = map_thresholds(name, scene, eng_grid[0], args.pulse,
+            thresholds[name] = map_thresholds(name, scene, eng_grid[0], settings.pulse,
                                               workers=workers, convergence=args.convergence,
                                               t_max=args.t_max, reference=reference,
                                               **{**threshold_options(name),
                                                  **_options.file_options(loaded, name)})
     from analytic.threshold_validity import curve_validity
-    validity = curve_validity(scene, maps[0].omega, maps[0].first, args.pulse, workers)
+    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
 
     def valid_text(w):

@@ -15,7 +15,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-from analytic.excitation import PULSE_KINDS, Pulse
 from analytic.options import MAX_RUN_STEPS
 from analytic.parameters import Scene
 from scenes import load_scene
@@ -94,8 +93,9 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--pulse", choices=PULSE_KINDS, default="sine",
-                        help="one-sine (Eq. 22) or one-cosine (Eq. 23) pulse")
+    """``--pulse`` and the M-P shape options (``compare/cli/pulse_shape.py``)."""
+    from .pulse_shape import add_pulse_shape_args
+    add_pulse_shape_args(parser)
 
 
 def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
@@ -160,12 +160,17 @@ def scaled_record(record, args: argparse.Namespace):
 
 def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] | None = None):
     """``--record FILE`` (a :class:`analytic.excitation.SampledRecord`, scaled by
-    ``--scale/--pga/--pgv``) or the pulse ``-A`` with ``-w`` or ``--period``
-    (``default`` fills in what is not given).  A record excludes the pulse options."""
+    ``--scale/--pga/--pgv``) or the pulse ``--pulse`` of peak acceleration ``-A``
+    at ``-w`` or ``--period`` (``default`` fills in what is not given).  A record
+    excludes the pulse options."""
     from .units import parse_acceleration
+    from .pulse_shape import shape_from_args, shaped_pulse
     record = getattr(args, "record", None)
     given = [f for f, v in (("--amplitude", args.amplitude), ("--omega", args.omega),
-                            ("--period", getattr(args, "period", None))) if v is not None]
+                            ("--period", getattr(args, "period", None)),
+                            ("--pulse", None if args.pulse == "sine" else args.pulse),
+                            ("--mp-gamma", getattr(args, "mp_gamma", None)),
+                            ("--mp-nu", getattr(args, "mp_nu", None))) if v is not None]
     if record is not None:
         if given:
             raise ValueError(f"--record replaces the pulse: drop {' and '.join(given)}")
@@ -182,7 +187,7 @@ def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] 
         missing = " and ".join(f for f, v in (("-A/--amplitude", amplitude),
                                               ("-w/--omega (or --period)", omega)) if v is None)
         raise ValueError(f"give {missing} for a pulse, or --record FILE")
-    return Pulse(amplitude, omega, args.pulse)
+    return shaped_pulse(shape_from_args(args), amplitude, omega, "-w/--omega (or --period)")
 
 
 def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",

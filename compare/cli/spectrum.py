@@ -113,8 +113,9 @@ def _settings(args: argparse.Namespace):
     if args.scan_step is not None and not (math.isfinite(args.scan_step)
                                            and 1e-4 < args.scan_step <= 100):
         raise ValueError(f"--scan-step must be in (0.0001, 100] m/s^2, got {args.scan_step!r}")
+    from compare.cli.pulse_shape import shape_from_args
     fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
-    kw = {"pulse": args.pulse, "fast": fast}
+    kw = {"pulse": shape_from_args(args), "fast": fast}
     if args.tol is not None:
         kw["tol"] = args.tol
     if args.scan_step is not None:
@@ -195,7 +196,7 @@ def run(args: argparse.Namespace) -> int:
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
     loaded = settings_from_args(args, engines_wanted)
-    _check_engine_budget(args, engines_wanted, omegas, loaded)
+    _check_engine_budget(args, engines_wanted, omegas, settings.pulse, loaded)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
                                 map_fn=_map_fn(scene, settings, workers))
@@ -211,7 +212,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         body = {**spec.to_dict(), "model_validity": validity}
         timings = {"wall_time": body.pop("wall_time"), "workers": workers}
-        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": settings.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": ENGINE}
         body = {"engine": ENGINE, "engine_version": version(), **body}
@@ -261,6 +262,9 @@ def _record_spectrum(args: argparse.Namespace, scene) -> int:
              if getattr(args, n) is not None]
     if args.omega != DEFAULT_OMEGA:
         given.insert(0, "--omega")
+    given[:0] = [f for f, v in (("--pulse", None if args.pulse == "sine" else args.pulse),
+                                ("--mp-gamma", args.mp_gamma), ("--mp-nu", args.mp_nu))
+                 if v is not None]
     if given or args.convergence:
         raise ValueError(f"--record searches the record's intensity: drop "
                          f"{' and '.join(given) or '--convergence'}")
@@ -280,12 +284,12 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     return names
 
 
-def _check_engine_budget(args, names, omegas, loaded=None) -> None:
+def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
     """Refuse before any work an engine run over the run budget: the longest is at
     the lowest Omega, at the finest step (``--convergence`` reruns at dt/4)."""
     import dataclasses
 
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from engines import configure
 
     from compare.cli.options import check_run_budget
@@ -296,7 +300,7 @@ def _check_engine_budget(args, names, omegas, loaded=None) -> None:
         finest = dt / 4 if args.convergence else dt
         option = "--dt" + (" (with --convergence: dt/4)" if args.convergence else "")
         check_run_budget(name, dataclasses.replace(settings, dt=finest),
-                         Pulse(1.0, float(min(omegas)), args.pulse), option=option)
+                         pulse_of(shape, 1.0, float(min(omegas))), option=option)
 
 
 def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
@@ -319,8 +323,8 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
     results, walls = [], {}
     for name in names:
         t0 = time.perf_counter()
-        results.append(es.engine_spectrum(name, scene, spec, kind=args.pulse, workers=workers,
-                                          convergence=args.convergence,
+        results.append(es.engine_spectrum(name, scene, spec, kind=spec.settings.pulse,
+                                          workers=workers, convergence=args.convergence,
                                           **{**threshold_options(name),
                                              **file_options(loaded, name), **options}))
         walls[name] = time.perf_counter() - t0
@@ -336,7 +340,7 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
         timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
                    "engine_cpu_s": {r.engine: r.cost() for r in results},
                    "load_average": list(os.getloadavg()), "workers": workers}
-        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": args.pulse,
+        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": spec.settings.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
                   "convergence": args.convergence,

@@ -86,7 +86,7 @@ def model_validity(scene, omega: float, kind: str, amplitudes: dict, friction) -
     """The model's validity at each ``{where: amplitude}``: contact forces and
     friction (:func:`analytic.bounds.check_model`) and the bob's clearance."""
     from analytic.clearance import check_clearance
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from analytic.bounds import check_model
     from analytic.simulate import simulate
     out, seen = [], {}
@@ -96,7 +96,7 @@ def model_validity(scene, omega: float, kind: str, amplitudes: dict, friction) -
         if a in seen:  # the same amplitude under another name: one model run
             out.append({**seen[a], "where": where})
             continue
-        pulse = Pulse(float(a), omega, kind)
+        pulse = pulse_of(kind, float(a), omega)
         forces = check_model(scene, pulse, friction=friction)
         reasons = [forces["reason"]] if not forces["valid"] else []
         if scene.has_pendulum:
@@ -119,7 +119,10 @@ def _model_threshold(scene, omega, kind):
 def model_jump(scene, omega: float, kind: str, a_engine: float, tol: float) -> str | None:
     """A mode jump of the model within ``omega (1 +/- JUMP_REL)`` whose levels
     enclose ``a_engine`` (within ``tol``): where, located by bisection on the
-    model to ``JUMP_REL omega / 16``; None otherwise."""
+    model to ``JUMP_REL omega / 16``; None otherwise, and for the pulse shapes the
+    compiled search does not cover (Ricker, M-P: only sine and cosine)."""
+    if not _compiled(kind):
+        return None
     w = [omega * (1.0 - JUMP_REL), omega, omega * (1.0 + JUMP_REL)]
     th = [_model_threshold(scene, x, kind) for x in w]
     levels = [a for a, _ in th if math.isfinite(a)]
@@ -144,9 +147,12 @@ def model_jump(scene, omega: float, kind: str, a_engine: float, tol: float) -> s
 def model_island(scene, omega, point: ThresholdPoint, kind, n: int = 40) -> str | None:
     """Where the engine's threshold is above the model's: does the model survive
     somewhere in between (a safe island)?  ``n`` compiled verdicts (~0.1 ms each)
-    resolve islands down to ``(a_engine - a_reference) / n``."""
+    resolve islands down to ``(a_engine - a_reference) / n``; None for the shapes
+    the compiled kernels do not cover (Ricker, M-P)."""
     from analytic import fast
     from analytic.excitation import Pulse
+    if not _compiled(kind):
+        return None
     lo, hi = point.a_reference, point.a_engine
     if not hi > lo:
         return None
@@ -157,6 +163,12 @@ def model_island(scene, omega, point: ThresholdPoint, kind, n: int = 40) -> str 
     return (f"the model overturns in a window from A = {lo:.4g} m/s^2 and survives again at "
             f"{min(safe):.4g}-{max(safe):.4g} m/s^2 (a safe island); the engine's "
             f"first overturn {hi:.4g} is the next onset")
+
+
+def _compiled(kind) -> bool:
+    """True for the shapes of the compiled model (one-sine, one-cosine)."""
+    from analytic.excitation import PULSE_KINDS
+    return isinstance(kind, str) and kind in PULSE_KINDS
 
 
 def _iterations(settings) -> int | None:
@@ -195,9 +207,9 @@ _NOISE = {"pivot_sliding_max": 1e-5, "penetration_max": 1e-4, "lintel_rotation_m
 def contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
     """The diagnostic farthest beyond its noise level in a run at ``amplitude``
     (and the verdict's own reason when that run collapsed)."""
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from compare.run import runs
-    tr = runs.simulate(engine, scene, Pulse(amplitude, omega, kind),
+    tr = runs.simulate(engine, scene, pulse_of(kind, amplitude, omega),
                        configure(engine, settings, verdict_only=True))
     ratios = {k: (tr.diagnostics.get(k) or 0.0) / n for k, n in _NOISE.items()}
     key = max(ratios, key=ratios.get)
@@ -210,13 +222,13 @@ def contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
 def explain_isolated(engine, scene, omega, iso: dict, settings, kind) -> str:
     """What made an isolated overturn: the impact of a full run at its amplitude
     (same perturbation) whose restitution is farthest off Eq. 19/20."""
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from compare.measure.restitution import restitution_from_trajectory
     from compare.measure.thresholds import TILT
     from compare.run import runs
     extra = {"theta0": TILT} if iso.get("perturbation") == "tilt" else {}
     run = configure(engine, settings, verdict_only=False, **extra)
-    tr = runs.simulate(engine, scene, Pulse(iso["amplitude"], omega, kind), run)
+    tr = runs.simulate(engine, scene, pulse_of(kind, iso["amplitude"], omega), run)
     rows = [r for r in restitution_from_trajectory(tr, scene) if math.isfinite(r.rel_error)]
     if not rows:
         return f"full run {tr.verdict.status}; no impact measured before it"

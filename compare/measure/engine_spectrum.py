@@ -82,10 +82,10 @@ def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "
     bound of the largest pulse a bracket may try (a friction of None is the engine's
     own default for each run, which follows the same rule)."""
     from analytic.bounds import required_friction
-    from analytic.excitation import Pulse
+    from analytic.pulses import pulse_of
     from engines.base import FRICTION_MARGIN
     settings = configure(engine, **options)
-    need = FRICTION_MARGIN * required_friction(scene, Pulse(a_max, omega, kind))
+    need = FRICTION_MARGIN * required_friction(scene, pulse_of(kind, a_max, omega))
     if settings.friction is not None and settings.friction < need:
         settings = configure(engine, settings, friction=need)
     return settings
@@ -105,7 +105,9 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
         [rad/s], the model's threshold [m/s^2] and mode.
     case : str
         'pendulum' or 'no_pendulum', carried into the result.
-    kind : {'sine', 'cosine'}
+    kind : str or PulseShape
+        A name of :data:`analytic.pulses.PULSE_FAMILY` or a shape (M-P's gamma,
+        nu); the model's jump and island causes need the compiled sine/cosine.
     tol : float
         Agreement tolerance on the relative error (default 2 %).
     rel_tol : float

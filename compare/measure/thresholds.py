@@ -41,12 +41,12 @@ import math
 import time
 from dataclasses import dataclass
 
-from analytic.excitation import Pulse
+from analytic.pulses import pulse_of
 
 from compare.measure.trajectories import Provenance, settings_provenance
 
 __all__ = ["Probe", "ThresholdPoint", "Search", "SEARCH", "PERTURBATIONS", "engine_threshold",
-           "overturns"]
+           "overturns", "overturns_under"]
 
 # Relative amplitude step of the neighbours and the initial tilt [rad] of the
 # robustness check.  1e-4 is 1/50 of the 0.5 % bracket and 1/200 of the 2 %
@@ -96,19 +96,30 @@ class Probe:
 
 
 def overturns(backend: str, scene, omega: float, amplitude: float, settings=None,
-              kind: str = "sine") -> Probe:
-    """One run of ``backend`` under a pulse: its :class:`Probe`.
+              kind="sine") -> Probe:
+    """One run of ``backend`` under a pulse (``kind``: a name of
+    :data:`analytic.pulses.PULSE_FAMILY` or a :class:`~analytic.pulses.PulseShape`,
+    ``amplitude`` its peak acceleration): its :class:`Probe`."""
+    return overturns_under(backend, scene, pulse_of(kind, amplitude, omega), settings,
+                           amplitude)
+
+
+def overturns_under(backend: str, scene, motion, settings=None,
+                    value: float = math.nan, verdict_only: bool = True) -> Probe:
+    """One run of ``backend`` under any ground motion: its :class:`Probe`, whose
+    ``amplitude`` is ``value`` (the scale the search moves).
 
     'collapsed', 'unstable' and 'undecided' runs do not count as overturned.
-    The run stops as soon as the verdict is certain (``verdict_only``).
+    With ``verdict_only`` (default) the run stops as soon as the verdict is
+    certain; without it an overturn counts only once the columns have fallen.
     """
     from engines import configure
     from compare.run import runs
-    settings = configure(backend, settings, verdict_only=True)
+    settings = configure(backend, settings, verdict_only=verdict_only)
     hits = runs.STATS["hits"]
-    traj = runs.simulate(backend, scene, Pulse(amplitude, omega, kind), settings)
+    traj = runs.simulate(backend, scene, motion, settings)
     cpu = traj.diagnostics.get("cpu_time", math.nan)
-    return Probe(float(amplitude), traj.verdict.status, traj.verdict.mode, "",
+    return Probe(float(value), traj.verdict.status, traj.verdict.mode, "",
                  float(cpu) if cpu is not None else math.nan, runs.STATS["hits"] > hits,
                  float(traj.t[-1]) if len(traj.t) else 0.0)
 
@@ -231,8 +242,8 @@ class ThresholdPoint:
 class _Runs:
     """The probes of one search, in order, with the CPU time they cost here."""
 
-    def __init__(self, backend, scene, omega, settings, kind):
-        self.backend, self.scene, self.omega, self.kind = backend, scene, omega, kind
+    def __init__(self, backend, probe, settings):
+        self.backend, self.probe = backend, probe  # probe(value, settings) -> Probe
         self.settings, self._tilted = settings, None
         self.probes: list[Probe] = []
         self.nominal: dict[float, Probe] = {}
@@ -246,7 +257,7 @@ class _Runs:
                 self._tilted = configure(self.backend, self.settings, theta0=TILT)
             settings = self._tilted
         c0 = time.process_time()
-        p = overturns(self.backend, self.scene, self.omega, amplitude, settings, self.kind)
+        p = self.probe(amplitude, settings)
         self.spent += time.process_time() - c0
         p = dataclasses.replace(p, amplitude=float(amplitude), perturbation=perturbation)
         self.probes.append(p)
@@ -268,15 +279,17 @@ def _isolated(p: Probe, neighbours) -> dict:
 
 
 def engine_threshold(backend: str, scene, omega: float, a_reference: float, settings=None, *,
-                     kind: str = "sine", mode_reference: str | None = None,
-                     search: Search = SEARCH, **changes) -> ThresholdPoint:
+                     kind="sine", mode_reference: str | None = None,
+                     search: Search = SEARCH, motion=None, **changes) -> ThresholdPoint:
     """``backend``'s robust first-overturning bracket at ``omega`` around ``a_reference``.
 
     Parameters
     ----------
     backend, scene, omega, a_reference, settings, kind
         The engine, scene, pulse frequency [rad/s], the model's threshold
-        [m/s^2] (the bracket's centre), the engine's settings, the pulse kind.
+        [m/s^2] (the bracket's centre), the engine's settings, the pulse kind
+        (a name of :data:`analytic.pulses.PULSE_FAMILY` or a
+        :class:`~analytic.pulses.PulseShape`; its peak acceleration is searched).
     mode_reference : str, optional
         The model's overturning mode, carried into the result.
     search : Search
@@ -284,6 +297,15 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     **changes
         Fields of ``search`` to replace (``rel_tol`` alone also sets
         ``rel_bracket = 0.45 rel_tol``).
+    motion : callable, optional
+        ``motion(value) -> excitation``: search the scale ``value`` of any ground
+        motion instead of the pulse's amplitude (e.g. a record scaled to a PGA,
+        :func:`analytic.ida.scale_to`); ``a_reference`` is then the model's
+        value, ``omega`` only a label (NaN allowed) and ``kind`` ignored.  With a
+        fixed window (``settings.t_max``) an overturn counts only when the
+        columns fall inside it, as in the model's IDA
+        (:func:`analytic.ida.model_verdict`): the engines' monitor calls an
+        overturn certain before the fall, which may end after the window.
 
     Returns
     -------
@@ -301,7 +323,15 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     :data:`PERTURBATIONS` (module docstring); an overturning end that is not
     reproduced is isolated and the search continues above it.
     """
-    omega = _check_positive("omega", omega)
+    if motion is None:
+        omega = _check_positive("omega", omega)
+
+        def probe(a, run):
+            return overturns(backend, scene, omega, a, run, kind)
+    else:
+        def probe(a, run):
+            return overturns_under(backend, scene, motion(a), run, a,
+                                   verdict_only=run is None or run.t_max is None)
     a_ref = _check_positive("a_reference", a_reference)
     if "rel_tol" in changes and "rel_bracket" not in changes:
         changes["rel_bracket"] = 0.45 * changes["rel_tol"]
@@ -311,7 +341,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     if not 0.0 < s.rel_tol < 0.5:
         raise ValueError(f"rel_tol must be in (0, 0.5), got {s.rel_tol!r}")
     t0 = time.perf_counter()
-    r = _Runs(backend, scene, omega, settings, kind)
+    r = _Runs(backend, probe, settings)
     ok, lo, hi = _first_bracket(r, a_ref, s)
     isolated: list[dict] = []
     while ok:

@@ -188,6 +188,9 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              figs((d, "restitution per impact") for d in plots.restitution_figures(doc)),
              tables.table(tables.HEADERS["restitution"], tables.restitution_rows(doc)),
              "<h2>Run times</h2>", tables.table(tables.HEADERS["timings"], tables.timing_rows(doc))]
+    if doc.get("records"):  # trilith report --record
+        from compare.report.record_section import record_section_html
+        body += record_section_html(doc["records"])
     if doc["errors"]:
         body += ["<h2>Runs that raised</h2>", tables.table(tables.HEADERS["errors"], tables.error_rows(doc))]
     from compare.report.atlas_page import stored_atlas_section
@@ -219,12 +222,15 @@ def add_model_validity(doc: dict, scene, workers: int = 1) -> dict:
     return doc
 
 
-def write_report(result, out_dir, provenance: dict | None = None) -> dict[str, Path]:
+def write_report(result, out_dir, provenance: dict | None = None,
+                 extra: dict | None = None) -> dict[str, Path]:
     """Write ``index.html``, ``summary.json``, ``summary.md``, ``trust.csv`` and
     ``thresholds.csv`` into ``out_dir``.
 
     ``provenance``: :func:`compare.run.provenance.collect` (date, commit, command,
     versions, machine, ``quick``); collected here without a command when None.
+    ``extra``: more top-level keys of the summary (``records``: the section of
+    :mod:`compare.report.record_section`).
     """
     from compare.run.provenance import collect
 
@@ -234,6 +240,7 @@ def write_report(result, out_dir, provenance: dict | None = None) -> dict[str, P
         provenance = collect(backends=result.versions)
     doc = add_model_validity(summary_dict(result, provenance), result.scene,
                              max(1, int(result.config.workers or 1)))
+    doc.update(plain(extra or {}))
     alphas = {True: result.scene.alpha, False: result.scene.without_pendulum().alpha}
     paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md",
              "trust_csv": out / "trust.csv", "thresholds_csv": out / "thresholds.csv"}

@@ -134,7 +134,8 @@ def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, s
     monkeypatch.setattr(compare.campaign.validation, "run_campaign",
                         lambda config: SimpleNamespace(verdicts=verdicts, versions={}))
     monkeypatch.setattr(compare.report.html, "write_report",
-                        lambda result, out, provenance=None: {"html": Path(out) / "index.html"})
+                        lambda result, out, provenance=None, extra=None:
+                        {"html": Path(out) / "index.html"})
     argv = ["report", "--quick", "--out", str(tmp_path / "r")] + (["--strict"] if strict else [])
     assert main(argv) == (1 if strict else 0)
     out = capsys.readouterr().out

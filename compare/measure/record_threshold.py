@@ -1,0 +1,128 @@
+"""An engine's first overturning intensity of a ground motion, by the one robust
+threshold search.
+
+The model's intensity comes from the window-aware IDA
+(:func:`analytic.ida.first_overturn_intensity`).  An engine's is the robust
+bracket of :func:`compare.measure.thresholds.engine_threshold` with the motion
+scaled to each probed intensity (``motion=``): the same perturbation set as the
+pulse spectra (neighbours at ``1 +/- 1e-4`` of the intensity, an initial tilt of
+1e-6 rad one step further out), isolated overturns kept apart and never taken as
+the threshold.  The bracket is centred on the model's intensity (on ``im_hi``
+when the model never overturned up to it) and widened by doubling where the
+engine disagrees.
+
+Both backends run the same fixed window, ``t_max = end_time + tail``; every run
+goes through the run store.
+
+The result's ``im_overturn`` is the engine's robust overturning end; a record
+censored at ``im_hi`` when the engine robustly survives there (no robust
+overturn at or below ``im_hi``); ``bracketed`` False when the search found no
+robust bracket at all (a collapse above the model, or too many isolated
+overturns): such a record is listed, never given an intensity.
+
+Creep and drift over a whole record (``long_run``): the nominal run at the
+engine's highest robust survival (``im_safe``, or the highest intensity run when
+censored) is rerun over the whole window (no early stop: the model and the
+engines alike run to ``end_time + tail``, so the tilt left is a residual, not
+the rocking at the instant the verdict became certain), and its diagnostics
+(:mod:`engines.diagnostics`) tell what the engine accumulates over the record:
+``pivot_sliding_max`` [m] (a pivot creeping along the ground),
+``lintel_rotation_max`` [rad] (the lintel drifting off the columns' rigid
+motion), ``penetration_max`` [m], and the residual tilt ``|theta|`` at the
+window's end [rad] beside the model's at the same intensity.
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["engine_intensity"]
+
+
+def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
+                     options: dict | None = None) -> dict:
+    """The robust first overturning intensity of ``backend`` under ``motion``.
+
+    Parameters
+    ----------
+    backend : str
+        An engine name.
+    scene : Scene
+    motion : SampledRecord or any motion with ``scaled``, ``pga``, ``pgv``
+    st : analytic.ida.IDASettings
+        The intensity measure, ``im_hi`` (censoring) and ``tail`` (the window).
+    im_model : float or None
+        The model's first overturning intensity (None: censored at ``im_hi``).
+    options : dict, optional
+        Engine settings beside the window (:func:`engines.configure`, e.g. ``dt``).
+
+    Returns
+    -------
+    dict
+        ``label``, ``im``, ``im_overturn`` / ``im_safe`` (None when censored or
+        not bracketed), ``censored``, ``bracketed``, ``bracket`` (``[survives,
+        overturns]`` even above ``im_hi``), ``collapsed`` (intensities whose
+        nominal run ended 'collapsed': the frame broke), ``isolated`` (overturns not
+        reproduced by their perturbed neighbours), ``flips``, ``n_runs``,
+        ``cpu_s`` (CPU seconds of the runs when computed), ``im_reference``.
+    """
+    import engines
+    from analytic.ida import scale_to
+    from compare.measure.thresholds import engine_threshold
+
+    settings = engines.configure(backend, t_max=motion.end_time + st.tail, **(options or {}))
+    centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
+    p = engine_threshold(backend, scene, math.nan, centre, settings,
+                         motion=lambda v: scale_to(motion, st.im, v))
+    over = p.bracketed and p.a_engine <= st.im_hi
+    censored = p.bracketed and not over or (not p.bracketed and _survives_all(p, st.im_hi))
+    long_run = _long_run(backend, scene, motion, st, settings, p, over)
+    return {"label": getattr(motion, "label", type(motion).__name__), "im": st.im,
+            "im_overturn": p.a_engine if over else None,
+            "im_safe": p.a_survives if over else None,
+            "censored": bool(censored), "bracketed": bool(p.bracketed),
+            "bracket": [p.a_survives, p.a_engine] if p.bracketed else None,
+            "collapsed": [q.amplitude for q in p.probes
+                          if q.status == "collapsed" and not q.perturbation],
+            "isolated": list(p.isolated), "flips": [f.to_dict() for f in p.flips],
+            "n_runs": p.n_runs, "cpu_s": p.cpu_s, "im_reference": centre,
+            "islands": [], "long_run": long_run}
+
+
+def _long_run(backend, scene, motion, st, settings, p, over: bool) -> dict | None:
+    """The diagnostics of the nominal run at the highest robust survival (module
+    docstring), beside the model's residual tilt at the same intensity."""
+    import engines
+    from analytic.ida import scale_to
+    from analytic.simulate import Settings, simulate
+    from compare.run import runs
+
+    alive = [q.amplitude for q in p.probes if not q.perturbation and q.status == "survived"
+             and (not over or q.amplitude <= p.a_survives)]
+    if not alive:
+        return None
+    value = max(alive)
+    scaled = scale_to(motion, st.im, value)
+    tr = runs.simulate(backend, scene, scaled, engines.configure(
+        backend, settings, verdict_only=False, early_stop=False))
+    model = simulate(scene, scaled, Settings(t_max=settings.t_max, sample_dt=0.01,
+                                             early_stop=False))
+    d = tr.diagnostics
+    sim_s = float(tr.t[-1]) if len(tr.t) else 0.0
+    cpu = d.get("cpu_time")
+    return {"im_value": value, "status": tr.verdict.status, "t_end": sim_s,
+            "pivot_sliding_max": d.get("pivot_sliding_max"),
+            "lintel_rotation_max": d.get("lintel_rotation_max"),
+            "penetration_max": d.get("penetration_max"),
+            "residual_tilt": float(abs(tr.theta[-1])) if len(tr.theta) else None,
+            "model_status": model.verdict.status,
+            "model_residual_tilt": float(abs(model.theta[-1])) if len(model.theta) else None,
+            "cpu_s": cpu, "cpu_per_sim_s": cpu / sim_s if cpu and sim_s > 0 else None}
+
+
+def _survives_all(p, im_hi: float) -> bool:
+    """No bracket, but every nominal run up to ``im_hi`` and beyond survived: the
+    engine never overturned in the searched range (censored, as the model's
+    records that never overturn)."""
+    nominal = [q for q in p.probes if not q.perturbation]
+    return bool(nominal) and all(q.status == "survived" for q in nominal) and max(
+        q.amplitude for q in nominal) >= im_hi
