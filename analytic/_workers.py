@@ -9,11 +9,11 @@ what the work needs before any fork and measures what one item costs.
 
 Notes
 -----
-A worker forked from a process that has loaded everything costs about
-15 ms of CPU (fork, initializer, its share of the task traffic, exit) and
-about as much again in the parent; a worker that has to load the compiled
-kernels itself costs 0.5-0.6 s (numba's import and its cache load).  Measured
-by ``python -m benchmarks.bench_cli_cost`` (``pool_start_cpu_s``).
+A worker forked from a process that has loaded everything costs about 14 ms
+of CPU, its own and the parent's (fork, initializer, its share of the task
+traffic, exit: ``pool_start_cpu_s`` of ``python -m benchmarks.bench_cli_cost``,
+2 cores, load average 9); a worker that has to load the compiled kernels
+itself costs 0.5-0.6 s (numba's import and its cache load).
 """
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ __all__ = ["fork_pool", "init_worker", "pool_size", "map_measured", "POOL_START_
 
 # CPU seconds one forked worker adds (child and parent) when the parent has loaded
 # everything the work needs (module docstring, Notes).
-POOL_START_CPU_S = 0.03
+POOL_START_CPU_S = 0.015
 # A worker is started only for work worth this many times its start cost: the
 # pool then adds at most 1/PAYOFF to the CPU time while it divides the wall time.
 PAYOFF = 10.0
