@@ -28,16 +28,11 @@ from __future__ import annotations
 import io
 import math
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.ticker  # noqa: E402
-import numpy as np  # noqa: E402
-
-from analytic.threshold_validity import invalid_spans  # noqa: E402
-from compare.report import figure_cache  # noqa: E402
-from compare.report.trust import label  # noqa: E402
+from analytic.threshold_validity import invalid_spans
+from compare.report import figure_cache
+from compare.report.trust import label
 
 __all__ = ["spectra_figures", "convergence_figure", "history_figures", "restitution_figures",
            "shade_invalid", "color", "marker", "DPI", "WIDTH"]
@@ -69,10 +64,19 @@ _RC = {"font.size": 9, "axes.titlesize": 9.5, "axes.labelsize": 9, "xtick.labels
 _CASES = {"pendulum": "with pendulum", "no_pendulum": "without pendulum"}
 
 
+def _pyplot():
+    """matplotlib's pyplot on the Agg backend, imported by the first figure drawn
+    (0.3-0.5 CPU s): a report whose figures all come from the store never needs it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
 def _png(fig) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
+    _pyplot().close(fig)
     return buf.getvalue()
 
 
@@ -84,7 +88,7 @@ def _figure(name: str, data: dict, draw) -> str:
     """``draw(data)`` (a Figure) as a base64 PNG, through the figure cache; drawn
     and saved under the report's type sizes (ticks are laid out when saved)."""
     def render() -> bytes:
-        with plt.rc_context(_RC):
+        with _pyplot().rc_context(_RC):
             return _png(draw(data))
     return figure_cache.png_base64(name, data, _OPTIONS, render)
 
@@ -133,7 +137,7 @@ def _spectrum_data(doc: dict, case: str) -> dict:
 
 def _draw_spectrum(d: dict):
     tol = d["tol"]
-    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
+    fig, (top, bot) = _pyplot().subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
                                    gridspec_kw={"height_ratios": [2, 1.2]})
     w, a = d["omega"], d["a"]
     if d["valid"]:
@@ -219,7 +223,7 @@ def convergence_figure(doc: dict) -> str | None:
 
 def _draw_convergence(d: dict):
     tol = d["tol"]
-    fig, ax = plt.subplots(figsize=(WIDTH, 3.4))
+    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.4))
     ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
     ax.axhline(0.0, color="0.5", lw=0.6)
     for s in d["series"]:
@@ -265,7 +269,7 @@ def _history_data(histories: dict, point: str, pend: bool, alpha: float, referen
 
 
 def _draw_history(d: dict):
-    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 4.6), sharex=True,
+    fig, (top, bot) = _pyplot().subplots(2, 1, figsize=(WIDTH, 4.6), sharex=True,
                                    gridspec_kw={"height_ratios": [1.5, 1]})
     for line in d["lines"]:
         is_ref = line["reference"]
@@ -317,7 +321,7 @@ def _restitution_data(doc: dict, pend: bool, title: str, key: str) -> dict:
 
 
 def _draw_restitution(d: dict):
-    fig, ax = plt.subplots(figsize=(WIDTH, 3.2))
+    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.2))
     tol = d["tol"]
     ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} %")
     ax.axhline(0.0, color="0.5", lw=0.6)
@@ -328,7 +332,8 @@ def _draw_restitution(d: dict):
                 color=r["color"], label=r["label"] if r["name"] not in seen else None)
         seen.add(r["name"])
     ax.set_title(d["title"])
-    ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+    from matplotlib.ticker import MaxNLocator
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("impact number")
     ax.set_ylabel("measured / predicted − 1 [%]")
     ax.legend()
