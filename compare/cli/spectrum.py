@@ -113,14 +113,14 @@ def _local_map(payloads, workers: int):
     """:func:`_cached_frequency` of every payload, yielded in order (see :func:`_map_fn`)."""
     import time
 
-    from analytic import fast
     from analytic._workers import pool_size
     from compare.run import runs
 
     found = [_stored_frequency(p) for p in payloads]
     todo = [i for i, f in enumerate(found) if f is None]
     computed = iter(())
-    if todo:
+    if todo:  # (only then numba: a rerun the store serves whole never loads it)
+        from analytic import fast
         fast.warm_up(record=False)
         first = max(todo, key=lambda i: payloads[i][2])
         t0 = time.process_time()
