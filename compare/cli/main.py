@@ -9,7 +9,7 @@ full or closed stdout).  A pipe whose reader went away
 Called as the ``trilith`` program (``argv`` None), :func:`main` ends by freezing
 the garbage collector (:func:`gc.freeze`): the interpreter's shutdown then
 skips scanning the objects numba, scipy and matplotlib created, which took
-0.3 CPU s after a spectrum (benchmarks/bench_cli_cost.py).  Every output is
+0.3 CPU s after a spectrum (docs/benchmarks.md, "Fixed costs").  Every output is
 written and closed before; the operating system frees the memory.
 """
 from __future__ import annotations
