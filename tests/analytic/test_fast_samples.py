@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from analytic import _fast_steps, reactions
+from analytic import _fast_steps, fast, reactions
 from analytic.excitation import Pulse
 from analytic.simulate import simulate
 from scenes import load_scene
@@ -50,6 +50,9 @@ def test_validity_is_the_same_with_and_without_the_compiled_path(monkeypatch):
     tr, (t, th, thd, ps, psd) = _samples(scene, Pulse(74.9, 26.0))
     call = (t, th, thd, ps, psd, tr.excitation, scene.model_args(), scene.alpha,
             tr.verdict.status == "overturned")
+    fast.warm_up(record=False)  # what a spectrum does first
+    assert reactions._compiled_accelerations() is not None
     with_kernels = reactions.validity_diagnostics(*call)
-    monkeypatch.delitem(sys.modules, "analytic._fast_steps")
+    monkeypatch.delitem(sys.modules, "analytic._fast_kernels")  # a process without them
+    assert reactions._compiled_accelerations() is None
     assert reactions.validity_diagnostics(*call) == with_kernels
