@@ -1,7 +1,7 @@
 """Report figures kept by the data they plot (compare/report/figure_cache.py):
 drawn once per distinct data, options and drawing code, stored as PNG bytes in
 the run store's data format, and a report rebuilt from the same results draws
-nothing."""
+nothing (nor reruns the model's validity checks)."""
 from __future__ import annotations
 
 import base64
@@ -73,14 +73,19 @@ def test_a_rebuilt_report_draws_no_figure(store, tmp_path, monkeypatch):
 
     from compare.report.html import write_report
 
-    drawn = []
-    real_png = plots._png
+    from analytic import threshold_validity
+
+    drawn, checked = [], []
+    real_png, real_check = plots._png, threshold_validity.curve_validity
     monkeypatch.setattr(plots, "_png", lambda fig: drawn.append(1) or real_png(fig))
+    monkeypatch.setattr(threshold_validity, "curve_validity",
+                        lambda *a, **k: checked.append(1) or real_check(*a, **k))
     result = synthetic_result()
     write_report(result, tmp_path / "cold", {})
-    cold = len(drawn)
-    assert cold >= 5  # spectra, convergence, histories, restitution
+    cold, cold_checks = len(drawn), len(checked)
+    assert cold >= 5 and cold_checks  # spectra, convergence, histories, restitution
     write_report(result, tmp_path / "warm", {})
     assert len(drawn) == cold, "a figure of unchanged data was drawn again"
+    assert len(checked) == cold_checks, "the model's validity was checked again"
     assert ((tmp_path / "warm" / "index.html").read_text()
             == (tmp_path / "cold" / "index.html").read_text())
