@@ -37,7 +37,7 @@ TARGET_WARM_RATIO = 0.05  # warm / cold CPU seconds of report --quick (see the m
 
 # What differs between two correct reports: what they cost, and when and how
 # they were run (the provenance holds the date and the command line).
-_NOT_RESULTS = ("timings", "wall_time", "provenance", "cost", "from_store")
+_NOT_RESULTS = ("timings", "wall_time", "provenance", "cost", "from_store", "cpu_s_spent")
 _COST_SENTENCE = re.compile(r" One run costs .*? \(wall time on the measuring machine\)\."
                             r"|; \d+ of \d+ points were served by the run store")
 
