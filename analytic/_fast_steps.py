@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from . import _numba_cache  # noqa: F401  (drops stale machine code before numba loads it)
@@ -26,6 +27,24 @@ _impact = njit(cache=True)(_eq.impact_velocities)
 _energy = njit(cache=True)(_eq.energy)
 _rest_energy = njit(cache=True)(_eq.rest_energy)
 _barrier = njit(cache=True)(_eq.overturn_energy_barrier)
+
+
+
+@njit(cache=True)
+def sample_accelerations(theta, theta_dot, psi, psi_dot, xg, sides, b, h, mu, gamma, j, l, g):
+    """``(theta_ddot, psi_ddot)`` at every sample, as rows of an ``(n, 2)`` array:
+    Eq. 8 / A.1 where ``sides`` is +1 / -1, Eq. 1 where it is 0 (rest; 0 without
+    a pendulum).  The same numbers, bit for bit, as
+    :func:`analytic.reactions._accelerations` sample by sample."""
+    out = np.zeros((theta.shape[0], 2))
+    for i in range(theta.shape[0]):
+        if sides[i] != 0.0:
+            out[i, 0], out[i, 1] = _rock(theta[i], theta_dot[i], psi[i], psi_dot[i], xg[i],
+                                         sides[i], b, h, mu, gamma, j, l, g)
+        elif gamma > 0.0:
+            out[i, 1] = _rest_acc(psi[i], xg[i], l, g)
+    return out
+
 
 # Pulse kinds (Eq. 22 / Eq. 23); analytic.fast maps the names onto them.
 KIND_SINE, KIND_COSINE = 0, 1

@@ -1,7 +1,20 @@
 """Local worker processes for parallel maps (spectra, overturn maps, the run store's
 ``compare.run.runs.run_many``): forked, so they inherit the loaded kernels and engines;
 deaf to Ctrl-C, which the parent handles; dead with their parent, even after a
-``kill -9`` of it; and killed at once when the caller stops early."""
+``kill -9`` of it; and killed at once when the caller stops early.
+
+Workers are started only when the work pays for them (:func:`pool_size`):
+:func:`map_measured` runs the first item in the calling process, which loads
+what the work needs before any fork and measures what one item costs.
+
+Notes
+-----
+A worker forked from a process that has loaded everything costs about 14 ms
+of CPU, its own and the parent's (fork, initializer, its share of the task
+traffic, exit: ``pool_start_cpu_s`` of ``python -m benchmarks.bench_cli_cost``,
+2 cores, load average 9); a worker that has to load the compiled kernels
+itself costs 0.5-0.6 s (numba's import and its cache load).
+"""
 from __future__ import annotations
 
 import contextlib
@@ -11,9 +24,17 @@ import signal
 import sys
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
-__all__ = ["fork_pool", "init_worker"]
+__all__ = ["fork_pool", "init_worker", "pool_size", "map_measured", "POOL_START_CPU_S",
+           "PAYOFF"]
+
+# CPU seconds one forked worker adds (child and parent) when the parent has loaded
+# everything the work needs (module docstring, Notes).
+POOL_START_CPU_S = 0.015
+# A worker is started only for work worth this many times its start cost: the
+# pool then adds at most 1/PAYOFF to the CPU time while it divides the wall time.
+PAYOFF = 10.0
 
 
 def _die_with_parent(parent_pid: int) -> None:
@@ -78,3 +99,71 @@ def fork_pool(workers: int):
             ex.shutdown(wait=False, cancel_futures=True)
             for proc in procs:
                 proc.join(timeout=1.0)
+
+
+def pool_size(n_items: int, item_cpu_s: float, requested: int) -> int:
+    """How many processes ``n_items`` items of ``item_cpu_s`` CPU seconds each are worth.
+
+    ``w = floor(n_items * item_cpu_s / (PAYOFF * POOL_START_CPU_S))``, clipped to
+    ``[1, min(requested, n_items)]``: each worker must take over at least
+    ``PAYOFF`` times the CPU its start costs (:data:`POOL_START_CPU_S`), so the
+    pool costs at most ``1/PAYOFF`` more CPU than one process would.  1 means
+    no pool.  The number of workers never changes a result (callers place
+    results by index).
+    """
+    if n_items <= 1 or requested <= 1:
+        return 1
+    work, start = n_items * max(item_cpu_s, 0.0), PAYOFF * POOL_START_CPU_S
+    worth = n_items if start <= 0.0 else int(work / start)
+    return max(1, min(requested, n_items, worth))
+
+
+def map_measured(fn, items, workers: int, *, on_done=None) -> list:
+    """``[fn(item) for item in items]``, in parallel when the work pays for it.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function of one item (it is sent to forked workers).
+    items : sequence
+        In the order to run them; put the costliest first (e.g. the highest
+        frequency of a spectrum).  ``items[0]`` runs here, before any fork: it
+        loads whatever ``fn`` needs (compiled kernels, scipy), so the workers
+        inherit it, and its CPU time is the cost per item that
+        :func:`pool_size` turns into a number of workers (the costliest item
+        makes that estimate err towards more workers; loading the caller did
+        not do beforehand counts as cost too).
+    workers : int
+        The most processes to use (>= 1).
+    on_done : callable, optional
+        ``on_done(index, result)`` as each item finishes (in completion order).
+
+    Returns
+    -------
+    list
+        The results in the order of ``items``, whatever the number of workers.
+    """
+    items = list(items)
+    out: list = [None] * len(items)
+    if not items:
+        return out
+    t0 = time.process_time()
+    out[0] = fn(items[0])
+    cost = time.process_time() - t0
+    if on_done is not None:
+        on_done(0, out[0])
+    n = pool_size(len(items) - 1, cost, workers)
+    if n == 1:
+        for i in range(1, len(items)):
+            out[i] = fn(items[i])
+            if on_done is not None:
+                on_done(i, out[i])
+        return out
+    with fork_pool(n) as ex:
+        futures = {ex.submit(fn, items[i]): i for i in range(1, len(items))}
+        for fut in as_completed(futures):
+            i = futures[fut]
+            out[i] = fut.result()
+            if on_done is not None:
+                on_done(i, out[i])
+    return out

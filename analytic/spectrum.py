@@ -17,12 +17,11 @@ from __future__ import annotations
 import functools
 import math
 import time
-from concurrent.futures import as_completed
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._workers import fork_pool
+from ._workers import map_measured
 from .first_overturn import (METHODS, SEARCH_ATOL, SEARCH_RTOL, SpectrumSettings,
                              first_overturn_amplitude, search_run_settings)
 from .parameters import Scene
@@ -160,7 +159,10 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
         Pulse frequencies [rad/s], each in (0, 1e4].
     settings : SpectrumSettings, optional
     workers : int
-        Processes (fork); results are ordered as ``omegas`` whatever the count.
+        The most processes (fork) to use: the highest frequency runs here first
+        and :func:`analytic._workers.pool_size` decides from its CPU time how
+        many workers the rest is worth.  Results are ordered as ``omegas`` and
+        identical whatever the count.
     progress : bool
         Show a tqdm bar (on stderr, only once the run has lasted 1 s).
     map_fn : callable, optional
@@ -198,24 +200,18 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
                 results.append(res)
                 if bar is not None:
                     bar.update(1)
-        elif workers == 1 or w.size == 1:
-            for omega in w:
-                results.append(_one_frequency(float(omega)))
-                if bar is not None:
-                    bar.update(1)
         else:
-            # Highest frequencies first: they scan the most amplitudes, and starting
-            # with them keeps both workers busy to the end.  Results are placed by
-            # index, so the order (and every number) is the same for any count.
+            # Highest frequencies first: they scan the most amplitudes, so the one
+            # run here before any fork is the costliest (map_measured decides the
+            # workers from it) and the workers stay busy to the end.  Results are
+            # placed by index, so the order (and every number) is the same for
+            # any count.
             order = np.argsort(-w, kind="stable")
-            slots: list = [None] * int(w.size)
-            with fork_pool(min(workers, int(w.size))) as ex:
-                futures = {ex.submit(_one_frequency, float(w[i])): int(i) for i in order}
-                for fut in as_completed(futures):
-                    slots[futures[fut]] = fut.result()
-                    if bar is not None:
-                        bar.update(1)
-            results = slots
+            done = map_measured(_one_frequency, [float(w[i]) for i in order], workers,
+                                on_done=None if bar is None else (lambda i, r: bar.update(1)))
+            results = [None] * int(w.size)
+            for k, i in enumerate(order):
+                results[int(i)] = done[k]
     finally:
         if bar is not None:
             bar.close()

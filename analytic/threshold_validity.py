@@ -22,11 +22,10 @@ who knows a coefficient.
 from __future__ import annotations
 
 import math
-from concurrent.futures import as_completed
 
 import numpy as np
 
-from ._workers import fork_pool
+from ._workers import map_measured
 from .clearance import check_clearance
 from .contact_forces import violations
 from .parameters import Scene
@@ -77,12 +76,34 @@ def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "si
             "bob_min_clearance": clear["min_clearance"], "model_reason": "; ".join(reasons)}
 
 
-_JOB: dict = {}
+def _job_validity(job: tuple) -> dict:
+    return point_validity(*job)
 
 
-def _one(i: int) -> tuple[int, dict]:
-    scene, omegas, amps, kind = _JOB["args"]
-    return i, point_validity(scene, amps[i], omegas[i], kind)
+def _many_validity(jobs: list[tuple], workers: int) -> list[dict]:
+    """:func:`point_validity` of every ``(scene, amplitude, omega, kind)``, in
+    order; the checked ones in one :func:`analytic._workers.map_measured`."""
+    from . import simulate  # noqa: F401 - loaded once here, inherited by forked workers
+
+    todo = [k for k, job in enumerate(jobs) if math.isfinite(job[1])]
+    out: list = [point_validity(jobs[0][0], math.nan, 0.0)] * len(jobs) if jobs else []
+    for k, res in zip(todo, map_measured(_job_validity, [jobs[k] for k in todo], workers)):
+        out[k] = res
+    return out
+
+
+def _jobs(scene: Scene, omegas, amplitudes, kind: str) -> list[tuple]:
+    w = [float(x) for x in np.atleast_1d(omegas)]
+    a = [math.nan if x is None else float(x) for x in np.atleast_1d(amplitudes)]
+    if len(w) != len(a):
+        raise ValueError(f"omegas and amplitudes must have equal lengths, got {len(w)} "
+                         f"and {len(a)}")
+    return [(scene, a[i], w[i], kind) for i in range(len(w))]
+
+
+def _check_workers(workers) -> None:
+    if not (isinstance(workers, int) and 1 <= workers <= 256):
+        raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
 
 
 def curve_validity(scene: Scene, omegas, amplitudes, kind: str = "sine",
@@ -97,43 +118,29 @@ def curve_validity(scene: Scene, omegas, amplitudes, kind: str = "sine",
         Equal lengths; amplitudes [m/s^2] may be NaN/None (point left unchecked).
     kind : {'sine', 'cosine'}
     workers : int
-        Forked processes, in [1, 256] (one accurate run per point, ~0.05-0.5 s).
+        The most forked processes, in [1, 256] (one accurate run per point,
+        ~0.05-0.5 s): :func:`analytic._workers.map_measured` runs the first
+        point here and starts the workers the rest is worth.
     """
-    w = [float(x) for x in np.atleast_1d(omegas)]
-    a = [math.nan if x is None else float(x) for x in np.atleast_1d(amplitudes)]
-    if len(w) != len(a):
-        raise ValueError(f"omegas and amplitudes must have equal lengths, got {len(w)} "
-                         f"and {len(a)}")
-    if not (isinstance(workers, int) and 1 <= workers <= 256):
-        raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
-    _JOB["args"] = (scene, w, a, kind)
-    try:
-        todo = [i for i in range(len(w)) if math.isfinite(a[i])]
-        out: list = [point_validity(scene, math.nan, 0.0)] * len(w)
-        if workers == 1 or len(todo) <= 1:
-            for i in todo:
-                out[i] = _one(i)[1]
-        else:
-            with fork_pool(min(workers, len(todo))) as ex:
-                for fut in as_completed([ex.submit(_one, i) for i in todo]):
-                    i, res = fut.result()
-                    out[i] = res
-    finally:
-        _JOB.clear()
-    return out
+    jobs = _jobs(scene, omegas, amplitudes, kind)
+    _check_workers(workers)
+    return _many_validity(jobs, workers)
 
 
 def spectrum_validity(spectrum, workers: int = 1) -> dict[str, list[dict]]:
     """Both curves of an :class:`analytic.spectrum.Spectrum`:
     ``{"no_pendulum": [...], "pendulum": [...]}``, one :func:`point_validity`
     per frequency, each checked on its own scene (the no-pendulum curve on
-    ``scene.without_pendulum()``)."""
+    ``scene.without_pendulum()``); both curves share one set of workers."""
+    _check_workers(workers)
     sc, kind = spectrum.scene, spectrum.settings.pulse
-    out = {"no_pendulum": curve_validity(sc.without_pendulum(), spectrum.omega,
-                                         spectrum.a_no_pendulum, kind, workers)}
-    out["pendulum"] = (out["no_pendulum"] if sc.gamma == 0.0 else
-                       curve_validity(sc, spectrum.omega, spectrum.a_pendulum, kind, workers))
-    return out
+    jobs = _jobs(sc.without_pendulum(), spectrum.omega, spectrum.a_no_pendulum, kind)
+    if sc.gamma != 0.0:
+        jobs += _jobs(sc, spectrum.omega, spectrum.a_pendulum, kind)
+    checked = _many_validity(jobs, workers)
+    n = len(spectrum.omega)
+    return {"no_pendulum": checked[:n], "pendulum": checked[n:] if n < len(checked)
+            else checked[:n]}
 
 
 def invalid_spans(omegas, valid, step: float | None = None) -> list[tuple[float, float]]:

@@ -5,11 +5,18 @@ its allowed range, exit code 2 (argparse's convention), never a traceback; so
 does an output that cannot be written (a full disk, a read-only filesystem, a
 full or closed stdout).  A pipe whose reader went away
 (``trilith ... --json | head``) ends quietly with exit code 1.
+
+Called as the ``trilith`` program (``argv`` None), :func:`main` ends by freezing
+the garbage collector (:func:`gc.freeze`): the interpreter's shutdown then
+skips scanning the objects numba, scipy and matplotlib created, which took
+0.3 CPU s after a spectrum (docs/benchmarks.md, "Fixed costs").  Every output is
+written and closed before; the operating system frees the memory.
 """
 from __future__ import annotations
 
 import argparse
 import errno
+import gc
 import importlib
 import os
 import re
@@ -128,6 +135,16 @@ def _stdout_open() -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``trilith`` command line ``argv`` (default ``sys.argv[1:]``);
+    returns the exit code."""
+    try:
+        return _main(argv)
+    finally:
+        if argv is None:  # the program itself: nothing runs after this but the exit
+            gc.freeze()
+
+
+def _main(argv: list[str] | None) -> int:
     if not _stdout_open():
         print("error: standard output is closed; redirect it to a file or /dev/null",
               file=sys.stderr)

@@ -88,18 +88,51 @@ def _stored_frequency(payload):
     return runs.lookup("spectrum-point", {**description, "omega": omega})
 
 
-def _map_fn(scene, settings, workers: int):
+def _map_fn(scene, settings, workers: int, scheduler: str | None):
     """``map_fn`` for :func:`analytic.spectrum.overturning_spectrum`: each frequency
-    through the store, on local processes or the ``--scheduler`` cluster."""
+    through the store, on local processes or the ``--scheduler`` cluster.
+
+    Locally, what the store holds is read here; of the rest, the highest
+    frequency is computed here first (after the kernels are loaded, so forked
+    workers inherit them) and its CPU time decides how many workers the others
+    are worth (:func:`analytic._workers.pool_size`)."""
     from compare.run import runs
     from compare.run.keys import scene_dict
 
     description = {"scene": scene_dict(scene), "settings": settings.describe()}
 
     def map_fn(fn, omegas):
-        return runs.run_many(_cached_frequency, [(fn, description, w) for w in omegas],
-                             workers=workers, lookup=_stored_frequency)
+        payloads = [(fn, description, w) for w in omegas]
+        if scheduler is not None:
+            yield from runs.run_many(_cached_frequency, payloads, workers=workers,
+                                     lookup=_stored_frequency)
+            return
+        yield from _local_map(payloads, workers)
     return map_fn
+
+
+def _local_map(payloads, workers: int):
+    """:func:`_cached_frequency` of every payload, yielded in order (see :func:`_map_fn`)."""
+    import time
+
+    from analytic._workers import pool_size
+    from compare.run import runs
+
+    found = [_stored_frequency(p) for p in payloads]
+    todo = [i for i, f in enumerate(found) if f is None]
+    computed = iter(())
+    if todo:  # (only then numba: a rerun the store serves whole never loads it)
+        from analytic import fast
+        fast.warm_up(record=False)
+        first = max(todo, key=lambda i: payloads[i][2])
+        t0 = time.process_time()
+        found[first] = _cached_frequency(payloads[first])
+        cost = time.process_time() - t0
+        rest = [payloads[i] for i in todo if i != first]
+        computed = runs.run_many(_cached_frequency, rest,
+                                 workers=pool_size(len(rest), cost, workers))
+    for value in found:
+        yield next(computed) if value is None else value
 
 
 def _settings(args: argparse.Namespace):
@@ -199,7 +232,7 @@ def run(args: argparse.Namespace) -> int:
     _check_engine_budget(args, engines_wanted, omegas, settings.pulse, loaded)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
-                                map_fn=_map_fn(scene, settings, workers))
+                                map_fn=_map_fn(scene, settings, workers, args.scheduler))
     if engines_wanted:
         return _run_engines(args, scene, spec, engines_wanted, workers, loaded)
     from analytic.threshold_validity import spectrum_validity

@@ -213,12 +213,19 @@ def add_model_validity(doc: dict, scene, workers: int = 1) -> dict:
     ``omega``; :func:`analytic.threshold_validity.point_validity`), unless the
     summary already carries it.  The campaign's pulses are one-sine (Eq. 22)."""
     from analytic.threshold_validity import curve_validity
+    from compare.run import runs
+    from compare.run.keys import scene_dict
 
     scenes = {"pendulum": scene, "no_pendulum": scene.without_pendulum()}
     for case, spec in doc.get("spectra", {}).items():
         if case in scenes and "model_validity" not in spec:
-            spec["model_validity"] = plain(curve_validity(
-                scenes[case], spec["omega"], spec["a"], "sine", workers))
+            sc = scenes[case]
+            # Kept in the active run store: a report rebuilt from stored runs
+            # reruns none of these accurate runs.
+            spec["model_validity"] = plain(runs.memo(
+                "curve-validity", {"scene": scene_dict(sc), "omega": spec["omega"],
+                                   "a": spec["a"], "kind": "sine"},
+                lambda: curve_validity(sc, spec["omega"], spec["a"], "sine", workers)))
     return doc
 
 

@@ -17,23 +17,23 @@ guessed from overlapping curves:
 Sizes: one case per figure, 5 in wide at :data:`DPI` (1000 px); the page sets
 two side by side in its 1100 px column (text about 13 px on screen) and one
 above the other on a phone (about 9 px at 390 px).
+
+Each figure is drawn in two steps: the data it plots is gathered first (plain
+numbers, lists and arrays, the backends' labels and styles included), then a
+``_draw_*`` function draws only that.  The PNG is kept in the run store under a
+key of that data (:mod:`compare.report.figure_cache`), so a report rebuilt from
+stored runs redraws nothing.
 """
 from __future__ import annotations
 
-import base64
-import functools
 import io
 import math
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.ticker  # noqa: E402
-import numpy as np  # noqa: E402
-
-from analytic.threshold_validity import invalid_spans  # noqa: E402
-from compare.report.trust import label  # noqa: E402
+from analytic.threshold_validity import invalid_spans
+from compare.report import figure_cache
+from compare.report.trust import label
 
 __all__ = ["spectra_figures", "convergence_figure", "convergence_axes", "history_figures",
            "restitution_figures", "shade_invalid", "color", "marker", "DPI", "WIDTH"]
@@ -65,20 +65,38 @@ _RC = {"font.size": 9, "axes.titlesize": 9.5, "axes.labelsize": 9, "xtick.labels
 _CASES = {"pendulum": "with pendulum", "no_pendulum": "without pendulum"}
 
 
-def _styled(fn):
-    """Draw under the report's type sizes."""
-    @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
-        with plt.rc_context(_RC):
-            return fn(*args, **kwargs)
-    return wrapper
+def _pyplot():
+    """matplotlib's pyplot on the Agg backend, imported by the first figure drawn
+    (0.3-0.5 CPU s): a report whose figures all come from the store never needs it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
 
 
-def _png(fig) -> str:
+def _png(fig) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
+    _pyplot().close(fig)
+    return buf.getvalue()
+
+
+# Everything besides the data and this module's code that changes a figure.
+_OPTIONS = {"dpi": DPI, "width": WIDTH, "rc": _RC, "format": "png", "bbox": "tight"}
+
+
+def _figure(name: str, data: dict, draw) -> str:
+    """``draw(data)`` (a Figure) as a base64 PNG, through the figure cache; drawn
+    and saved under the report's type sizes (ticks are laid out when saved)."""
+    def render() -> bytes:
+        with _pyplot().rc_context(_RC):
+            return _png(draw(data))
+    return figure_cache.png_base64(name, data, _OPTIONS, render)
+
+
+def _style_of(name: str) -> dict:
+    """What a backend's points look like: its label, colour and marker."""
+    return {"name": name, "label": label(name), "color": color(name), "marker": marker(name)}
 
 
 def _arr(values) -> np.ndarray:
@@ -103,33 +121,43 @@ def shade_invalid(axes, omega, valid, label_it: bool = True) -> bool:
     return bool(spans)
 
 
-@_styled
-def _spectrum_case(doc: dict, case: str) -> str:
+def _spectrum_data(doc: dict, case: str) -> dict:
     spec = doc["spectra"][case]
-    tol = 100.0 * doc["config"]["tolerances"]["threshold"]
-    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
-                                   gridspec_kw={"height_ratios": [2, 1.2]})
-    w, a = _arr(spec["omega"]), _arr(spec["a"])
     validity = spec.get("model_validity")
-    if validity:
-        shade_invalid((top, bot), w, [v.get("model_valid") for v in validity])
-    for jp in spec.get("jumps", []):  # no line across a jump: the curve is discontinuous
-        i = int(np.searchsorted(w, jp["omega_hi"]))
+    return {"title": _CASES.get(case, case),
+            "tol": 100.0 * doc["config"]["tolerances"]["threshold"],
+            "omega": _arr(spec["omega"]), "a": _arr(spec["a"]),
+            "valid": [v.get("model_valid") for v in validity] if validity else None,
+            "breaks": [jp["omega_hi"] for jp in spec.get("jumps", [])],
+            "jumps": _jump_omegas(spec),
+            "engines": [{**_style_of(name), "omega": _arr([p["omega"] for p in pts]),
+                         "a": _arr([p["a_engine"] for p in pts]),
+                         "error": 100.0 * _arr([p["rel_error"] for p in pts])}
+                        for name, pts in spec.get("engines", {}).items()]}
+
+
+def _draw_spectrum(d: dict):
+    tol = d["tol"]
+    fig, (top, bot) = _pyplot().subplots(2, 1, figsize=(WIDTH, 5.0), sharex=True,
+                                   gridspec_kw={"height_ratios": [2, 1.2]})
+    w, a = d["omega"], d["a"]
+    if d["valid"]:
+        shade_invalid((top, bot), w, d["valid"])
+    for hi in d["breaks"]:  # no line across a jump: the curve is discontinuous
+        i = int(np.searchsorted(w, hi))
         w, a = np.insert(w, i, np.nan), np.insert(a, i, np.nan)
     top.plot(w, a, "k-", lw=1.0, label="model")
     bot.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} % tolerance")
     bot.axhline(0.0, color="0.5", lw=0.6)
-    for name, pts in spec.get("engines", {}).items():
-        style = dict(color=color(name), marker=marker(name), ls="none",
-                     mfc="none", ms=6)
-        top.plot([p["omega"] for p in pts], _arr([p["a_engine"] for p in pts]),
-                 label=label(name), **style)
-        bot.plot([p["omega"] for p in pts], 100.0 * _arr([p["rel_error"] for p in pts]), **style)
-    for k, wj in enumerate(_jump_omegas(spec)):
+    for eng in d["engines"]:
+        style = dict(color=eng["color"], marker=eng["marker"], ls="none", mfc="none", ms=6)
+        top.plot(eng["omega"], eng["a"], label=eng["label"], **style)
+        bot.plot(eng["omega"], eng["error"], **style)
+    for k, wj in enumerate(d["jumps"]):
         for ax in (top, bot):
             ax.axvline(wj, color="tab:red", lw=0.8, ls=":",
                        label="mode jump" if (k == 0 and ax is top) else None)
-    top.set_title(_CASES.get(case, case), loc="left")
+    top.set_title(d["title"], loc="left")
     top.set_ylabel("first overturning A [m/s²]")
     g_axis = top.secondary_yaxis("right", functions=(lambda x: x / 9.80665,
                                                      lambda x: x * 9.80665))
@@ -139,9 +167,7 @@ def _spectrum_case(doc: dict, case: str) -> str:
     hz = top.secondary_xaxis("top", functions=(lambda x: x / (2 * math.pi),
                                                lambda x: x * 2 * math.pi))
     hz.set_xlabel("f = Ω/2π [Hz]")
-    lim = max([2.0 * tol] + [abs(v) * 1.2 for v in
-                             100.0 * _arr([p["rel_error"] for pts in
-                                           spec.get("engines", {}).values() for p in pts])
+    lim = max([2.0 * tol] + [abs(v) * 1.2 for eng in d["engines"] for v in eng["error"]
                              if math.isfinite(v)])
     bot.set_ylim(-lim, lim)
     # One legend, on the spectrum's empty upper left: the error panel's points
@@ -150,15 +176,15 @@ def _spectrum_case(doc: dict, case: str) -> str:
     extra = bot.get_legend_handles_labels()
     top.legend(handles + extra[0], labels + extra[1], loc="upper left")
     fig.tight_layout()
-    return _png(fig)
+    return fig
 
 
 def spectra_figures(doc: dict) -> list[tuple[str, str]]:
     """``[(case, png)]``: engine thresholds on the reference spectrum (top) and
     their relative error [%] against Omega with the +-tolerance band (bottom),
     one figure per case (with, then without pendulum)."""
-    return [(case, _spectrum_case(doc, case)) for case in ("pendulum", "no_pendulum")
-            if case in doc.get("spectra", {})]
+    return [(case, _figure("spectrum", _spectrum_data(doc, case), _draw_spectrum))
+            for case in ("pendulum", "no_pendulum") if case in doc.get("spectra", {})]
 
 
 def _convergence(point: dict) -> tuple[np.ndarray, np.ndarray, list[tuple]] | None:
@@ -206,7 +232,6 @@ def convergence_axes(ax, series: list[tuple], tol: float) -> None:
     ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.2))
 
 
-@_styled
 def convergence_figure(doc: dict) -> str | None:
     """Relative threshold error against the engine time step for every point
     that carries a convergence study (a flat line away from zero: the
@@ -218,13 +243,23 @@ def convergence_figure(doc: dict) -> str | None:
             for p in pts:
                 conv = _convergence(p)
                 if conv is not None:
-                    series.append((name, case, p, conv))
+                    dt, err, more = conv
+                    series.append({"name": name, "case": case, "omega": p["omega"],
+                                   "dt": dt, "err": err, "more": [list(m) for m in more]})
     if not series:
         return None
-    fig, ax = plt.subplots(figsize=(WIDTH, 3.4))
-    convergence_axes(ax, series, 100.0 * doc["config"]["tolerances"]["threshold"])
+    data = {"tol": 100.0 * doc["config"]["tolerances"]["threshold"], "series": series}
+    return _figure("convergence", data, _draw_convergence)
+
+
+def _draw_convergence(d: dict):
+    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.4))
+    convergence_axes(ax, [(s["name"], s["case"], {"omega": s["omega"]},
+                           (np.asarray(s["dt"], dtype=float), np.asarray(s["err"], dtype=float),
+                            [tuple(m) for m in s["more"]]))
+                          for s in d["series"]], d["tol"])
     fig.tight_layout()
-    return _png(fig)
+    return fig
 
 
 def _error_vs_time(ref, traj, alpha: float) -> tuple[np.ndarray, np.ndarray]:
@@ -240,39 +275,51 @@ def _error_vs_time(ref, traj, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     return grid, err
 
 
-@_styled
-def _history_case(histories: dict, point: str, pend: bool, alpha: float, reference: str,
-                  title: str) -> str:
-    fig, (top, bot) = plt.subplots(2, 1, figsize=(WIDTH, 4.6), sharex=True,
-                                   gridspec_kw={"height_ratios": [1.5, 1]})
+def _history_data(histories: dict, point: str, pend: bool, alpha: float, reference: str,
+                  title: str) -> dict:
     ref = histories.get((point, pend, reference))
+    lines = []
     for (pt, p, name), traj in sorted(histories.items(), key=lambda kv: str(kv[0])):
         if pt != point or p != pend:
             continue
-        is_ref = name == reference
-        top.plot(traj.t, traj.theta / alpha, color=color(name), lw=1.5 if is_ref else 1.0,
-                 ls="-" if is_ref else "--", label=label(name), zorder=1 if is_ref else 2)
-        if ref is not None and not is_ref:
+        line = {**_style_of(name), "reference": name == reference, "t": np.asarray(traj.t),
+                "theta": np.asarray(traj.theta) / alpha, "grid": None, "error": None}
+        if ref is not None and name != reference:
             grid, err = _error_vs_time(ref, traj, alpha)
             if grid.size:
-                bot.semilogy(grid, np.maximum(err, 1e-7), color=color(name), lw=0.9,
-                             label=label(name))
-    if ref is not None and ref.impacts:
+                line.update(grid=grid, error=np.maximum(err, 1e-7))
+        lines.append(line)
+    first_impact = float(ref.impacts[0].t) if ref is not None and ref.impacts else None
+    return {"title": f"{title}, {'with' if pend else 'without'} pendulum", "lines": lines,
+            "first_impact": first_impact}
+
+
+def _draw_history(d: dict):
+    fig, (top, bot) = _pyplot().subplots(2, 1, figsize=(WIDTH, 4.6), sharex=True,
+                                   gridspec_kw={"height_ratios": [1.5, 1]})
+    for line in d["lines"]:
+        is_ref = line["reference"]
+        top.plot(line["t"], line["theta"], color=line["color"], lw=1.5 if is_ref else 1.0,
+                 ls="-" if is_ref else "--", label=line["label"], zorder=1 if is_ref else 2)
+        if line["grid"] is not None:
+            bot.semilogy(line["grid"], line["error"], color=line["color"], lw=0.9,
+                         label=line["label"])
+    if d["first_impact"] is not None:
         for ax in (top, bot):
-            ax.axvline(ref.impacts[0].t, color="0.4", lw=0.7, ls=":")
-        top.annotate("1st impact", (ref.impacts[0].t, 1.6), color="0.3",
+            ax.axvline(d["first_impact"], color="0.4", lw=0.7, ls=":")
+        top.annotate("1st impact", (d["first_impact"], 1.6), color="0.3",
                      xytext=(2, 0), textcoords="offset points")
     for y in (-1.0, 1.0):
         top.axhline(y, color="0.75", lw=0.5)
     top.set_ylim(-2.0, 2.0)
-    top.set_title(f"{title}, {'with' if pend else 'without'} pendulum")
+    top.set_title(d["title"])
     top.set_ylabel("θ / α")
     bot.set_ylabel("|θ − θ_model| / α")
     bot.set_xlabel("t [s]")
     bot.set_ylim(1e-7, 10.0)
     top.legend(loc="lower left", ncol=2)
     fig.tight_layout()
-    return _png(fig)
+    return fig
 
 
 def history_figures(histories: dict, point: str, alphas: dict, reference: str,
@@ -286,31 +333,38 @@ def history_figures(histories: dict, point: str, alphas: dict, reference: str,
     before it the error measures the integration, after it the impact model.
     """
     cases = sorted({p for (pt, p, _) in histories if pt == point}, reverse=True)
-    return [_history_case(histories, point, pend, alphas[pend], reference, title)
+    return [_figure("history", _history_data(histories, point, pend, alphas[pend], reference,
+                                              title), _draw_history)
             for pend in cases]
 
 
-@_styled
-def _restitution_group(doc: dict, pend: bool, title: str, key: str) -> str:
+def _restitution_data(doc: dict, pend: bool, title: str, key: str) -> dict:
     rows = [r for r in doc.get("restitution", []) if r["pendulum"] == pend]
-    fig, ax = plt.subplots(figsize=(WIDTH, 3.2))
-    tol = 100.0 * doc["config"]["tolerances"][key]
+    return {"title": title, "tol": 100.0 * doc["config"]["tolerances"][key],
+            "rows": [{**_style_of(r["backend"]),
+                      "error": [100.0 * i["rel_error"] for i in r["impacts"]
+                                if i.get("rel_error") is not None]} for r in rows]}
+
+
+def _draw_restitution(d: dict):
+    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.2))
+    tol = d["tol"]
     ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} %")
     ax.axhline(0.0, color="0.5", lw=0.6)
     seen = set()
-    for r in rows:
-        name = r["backend"]
-        errs = [100.0 * i["rel_error"] for i in r["impacts"] if i.get("rel_error") is not None]
-        ax.plot(np.arange(1, len(errs) + 1), errs, marker=marker(name), ms=5,
-                lw=0.8, color=color(name), label=label(name) if name not in seen else None)
-        seen.add(name)
-    ax.set_title(title)
-    ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+    for r in d["rows"]:
+        errs = r["error"]
+        ax.plot(np.arange(1, len(errs) + 1), errs, marker=r["marker"], ms=5, lw=0.8,
+                color=r["color"], label=r["label"] if r["name"] not in seen else None)
+        seen.add(r["name"])
+    ax.set_title(d["title"])
+    from matplotlib.ticker import MaxNLocator
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("impact number")
     ax.set_ylabel("measured / predicted − 1 [%]")
     ax.legend()
     fig.tight_layout()
-    return _png(fig)
+    return fig
 
 
 def restitution_figures(doc: dict) -> list[str]:
@@ -320,5 +374,5 @@ def restitution_figures(doc: dict) -> list[str]:
     rows = doc.get("restitution", [])
     groups = [(False, "Eq. 20 (no pendulum)", "restitution"),
               (True, "Eq. 19 (with pendulum)", "restitution_pendulum")]
-    return [_restitution_group(doc, *g) for g in groups
-            if any(r["pendulum"] == g[0] for r in rows)]
+    return [_figure("restitution", _restitution_data(doc, *g), _draw_restitution)
+            for g in groups if any(r["pendulum"] == g[0] for r in rows)]

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from analytic import _workers
 from analytic import equations as eq
 from analytic import fast
 from analytic.excitation import Pulse
@@ -18,12 +19,18 @@ from analytic.spectrum import (Spectrum, SpectrumSettings, first_overturn_amplit
 from compare.cli.main import main as cli_main
 from compare.cli.options import parse_omega_range
 
+from tests.support.paths import ROOT
+
 FIG5_OMEGA = np.arange(3.0, 31.0, 1.0)  # the paper's Fig. 5 range
 
 
 @pytest.fixture(scope="module")
 def fig5_spectrum(fig5) -> Spectrum:
-    return overturning_spectrum(fig5, FIG5_OMEGA, workers=2)
+    # Two workers whatever the machine measures (a fast one would find the
+    # work not worth a second process): the pool is what is tested here.
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(_workers, "POOL_START_CPU_S", 0.0)
+        return overturning_spectrum(fig5, FIG5_OMEGA, workers=2)
 
 
 def test_fig5_gain_never_negative(fig5_spectrum):
@@ -60,6 +67,16 @@ def test_fig5_matches_paper_shape(fig5_spectrum):
     assert modes[9.0] == "after-impact" and modes[11.0] == "no-impact"
     jumps = [(j["curve"], j["omega_before"]) for j in sp.mode_jumps()]
     assert ("pendulum", 10.0) in jumps
+
+
+def test_thresholds_are_those_of_the_reference_commit(fig5_spectrum):
+    """Bit for bit the thresholds ``trilith spectrum --omega 3:30:1`` printed
+    before its workers were decided by the work (the commit and command are in
+    the file, which the spectrum CLI benchmark also reads)."""
+    ref = json.loads((ROOT / "benchmarks" / "spectrum_cli_reference.json").read_text())
+    got = fig5_spectrum.to_dict()
+    for key, values in ref["thresholds"].items():
+        assert got[key] == values, key
 
 
 def test_workers_do_not_change_results(fig5, fig5_spectrum):

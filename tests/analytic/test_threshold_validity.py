@@ -7,6 +7,7 @@ import math
 
 import pytest
 
+from analytic import _workers
 from analytic.threshold_validity import (VALIDITY_FIELDS, curve_validity, invalid_spans,
                                          point_validity)
 from scenes import load_scene
@@ -38,10 +39,11 @@ def test_no_pendulum_has_no_clearance(fig5):
     assert v["bob_min_clearance"] is None and v["model_valid"] is True
 
 
-def test_curve_keeps_order_skips_missing_and_is_the_same_on_two_workers(fig5):
-    omegas, amps = [5.0, 26.0, 12.0], [3.0, 74.9, math.nan]
+def test_curve_keeps_order_skips_missing_and_is_the_same_on_two_workers(fig5, monkeypatch):
+    omegas, amps = [5.0, 26.0, 12.0, 8.0], [3.0, 74.9, math.nan, 3.5]
     one = curve_validity(fig5, omegas, amps, workers=1)
-    assert [v["model_valid"] for v in one] == [True, False, None]
+    assert [v["model_valid"] for v in one] == [True, False, None, True]
+    monkeypatch.setattr(_workers, "POOL_START_CPU_S", 0.0)  # a pool, however cheap the work
     assert curve_validity(fig5, omegas, amps, workers=2) == one
 
 
