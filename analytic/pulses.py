@@ -39,7 +39,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .excitation import MAX_ACCELERATION, MAX_PULSE_LENGTH, _positive_factor, _real
 
@@ -282,6 +281,7 @@ class MavroeidisPapageorgiou:
         t = self._grid()
         a = np.abs(self.acceleration_array(t))
         inner = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
+        from scipy.optimize import minimize_scalar  # here: the CLI's parser imports this module
         out = []
         for i in inner:
             res = minimize_scalar(lambda x: -abs(self.acceleration(x)), method="bounded",
@@ -301,6 +301,7 @@ class MavroeidisPapageorgiou:
         v = np.abs([self.velocity(float(x)) for x in t])
         i = int(np.argmax(v))
         lo, hi = float(t[max(i - 1, 0)]), float(t[min(i + 1, t.size - 1)])
+        from scipy.optimize import minimize_scalar
         res = minimize_scalar(lambda x: -abs(self.velocity(x)), method="bounded",
                               bounds=(lo, hi), options={"xatol": 1e-12 * self.end_time})
         return max(float(v[i]), abs(self.velocity(float(res.x))))
