@@ -91,7 +91,7 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
     import numpy as np
 
     from analytic.overturn_map import verdict_map
-    from compare.cli.map import _subsample, plot_maps
+    from compare.cli.map_plot import plot_maps, subsample
     from compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
                                      use_store)
     from compare.run.jsonable import plain
@@ -115,7 +115,7 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
     if values.size * scales.size > MAX_RECORD_CELLS:
         raise ValueError(f"--intensity x --time-scale gives {values.size * scales.size} cells, "
                          f"more than {MAX_RECORD_CELLS} (each a run of the whole record)")
-    eng_values, eng_scales = _subsample(values, ENGINE_POINTS), _subsample(scales, ENGINE_POINTS)
+    eng_values, eng_scales = subsample(values, ENGINE_POINTS), subsample(scales, ENGINE_POINTS)
     n_eng = len(engines_) * eng_values.size * eng_scales.size
     if n_eng > args.max_engine_runs:
         raise ValueError(f"the engine grids need {n_eng} runs, more than --max-engine-runs "
