@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analytic.options import check_real
+from analytic.excitation import Still
 from engines.base import Engine, EngineSettings
 from engines.diagnostics import PlaneState, Pose
 from engines._quiet_pybullet import pybullet as pb
@@ -179,7 +180,8 @@ class PyBulletEngine(Engine):
         world.configure_client(c, scene, s)
         self.moving = s.base_motion == "ground"
         self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(self.friction),
-                                  self.moving, s.friction_anchor, slop=world.effective_slop(s))
+                                  self.moving, s.friction_anchor, slop=world.effective_slop(s),
+                                  under_load=not isinstance(self.excitation, Still))
         self.start_y = {body: pb.getBasePositionAndOrientation(body, physicsClientId=c)[0][1]
                         for body in self.bodies.dynamic}
         if self.moving:
