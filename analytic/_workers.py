@@ -20,14 +20,15 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import resource
 import signal
 import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
-__all__ = ["fork_pool", "init_worker", "pool_size", "map_measured", "POOL_START_CPU_S",
-           "PAYOFF"]
+__all__ = ["fork_pool", "init_worker", "pool_size", "map_measured", "cpu_seconds",
+           "POOL_START_CPU_S", "PAYOFF"]
 
 # CPU seconds one forked worker adds (child and parent) when the parent has loaded
 # everything the work needs (module docstring, Notes).
@@ -35,6 +36,17 @@ POOL_START_CPU_S = 0.015
 # A worker is started only for work worth this many times its start cost: the
 # pool then adds at most 1/PAYOFF to the CPU time while it divides the wall time.
 PAYOFF = 10.0
+
+
+def cpu_seconds() -> float:
+    """User + system CPU time of this process and its reaped children [s].
+
+    A pool's workers are reaped when it shuts down, so the difference of two calls
+    around a pooled map is the map's whole CPU, whatever the number of workers.
+    """
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
+        resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def _die_with_parent(parent_pid: int) -> None:

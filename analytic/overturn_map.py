@@ -22,7 +22,7 @@ import numpy as np
 
 from . import _fast_kernels as _k
 from . import fast
-from ._workers import fork_pool
+from ._workers import cpu_seconds, fork_pool
 from .parameters import Scene
 from .spectrum import SpectrumSettings, first_overturn_amplitude
 
@@ -47,7 +47,8 @@ class OverturnMap:
     ``cells[i, j]`` indexes ``labels`` for ``amplitude[i]`` [m/s^2] and
     ``omega[j]`` [rad/s]; ``first[j]`` is the first overturning amplitude at
     ``omega[j]`` from :func:`analytic.spectrum.first_overturn_amplitude` (NaN:
-    none up to the grid's top, or not computed).
+    none up to the grid's top, or not computed).  ``wall_time`` [s] and
+    ``cpu_s`` (CPU seconds of the process and its workers) are what the map took.
     """
 
     omega: np.ndarray
@@ -59,6 +60,7 @@ class OverturnMap:
     pulse: str
     scene: Scene
     wall_time: float = math.nan
+    cpu_s: float = math.nan
 
     def counts(self) -> dict:
         """Number of cells per label."""
@@ -69,7 +71,7 @@ class OverturnMap:
                 "omega": self.omega.tolist(), "amplitude": self.amplitude.tolist(),
                 "labels": list(self.labels), "cells": self.cells.tolist(),
                 "first_overturn": [float(a) if math.isfinite(a) else None for a in self.first],
-                "counts": self.counts(), "wall_time": self.wall_time}
+                "counts": self.counts(), "wall_time": self.wall_time, "cpu_s": self.cpu_s}
 
     def csv_rows(self):
         """``(omega, amplitude, label)`` for every cell, omega-major."""
@@ -173,7 +175,7 @@ def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | 
         raise ValueError(f"a {ss.pulse} map of {w.size * a.size} cells runs the accurate model "
                          f"(~20 ms a cell); at most {MAX_ACCURATE_CELLS} cells")
     ss = replace(ss, a_max=float(min(ss.a_max, a.max())))
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), cpu_seconds()
     if ss.compiled:
         fast.warm_up(record=False)
     _JOB.update(scene=scene, ss=ss, amps=a, first=first_curve)
@@ -186,7 +188,8 @@ def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | 
     return OverturnMap(omega=w, amplitude=a, cells=cells, labels=labels,
                        first=np.array([f for _, f in cols]),
                        backend=fast.NAME if ss.compiled else "analytic",
-                       pulse=ss.pulse, scene=scene, wall_time=time.perf_counter() - t0)
+                       pulse=ss.pulse, scene=scene, wall_time=time.perf_counter() - t0,
+                       cpu_s=cpu_seconds() - c0)
 
 
 def verdict_map(run, scene: Scene, omegas, amplitudes, backend: str, pulse: str = "sine",
@@ -199,7 +202,7 @@ def verdict_map(run, scene: Scene, omegas, amplitudes, backend: str, pulse: str 
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     w, a = _check_grid(omegas, amplitudes)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), cpu_seconds()
     cells_ij = [(i, j) for j in range(w.size) for i in range(a.size)]
     _JOB.update(run=run, amps=a, omegas=w)
     try:
@@ -215,4 +218,5 @@ def verdict_map(run, scene: Scene, omegas, amplitudes, backend: str, pulse: str 
         cells[i, j] = labels.index(lab)
     return OverturnMap(omega=w, amplitude=a, cells=cells, labels=tuple(labels),
                        first=np.full(w.size, math.nan), backend=backend, pulse=pulse,
-                       scene=scene, wall_time=time.perf_counter() - t0)
+                       scene=scene, wall_time=time.perf_counter() - t0,
+                       cpu_s=cpu_seconds() - c0)

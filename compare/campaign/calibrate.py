@@ -35,11 +35,12 @@ from __future__ import annotations
 import itertools
 import math
 import os
-import resource
 from dataclasses import dataclass, field
 
+from analytic._workers import cpu_seconds
+
 __all__ = ["METRICS", "ValidationSet", "Evaluation", "Calibration", "calibrate",
-           "default_space", "default_tolerance", "pareto_front", "cpu_seconds"]
+           "default_space", "default_tolerance", "pareto_front"]
 
 METRICS = ("restitution", "thresholds", "histories")
 # Multiples of an engine's calibrated step tried by default: thresholds were seen
@@ -143,13 +144,6 @@ def default_tolerance(metric: str) -> float:
     t = Tolerances()
     return {"restitution": t.restitution, "thresholds": t.threshold,
             "histories": t.theta_rms_first}[metric]
-
-
-def cpu_seconds() -> float:
-    """User + system CPU time of this process and its reaped children [s]."""
-    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
-        resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def pareto_front(evaluations) -> list:

@@ -12,7 +12,7 @@ from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_ar
                                  add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
-from compare.cli.map_plot import plot_maps, subsample
+from compare.cli.map_plot import plot_maps, print_map_summary, subsample
 from compare.measure.map_thresholds import LEAST_RUNS
 from compare.run.jsonable import plain
 
@@ -206,11 +206,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(plain({"maps": [first] + engine_maps}))
         return 0
     for m in maps:
-        print(f"{m.backend}: scene {scene.name}, {m.pulse} pulse, {m.omega.size} frequencies x "
-              f"{m.amplitude.size} amplitudes in {m.wall_time:.2f} s")
-        for lab, n in m.counts().items():
-            if n:
-                print(f"  {lab:>26}: {n}")
+        print_map_summary(m, f"scene {scene.name}, {m.pulse} pulse, {m.omega.size} "
+                             f"frequencies x {m.amplitude.size} amplitudes")
     for name, pts in thresholds.items():
         _print_thresholds(name, pts)
     bad = [float(w) for w, v in zip(maps[0].omega, validity) if v["model_valid"] is False]

@@ -91,7 +91,7 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
     import numpy as np
 
     from analytic.overturn_map import verdict_map
-    from compare.cli.map_plot import plot_maps, subsample
+    from compare.cli.map_plot import plot_maps, print_map_summary, subsample
     from compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
                                      use_store)
     from compare.run.jsonable import plain
@@ -152,11 +152,9 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
                           "maps": [m.to_dict() for m in maps]}))
         return 0
     for m in maps:
-        print(f"{m.backend}: record {record.label}, {m.omega.size} time scales x "
-              f"{m.amplitude.size} {args.im} values, window end + {args.tail:g} s")
-        for lab, n in m.counts().items():
-            if n:
-                print(f"  {lab:>26}: {n}")
+        print_map_summary(m, f"record {record.label}, {m.omega.size} time scales x "
+                             f"{m.amplitude.size} {args.im} values, window end + "
+                             f"{args.tail:g} s")
         firsts = ", ".join(f"k={k:g}: {'-' if not math.isfinite(a) else f'{a:.4g}'}"
                            for k, a in zip(m.omega, m.first))
         print(f"  first overturning {args.im} on the grid: {firsts}")
