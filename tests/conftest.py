@@ -1,5 +1,6 @@
-"""Shared fixtures: the paper's Fig. 5 scene (with and without pendulum) and a
-cached accurate-simulator run (several tests look at the same trajectories)."""
+"""Shared fixtures: the paper's Fig. 5 scene (with and without pendulum), a cached
+accurate-simulator run (several tests look at the same trajectories), and ``no_work``
+(every entry point that does real work fails the test: checks at the door)."""
 from __future__ import annotations
 
 import atexit
@@ -49,3 +50,34 @@ def run_analytic():
             t_max: float | None = None, criterion: str = "topple"):
         return _cached_run(scene, float(amplitude), float(omega), kind, t_max, criterion)
     return run
+
+
+class WorkStarted(AssertionError):
+    pass
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """Make every entry point that does real work fail the test."""
+    import analytic.fast
+    import analytic.simulate
+    import analytic.spectrum
+    import compare.campaign.validation
+    import compare.cli.bench
+    import compare.cli.record
+    import compare.cli.view
+    import compare.measure.restitution
+    import compare.report.figures
+    import engines.base
+
+    def boom(*args, **kwargs):
+        raise WorkStarted("work started before the input was checked")
+
+    for module, name in ((analytic.simulate, "simulate"), (analytic.fast, "simulate"),
+                         (engines.base.Engine, "run"),  # every registered engine
+                         (analytic.spectrum, "overturning_spectrum"),
+                         (compare.campaign.validation, "run_campaign"), (compare.report.figures, "make_figures"),
+                         (compare.cli.record, "record"), (compare.cli.view, "view"),
+                         (compare.cli.bench, "_load_bench"),
+                         (compare.measure.restitution, "measure_restitution")):
+        monkeypatch.setattr(module, name, boom)

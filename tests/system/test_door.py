@@ -25,37 +25,6 @@ SAMPLE_CSV = ROOT / "scenes" / "records" / "sample.csv"
 SAMPLE_AT2 = ROOT / "scenes" / "records" / "sample.AT2"
 
 
-class WorkStarted(AssertionError):
-    pass
-
-
-@pytest.fixture
-def no_work(monkeypatch):
-    """Make every entry point that does real work fail the test."""
-    import analytic.fast
-    import analytic.simulate
-    import analytic.spectrum
-    import compare.campaign.validation
-    import compare.cli.bench
-    import compare.cli.record
-    import compare.cli.view
-    import compare.measure.restitution
-    import compare.report.figures
-    import engines.base
-
-    def boom(*args, **kwargs):
-        raise WorkStarted("work started before the input was checked")
-
-    for module, name in ((analytic.simulate, "simulate"), (analytic.fast, "simulate"),
-                         (engines.base.Engine, "run"),  # every registered engine
-                         (analytic.spectrum, "overturning_spectrum"),
-                         (compare.campaign.validation, "run_campaign"), (compare.report.figures, "make_figures"),
-                         (compare.cli.record, "record"), (compare.cli.view, "view"),
-                         (compare.cli.bench, "_load_bench"),
-                         (compare.measure.restitution, "measure_restitution")):
-        monkeypatch.setattr(module, name, boom)
-
-
 @pytest.fixture(scope="module")
 def files(tmp_path_factory) -> dict[str, str]:
     """Bad files of every kind, and an existing file/directory for output checks."""

@@ -12,7 +12,6 @@ from analytic.pulses import PULSE_FAMILY, MavroeidisPapageorgiou, PulseShape, Ri
 from compare.cli.main import main
 
 from tests.support.paths import ROOT
-from tests.system.test_door import no_work  # noqa: F401  (fixture: any run fails the test)
 
 SAMPLE_CSV = str(ROOT / "scenes" / "records" / "sample.csv")
 
@@ -44,7 +43,7 @@ DOOR_CASES = [
 
 
 @pytest.mark.parametrize("argv, needle", DOOR_CASES, ids=[" ".join(a) for a, _ in DOOR_CASES])
-def test_bad_pulse_refused_at_the_door(argv, needle, no_work, capsys):  # noqa: F811
+def test_bad_pulse_refused_at_the_door(argv, needle, no_work, capsys):
     assert main(argv) == 2
     captured = capsys.readouterr()
     lines = captured.err.splitlines()

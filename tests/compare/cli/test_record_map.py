@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from compare.cli.main import main
-from tests.system.test_door import no_work  # noqa: F401  (fixture: any run fails the test)
 
 
 @pytest.fixture
@@ -51,7 +50,7 @@ def test_cells_are_the_model_verdicts(short_record, tmp_path, capsys):
     (["--tail", "-1"], "--tail must be in [0, 600] s"),
     (["--engine", "pymunk", "--intensity", "1:10:1", "--time-scale", "0.5:2:0.1",
       "--max-engine-runs", "4"], "more than --max-engine-runs 4")])
-def test_bad_record_map_refused(short_record, extra, needle, no_work, capsys):  # noqa: F811
+def test_bad_record_map_refused(short_record, extra, needle, no_work, capsys):
     assert main(["map", "--record", short_record, *extra]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("error: ") and needle in err[0], err

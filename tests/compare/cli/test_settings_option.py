@@ -11,7 +11,6 @@ from compare.cli.main import main
 from compare.run import runs
 
 from tests.support.paths import ROOT
-from tests.system.test_door import no_work  # noqa: F401  (the fixture)
 
 BAD = {
     "dt": ("[pymunk]\ndt = 0.5\n", "dt must be"),

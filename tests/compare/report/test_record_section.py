@@ -9,7 +9,6 @@ from compare.cli.main import main
 from compare.report.record_section import _row, record_section, record_section_html
 from scenes import load_scene
 from tests.compare.measure.test_record_threshold import half_sine_record
-from tests.system.test_door import no_work  # noqa: F401  (fixture: any run fails the test)
 
 ST = IDASettings(im="pga", im_lo=2.0, im_hi=40.0, rel_step=0.5, rtol=0.01, tail=1.0)
 
@@ -47,7 +46,7 @@ def test_cause_rule(engine, model_valid, isolated, bracketed, cause):
     assert _row("pymunk", "r", m, res, valid, ST)["cause"] == cause
 
 
-def test_report_refuses_a_bad_record_at_the_door(tmp_path, no_work, capsys):  # noqa: F811
+def test_report_refuses_a_bad_record_at_the_door(tmp_path, no_work, capsys):
     assert main(["report", "--quick", "--record", str(tmp_path / "none.csv"), "--out",
                  str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.splitlines()
