@@ -27,11 +27,11 @@ def add_parser(subparsers) -> None:
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     add_engine_list_arg(p, DEFAULT_ENGINES)
     p.add_argument("--omega", default="4:28:2", metavar="START:STOP:STEP",
-                   help="pulse frequencies [rad/s] (default: 4:28:2)")
+                   help="pulse frequencies [rad/s]")
     p.add_argument("--factors", default="1,2,5,10", metavar="F[,F...]",
                    help="time steps as multiples of each engine's calibrated threshold "
                         "step, increasing, in [1, 50]; a coarser one runs only where the "
-                        "finer one agreed (default: 1,2,5,10)")
+                        "finer one agreed")
     p.add_argument("--json", default=None, metavar="FILE",
                    help="write the atlas as JSON (docs/validation/atlas.json is the stored one)")
     p.add_argument("--html", default=None, metavar="FILE",

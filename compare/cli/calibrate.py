@@ -29,7 +29,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help=f"the engine to calibrate: {', '.join(engine_names())}")
     add_scene_args(parser)
     parser.add_argument("--metric", choices=METRICS, default="thresholds",
-                        help="what must agree (default: thresholds)")
+                        help="what must agree")
     parser.add_argument("--tolerance", type=float, default=None, metavar="X",
                         help="largest acceptable worst error, in (0, 1] (default: the report's "
                              "own: 0.005 restitution, 0.02 thresholds, 1e-3 alpha histories)")

@@ -162,13 +162,17 @@ def test_quiet_and_verbose(tmp_path, capsys):
 
 
 def test_help_shows_defaults_without_markup(capsys):
-    for command in ("simulate", "spectrum", "report", "bench", "record", "figures"):
+    import re
+    for command in ("simulate", "spectrum", "report", "bench", "record", "figures", "map",
+                    "atlas", "calibrate", "campaign"):
         with pytest.raises(SystemExit):
             main([command, "--help"])
         # Whitespace joined: argparse may wrap a line right after "(default:"
         # (the engine list in the defaults grows with the registry).
         text = " ".join(capsys.readouterr().out.split())
         assert "``" not in text and "(default: " in text
+        # A default written in the help text and added by the formatter shows twice.
+        assert not re.search(r"(\(default: [^)]*\)) \1", text), command
     with pytest.raises(SystemExit):
         main(["report", "--help"])
     assert "(default: -1)" in capsys.readouterr().out  # one --workers default
