@@ -213,7 +213,9 @@ class RunMonitor:
         if (self.certain_at is None and t >= self.t_end_pulse and not self._parted
                 and self._overturn_certain(theta, theta_dot, psi, psi_dot)):
             self.certain_at = t
-            if self.verdict_only:
+            # A fixed window keeps the paper's convention, as the model's fixed-window
+            # runs do: overturned only if the threshold is reached before t_max.
+            if self.verdict_only and self.t_max is None:
                 mode = "after-impact" if self._impacts else "no-impact"
                 self.verdict = Verdict("overturned", t, mode, len(self._impacts),
                                        "certain: past alpha after the pulse with the energy "

@@ -57,3 +57,19 @@ def test_overturn_certain_rules_after_the_pulse():
     pend = Scene()
     with_pendulum = RunMonitor(pend, pulse, EngineSettings(verdict_only=True))
     assert not with_pendulum.record(0.7, 1.2 * pend.alpha, 1.2 * pend.alpha, 3.0)
+
+
+def test_a_fixed_window_ignores_a_certain_fall():
+    """With ``t_max`` fixed, a run is 'overturned' only if the threshold is reached
+    inside the window (the model's fixed-window convention, analytic/simulate.py):
+    a fall that became certain is not called before the threshold, and a window
+    that ends mid-fall is 'survived' by that convention, as the model would say."""
+    bare = Scene(gamma=0.0)
+    a = bare.alpha
+    pulse = Pulse(20.0, 10.0)  # ends at 0.628 s
+    window = RunMonitor(bare, pulse, EngineSettings(verdict_only=True, t_max=0.9,
+                                                    early_stop=False))
+    assert not window.record(0.8, 1.3 * a, 1.3 * a, 0.5)  # certain, but not decided
+    assert window.certain_at == 0.8
+    assert window.record(0.9, 2.0 * a, 2.0 * a, 1.0)  # the window ends mid-fall
+    assert window.verdict.status == "survived" and "end of run" in window.verdict.reason
