@@ -88,10 +88,12 @@ def run(args: argparse.Namespace) -> int:
         workers = resolve_workers(args.workers)
         use_store(args)
         doc = run_atlas(config, workers, None if budget is None else 60.0 * budget)
-        doc["engines_not_run"] = [e for e in DEFAULT_ENGINES if e not in engines]
+        from engines import engine_names
+        doc["engines_not_run"] = [e for e in engine_names() if e not in engines]
         doc["settings_file"] = None if loaded is None else loaded.describe()
-        from compare.run.provenance import command_line
-        doc["command"] = command_line(args)
+        from compare.run.provenance import collect
+        doc["provenance"] = collect(args)
+        doc["command"] = doc["provenance"]["command"]
         if args.json is not None:
             from compare.run.jsonable import plain
             atomic.write_text(args.json, json.dumps(plain(doc), separators=(",", ":"),
