@@ -4,7 +4,9 @@
 measures every engine's first-overturning amplitude against the model's on the
 scenes of Figs. 8-11, Omega 4..28 rad/s by 2, at each engine's calibrated
 threshold step and 2x, 5x, 10x coarser, through the run store (killed, it
-resumes).  ``--from FILE`` renders a stored atlas without running anything.
+resumes).  ``--from FILE`` renders a stored atlas without running anything;
+repeated, it joins atlases of different engines measured separately
+(``compare/campaign/atlas_merge.py``).
 """
 from __future__ import annotations
 
@@ -36,8 +38,10 @@ def add_parser(subparsers) -> None:
                    help="write the atlas as JSON (docs/validation/atlas.json is the stored one)")
     p.add_argument("--html", default=None, metavar="FILE",
                    help="write a standalone HTML page (heat maps, trusted region, cost)")
-    p.add_argument("--from", dest="source", default=None, metavar="FILE",
-                   help="render a stored atlas JSON (with --html); run nothing")
+    p.add_argument("--from", dest="from", action="append", default=None, metavar="FILE",
+                   help="a stored atlas JSON; run nothing, write it with --html/--json. "
+                        "Repeated: one atlas of the engines of every file (measured "
+                        "separately, on the same scenes, grid and model)")
     p.add_argument("--time-budget", type=float, default=None, metavar="MIN",
                    help="wall minutes after which no new chunk of engine jobs starts; the "
                         "jobs left are recorded as not run (default: no limit)")
@@ -55,21 +59,26 @@ def _factors(text: str) -> tuple[float, ...]:
 
 def run(args: argparse.Namespace) -> int:
     from compare.campaign.atlas import AtlasConfig, run_atlas
-    from compare.run import atomic
 
     if args.json is not None:
         check_output_path(args.json, "--json", suffixes=(".json",))
     if args.html is not None:
         check_output_path(args.html, "--html", suffixes=(".html",))
-    if args.source is not None:
-        if args.html is None:
-            raise ValueError("--from renders a stored atlas: give --html FILE")
-        try:
-            doc = json.loads(open(args.source, encoding="utf-8").read())
-        except (OSError, ValueError) as exc:
-            raise ValueError(f"--from {args.source!r}: not a readable atlas JSON ({exc})") from None
-        if not isinstance(doc, dict) or "points" not in doc:
-            raise ValueError(f"--from {args.source!r}: not an atlas (no 'points')")
+    sources = getattr(args, "from")  # "from" is a keyword: the flag's own name as dest
+    if sources is not None:
+        if args.html is None and args.json is None:
+            raise ValueError("--from reads stored atlases: give --html FILE and/or --json FILE")
+        docs = [_read_atlas(path) for path in sources]
+        if len(docs) > 1:
+            from compare.campaign.atlas_merge import merge_atlases
+            from compare.run.provenance import collect
+            doc = merge_atlases(docs, [f"--from {p!r}" for p in sources])
+            doc["provenance"] = collect(args)
+            doc["command"] = doc["provenance"]["command"]
+        else:
+            doc = docs[0]
+        if args.json is not None:
+            _write_json(args.json, doc)
     else:
         engines = parse_engine_list(args.engine)
         omegas = parse_omega_range(args.omega, "--omega")
@@ -95,16 +104,31 @@ def run(args: argparse.Namespace) -> int:
         doc["provenance"] = collect(args)
         doc["command"] = doc["provenance"]["command"]
         if args.json is not None:
-            from compare.run.jsonable import plain
-            atomic.write_text(args.json, json.dumps(plain(doc), separators=(",", ":"),
-                                                    allow_nan=False) + "\n")
-            info(f"wrote {args.json}")
+            _write_json(args.json, doc)
     if args.html is not None:
         from compare.report.atlas_page import write_page
         write_page(doc, args.html)
         info(f"wrote {args.html}")
     _print(doc)
     return 0
+
+
+def _read_atlas(path: str) -> dict:
+    try:
+        doc = json.loads(open(path, encoding="utf-8").read())
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"--from {path!r}: not a readable atlas JSON ({exc})") from None
+    if not isinstance(doc, dict) or not {"points", "steps", "config"} <= set(doc):
+        raise ValueError(f"--from {path!r}: not an atlas (needs 'points', 'steps', 'config')")
+    return doc
+
+
+def _write_json(path: str, doc: dict) -> None:
+    from compare.run import atomic
+    from compare.run.jsonable import plain
+    atomic.write_text(path, json.dumps(plain(doc), separators=(",", ":"), allow_nan=False)
+                      + "\n")
+    info(f"wrote {path}")
 
 
 def _print(doc: dict) -> None:

@@ -45,7 +45,11 @@ def command_line(args: argparse.Namespace | None, prog: str = "trilith") -> str:
         flag = "--" + key.replace("_", "-")
         if value is None or value is False:
             continue
-        words += [flag] if value is True else [flag, str(value)]
+        if isinstance(value, list):  # a repeated option (action="append")
+            for item in value:
+                words += [flag, str(item)]
+        else:
+            words += [flag] if value is True else [flag, str(value)]
     return shlex.join(w for w in words if w)
 
 

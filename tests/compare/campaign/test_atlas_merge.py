@@ -1,0 +1,77 @@
+"""Atlases of different engines, measured separately, join into one only when they
+measured the same thing (compare/campaign/atlas_merge.py)."""
+from __future__ import annotations
+
+import copy
+import json
+
+import pytest
+
+from compare.campaign import atlas
+from compare.campaign.atlas_merge import merge_atlases
+from compare.cli.main import main
+
+
+def _part(engine: str, error: float, load: float) -> dict:
+    pts = []
+    for scene, valid in (("fig8_a", True), ("fig8_b", False)):
+        rows = [{"dt": 1e-3, "rel_error": error, "cause": "agrees", "cpu_s": 0.5,
+                 "sim_s": 5.0}] if valid else []
+        pts.append({"scene": scene, "case": "pendulum", "pulse": "sine", "omega": 10.0,
+                    "a_reference": 10.0, "mode": "no-impact", "valid": valid,
+                    "model_reason": "" if valid else "columns hop", "engines": {engine: rows}})
+    return {"schema_version": 1, "config": {"engines": [engine], "scenes": [["fig8_*", "sine"]],
+                                            "omegas": [10.0], "factors": [1.0],
+                                            "cases": ["pendulum"], "rel_bracket": 0.03,
+                                            "rel_tol": 0.004, "tol": 0.02, "settings": {}},
+            "versions": {engine: f"{engine} 1.0"}, "steps": {engine: [1e-3]}, "points": pts,
+            "cost": atlas.cost_table(pts, (engine,)), "not_run": {},
+            "command": f"trilith atlas --engine {engine}", "wall_s": 10.0,
+            "parent_cpu_s": 8.0, "load_average": [load, load + 1], "workers": 1}
+
+
+def test_parts_join_with_their_provenance():
+    merged = merge_atlases([_part("pymunk", 0.001, 1.0), _part("dart", -0.004, 3.0)])
+    assert list(merged["steps"]) == ["pymunk", "dart"]
+    assert merged["points"][0]["engines"]["dart"][0]["rel_error"] == -0.004
+    assert merged["points"][0]["engines"]["pymunk"][0]["rel_error"] == 0.001
+    assert [p["command"] for p in merged["parts"]] == ["trilith atlas --engine pymunk",
+                                                       "trilith atlas --engine dart"]
+    assert merged["load_average"] == [1.0, 4.0] and merged["wall_s"] == 20.0
+    assert {c["engine"] for c in merged["cost"]} == {"pymunk", "dart"}
+    assert "pymunk" not in merged["engines_not_run"] and "drake" in merged["engines_not_run"]
+    # A merged atlas merges again: its parts are kept, not nested.
+    again = merge_atlases([merged, _part("drake", 0.0, 2.0)])
+    assert len(again["parts"]) == 3 and list(again["steps"]) == ["pymunk", "dart", "drake"]
+
+
+@pytest.mark.parametrize("spoil, needle", [
+    (lambda d: d["config"].update(omegas=[12.0]), "config 'omegas' differs"),
+    (lambda d: d["points"][0].update(a_reference=10.5), "the model differs at fig8_a"),
+    (lambda d: d["points"].pop(), "different points"),
+    (lambda d: d.update(steps={"pymunk": [1e-3]}), "engine 'pymunk' is in both"),
+    (lambda d: d.pop("steps"), "not an atlas"),
+])
+def test_parts_that_measured_different_things_are_refused(spoil, needle):
+    other = _part("dart", 0.0, 1.0)
+    spoil(other)
+    with pytest.raises(ValueError, match=needle):
+        merge_atlases([_part("pymunk", 0.0, 1.0), copy.deepcopy(other)], ["a.json", "b.json"])
+
+
+def test_cli_joins_files_and_refuses_a_bad_one(tmp_path, capsys):
+    a, b, out = tmp_path / "a.json", tmp_path / "b.json", tmp_path / "all.json"
+    a.write_text(json.dumps(_part("pymunk", 0.001, 1.0)))
+    b.write_text(json.dumps(_part("mujoco", 0.002, 1.0)))
+    assert main(["atlas", "--from", str(a), "--from", str(b), "--json", str(out),
+                 "--html", str(tmp_path / "all.html")]) == 0
+    doc = json.loads(out.read_text())
+    assert list(doc["steps"]) == ["pymunk", "mujoco"] and "--from" in doc["command"]
+    assert "Trusted region" in (tmp_path / "all.html").read_text()
+    capsys.readouterr()
+    (tmp_path / "c.json").write_text(json.dumps(_part("pymunk", 0.0, 1.0)))
+    assert main(["atlas", "--from", str(a), "--from", str(tmp_path / "c.json"),
+                 "--json", str(tmp_path / "x.json")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: engine 'pymunk' is in both") and err.count("\n") == 1
+    assert not (tmp_path / "x.json").exists()
