@@ -18,7 +18,7 @@ import io
 import math
 from pathlib import Path
 
-__all__ = ["CAUSE_SYMBOL", "trusted_rows", "cost_rows", "heat_map_png", "atlas_html",
+__all__ = ["CAUSE_SYMBOL", "step_rows", "trusted_rows", "cost_rows", "heat_map_png", "atlas_html",
            "write_page"]
 
 CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
@@ -38,32 +38,53 @@ def _rows_of(doc: dict, engine: str) -> list[tuple[dict, list]]:
     return [(pt, pt["engines"].get(engine, [])) for pt in doc["points"]]
 
 
+def step_rows(doc: dict):
+    """Per engine and step, in order, a dict: ``engine``, ``dt``, ``factor``, ``valid``
+    (the points where the model is valid and overturns), ``measured`` (``(point,
+    row)`` measured at that step: those that agreed at every finer one), ``agree``,
+    ``worst`` (largest finite |error| measured at it, or None), ``disagree``
+    (``(point, row)`` that do not agree), ``cost`` (its ``cost`` entry) and
+    ``not_run`` (jobs the time budget left)."""
+    valid = [pt for pt in doc["points"] if pt["a_reference"] is not None
+             and pt["valid"] is not False]
+    cost = {(c["engine"], c["dt"]): c for c in doc.get("cost", [])}
+    factors = doc.get("config", {}).get("factors", [])
+    for engine, steps in doc.get("steps", {}).items():
+        for level, dt in enumerate(steps):
+            at = [(pt, pt["engines"][engine][level]) for pt in valid
+                  if len(pt["engines"].get(engine, [])) > level]
+            errs = [abs(r["rel_error"]) for _, r in at if r.get("rel_error") is not None
+                    and math.isfinite(r["rel_error"])]
+            yield {"engine": engine, "dt": dt,
+                   "factor": factors[level] if level < len(factors) else None,
+                   "valid": len(valid), "measured": at,
+                   "agree": sum(r.get("cause") == "agrees" for _, r in at),
+                   "worst": max(errs) if errs else None,
+                   "disagree": [(pt, r) for pt, r in at if r.get("cause") != "agrees"],
+                   "cost": cost.get((engine, dt), {}),
+                   "not_run": doc.get("not_run", {}).get(engine, {}).get(repr(dt))}
+
+
 def trusted_rows(doc: dict) -> list[list]:
     """Per engine and step: points that agree (at that step and every finer one)
     over the points where the model is valid and overturns; the worst error
     measured at that step; the disagreeing points with their cause."""
     tol = _tol(doc)
     out = []
-    for engine, steps in doc.get("steps", {}).items():
-        valid = [(pt, rows) for pt, rows in _rows_of(doc, engine)
-                 if pt["a_reference"] is not None and pt["valid"] is not False]
-        for level, dt in enumerate(steps):
-            at = [(pt, rows[level]) for pt, rows in valid if len(rows) > level]
-            agree = [r for _, r in at if r.get("cause") == "agrees"]
-            errs = [abs(r["rel_error"]) for _, r in at if r.get("rel_error") is not None
-                    and math.isfinite(r["rel_error"])]
-            bad = [f"{pt['scene']}{'' if pt['case'] == 'pendulum' else ' np'} "
-                   f"{pt['omega']:g}: {r.get('cause') or r.get('error', 'error')}"
-                   for pt, r in at if r.get("cause") != "agrees"]
-            shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
-            skipped = doc.get("not_run", {}).get(engine, {}).get(repr(dt))
-            if skipped:
-                shown = f"{skipped} jobs not run (time budget); " + shown
-            out.append([engine, f"{dt:.3g}", f"{len(agree)} / {len(valid)}",
-                        f"{100 * len(agree) / len(valid):.0f} %" if valid else "-",
-                        f"{100 * max(errs):.2g} %" if errs else "-",
-                        shown or ("none" if at else f"not run (finer step disagreed or "
-                                                    f"within {100 * tol:g} % nowhere)")])
+    for row in step_rows(doc):
+        bad = [f"{pt['scene']}{'' if pt['case'] == 'pendulum' else ' np'} "
+               f"{pt['omega']:g}: {r.get('cause') or r.get('error', 'error')}"
+               for pt, r in row["disagree"]]
+        shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
+        if row["not_run"]:
+            shown = f"{row['not_run']} jobs not run (time budget); " + shown
+        n = row["valid"]
+        out.append([row["engine"], f"{row['dt']:.3g}", f"{row['agree']} / {n}",
+                    f"{100 * row['agree'] / n:.0f} %" if n else "-",
+                    "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %",
+                    shown or ("none" if row["measured"] else
+                              f"not run (finer step disagreed or within {100 * tol:g} % "
+                              f"nowhere)")])
     return out
 
 
