@@ -190,6 +190,7 @@ def _table(head: list[str], rows: list[list]) -> str:
 def atlas_html(doc: dict, level: int = 2) -> str:
     """The atlas as an HTML fragment (headings at ``level``): what was run, the heat
     maps, the trusted region and the cost."""
+    from compare.report.atlas_findings import part_line, parts_of
     h, sub = f"h{level}", f"h{level + 1}"
     cfg = doc.get("config", {})
     ran = ", ".join(doc.get("steps", {})) or "none"
@@ -214,22 +215,27 @@ def atlas_html(doc: dict, level: int = 2) -> str:
               + "); a dot: the model does not overturn in its search range.")
     for engine in doc.get("steps", {}):
         png = base64.b64encode(heat_map_png(doc, engine)).decode()
-        parts.append(f"<{sub}>{html.escape(engine)}</{sub}><img alt='atlas heat map "
-                     f"{html.escape(engine)}' src='data:image/png;base64,{png}'>"
+        # Readable on a phone: the map keeps 600 px and scrolls sideways rather
+        # than shrinking its scene labels below legibility.
+        parts.append(f"<{sub}>{html.escape(engine)}</{sub}><div class='scroll'><img "
+                     f"style='min-width:600px' alt='atlas heat map {html.escape(engine)}' "
+                     f"src='data:image/png;base64,{png}'></div>"
                      f"<p class='small'>{html.escape(legend)}</p>")
     parts += [f"<{sub}>Trusted region per engine and step</{sub}>",
               _table(TRUSTED_HEAD, trusted_rows(doc)),
               f"<{sub}>Cost per engine and step</{sub}>", _table(COST_HEAD, cost_rows(doc)),
-              "<p>Load average " + " -> ".join(f"{x:.1f}" for x in doc.get("load_average") or [])
-              + ", "
-              f"{doc.get('workers', '?')} workers; command: "
-              f"<code>{html.escape(str(doc.get('command', '')))}</code></p>"]
+              f"<{sub}>How it was measured</{sub}><ul>"
+              + "".join(f"<li>{html.escape(part_line(p, ('', '')))}</li>" for p in parts_of(doc))
+              + "</ul>" + (f"<p>Joined by <code>{html.escape(str(doc.get('command')))}</code>"
+                           "</p>" if len(parts_of(doc)) > 1 else "")]
     return "\n".join(parts)
 
 
 STYLE = ("body{font-family:sans-serif;margin:1em;max-width:1300px}img{max-width:100%;"
          "height:auto}table{border-collapse:collapse;font-size:12px}td,th{border:1px solid "
-         "#ccc;padding:2px 6px;text-align:left;vertical-align:top}.scroll{overflow-x:auto}")
+         "#ccc;padding:2px 6px;text-align:left;vertical-align:top}.scroll{overflow-x:auto}"
+         "@media (max-width:600px){body{margin:0.4em}table{font-size:11px}"
+         "td,th{padding:2px 3px}}")
 
 
 def write_page(doc: dict, path) -> Path:
