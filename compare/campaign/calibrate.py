@@ -90,7 +90,7 @@ class Evaluation:
     errors: tuple  # (case label, error) pairs; nan where the engine gave no answer
     engine_cpu_s: float  # the engine runs' own CPU, measured inside each run
     cpu_s: float  # the whole evaluation, reference runs and measurement included
-    simulated_s: float  # 0 when the metric does not sum simulated time (thresholds)
+    simulated_s: float  # simulated seconds of every engine run of the evaluation
     runs: int
 
     @property
@@ -192,15 +192,17 @@ def _restitution(engine, scene, vs: ValidationSet, options):
 def _thresholds(engine, scene, reference, options, workers):
     from compare.measure.engine_spectrum import engine_spectrum
     es = engine_spectrum(engine, scene, reference, workers=workers, **options)
-    errors, engine_cpu, runs = [], 0.0, 0
+    errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for curve, points in es.curves.items():
         for p in points:
             runs += p.n_runs
             engine_cpu += p.cpu_s
+            if math.isfinite(p.point.sim_s):  # NaN: served by the store (bypassed here)
+                simulated += p.point.sim_s
             if p.cause == "model":  # the model cannot judge the engine there
                 continue
             errors.append((f"{curve} Omega {p.omega:g}", abs(p.rel_error)))
-    return errors, engine_cpu, 0.0, runs
+    return errors, engine_cpu, simulated, runs
 
 
 def _histories(engine, scene, vs: ValidationSet, options):

@@ -73,3 +73,15 @@ def test_calibrate_door(argv, words, capsys):
     assert main(["calibrate", "--engine", "pymunk", *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and words in err[0]
+
+
+def test_threshold_calibration_measures_its_cost_per_simulated_second():
+    # One frequency, both curves, one coarse step: the robust search's runs are
+    # counted, their CPU and simulated time summed, so the real-time factor is the
+    # engine's own (a threshold search simulates seconds per probe).
+    cal = calibrate("pymunk", "thresholds", validation=ValidationSet(omegas=(12.0,)),
+                    space={"dt": [2e-3]})
+    (ev,) = cal.evaluations
+    assert {label for label, _ in ev.errors} <= {"pendulum Omega 12", "no_pendulum Omega 12"}
+    assert ev.runs >= 4 and ev.simulated_s > 0
+    assert 0 < ev.engine_cpu_s < ev.cpu_s and math.isfinite(ev.real_time_factor)
