@@ -1,5 +1,6 @@
 """The Pareto front of a calibration: CPU cost against worst error, one point per
-candidate, the front joined, the tolerance drawn and the recommendation marked."""
+candidate, the front joined, the tolerance drawn and the recommendation marked;
+candidates that gave no answer somewhere on the top edge."""
 from __future__ import annotations
 
 import math
@@ -35,9 +36,28 @@ def pareto_plot(cal, path) -> None:
         ax.scatter([rec.engine_cpu_s], [max(rec.worst_error, 1e-6)], s=140, facecolors="none",
                    edgecolors="C2", linewidths=2, label="recommended (cheapest within)",
                    zorder=4)
+    # A candidate with no answer at some point (no robust bracket: infinite worst
+    # error) is still a measured cost: drawn on the top edge, not left out.
+    lost = [e for e in cal.evaluations if not math.isfinite(e.worst_error)
+            and e.engine_cpu_s > 0]
+    if lost:
+        ax.scatter([e.engine_cpu_s for e in lost], [0.97] * len(lost), marker="^", s=40,
+                   color="C3", transform=ax.get_xaxis_transform(), clip_on=False,
+                   label="no answer at some point (no bracket)", zorder=3)
+        for e in lost:
+            ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()),
+                        (e.engine_cpu_s, 0.97), xycoords=ax.get_xaxis_transform(),
+                        textcoords="offset points", xytext=(4, -12), fontsize=8, color="C3")
     ax.margins(x=0.2, y=0.15)  # room for the labels at the ends
     ax.set_xscale("log")
     ax.set_yscale("log")
+    costs = [e.engine_cpu_s for e in pts + lost]
+    if costs:  # every candidate in view, the top-edge ones too
+        ax.set_xlim(min(costs) / 1.6, max(costs) * 1.6)
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
+    ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))  # 1-2-5 seconds, plain
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
     unit = {"restitution": "relative error vs Eq. 19/20",
             "thresholds": "relative threshold error",
             "histories": "theta RMS / alpha before the first impact"}[cal.metric]
