@@ -65,7 +65,7 @@ def _check_budget(config) -> None:
     from scenes import POINTS
 
     from compare.campaign.validation import backend_settings
-    from compare.cli.options import check_run_budget
+    from compare.cli.excitation_args import check_run_budget
 
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
     for name in config.engines:

@@ -325,7 +325,7 @@ def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
     from analytic.pulses import pulse_of
     from engines import configure
 
-    from compare.cli.options import check_run_budget
+    from compare.cli.excitation_args import check_run_budget
 
     for name in names:
         settings = configure(name, **file_options(loaded, name))
