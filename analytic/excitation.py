@@ -57,6 +57,13 @@ def _positive_factor(factor) -> float:
     return f
 
 
+def _check_amplitude(name: str, value, limit: float, unit: str) -> float:
+    x = _real(name, value)
+    if not math.isfinite(x) or abs(x) > limit:
+        raise ValueError(f"{name} must be finite with |{name}| <= {limit:.4g} {unit}, got {value!r}")
+    return x
+
+
 @dataclass(frozen=True)
 class Pulse:
     """One full cycle of ``A sin(Omega t)`` (``kind='sine'``, Eq. 22) or

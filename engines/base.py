@@ -21,9 +21,10 @@ from typing import ClassVar
 
 from analytic.bounds import required_friction
 from analytic.excitation import Pulse, SampledRecord, Still
-from analytic.pulses import MavroeidisPapageorgiou, Ricker
+from analytic.mavroeidis_papageorgiou import MavroeidisPapageorgiou
 from analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
 from analytic.parameters import Scene
+from analytic.ricker import Ricker
 from analytic.trajectory import Trajectory
 
 from .diagnostics import Diagnostics, PlaneState

@@ -140,7 +140,7 @@ class Calibration:
 
 def default_tolerance(metric: str) -> float:
     """The validation campaign's tolerance for ``metric`` (one source for both)."""
-    from compare.campaign.validation import Tolerances
+    from compare.campaign.config import Tolerances
     t = Tolerances()
     return {"restitution": t.restitution, "thresholds": t.threshold,
             "histories": t.theta_rms_first}[metric]
@@ -243,7 +243,7 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         before any run.
     tolerance : float, optional
         Largest acceptable worst error, in (0, 1]; default the validation
-        campaign's own (:class:`compare.campaign.validation.Tolerances`): 0.5 %
+        campaign's own (:class:`compare.campaign.config.Tolerances`): 0.5 %
         for restitution, 2 % for thresholds, 1e-3 alpha for histories.
     workers : int
         Processes for the threshold search.

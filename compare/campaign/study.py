@@ -233,7 +233,7 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
     for the largest pulse of the bisection): the engine's calibrated threshold
     settings, ``options`` (a settings file's table) over them, at time step ``dt``
     (0: the table's step, else the calibrated threshold step)."""
-    from compare.campaign.validation import CampaignConfig, engine_options
+    from compare.campaign.config import CampaignConfig, engine_options
     from compare.measure.engine_spectrum import pulse_settings
 
     config = CampaignConfig(engines=(engine,), engine_dt=dt or None,

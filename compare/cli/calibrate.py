@@ -8,6 +8,7 @@ import sys
 from analytic.options import MAX_ENGINE_DT
 
 from compare.cli import options as _common
+from compare.cli.excitation_args import check_run_budget
 from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
                                  envelope, info, print_json, resolve_workers, sig)
 from compare.run.jsonable import plain
@@ -97,8 +98,8 @@ def _check_budget(engine: str, space: dict, vs) -> None:
     for dt in space.get("dt", [settings.dt]):
         if not 0.0 < dt <= MAX_ENGINE_DT:
             raise ValueError(f"--dt: each step must be in (0, {MAX_ENGINE_DT:g}] s, got {dt!r}")
-        _common.check_run_budget(engine, dataclasses.replace(settings, dt=dt),
-                                 Pulse(1.0, min(vs.omegas)), option="--dt")
+        check_run_budget(engine, dataclasses.replace(settings, dt=dt),
+                         Pulse(1.0, min(vs.omegas)), option="--dt")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -16,8 +16,9 @@ import sys
 import time
 from pathlib import Path
 
+from compare.cli.excitation_args import check_run_budget
 from compare.cli.options import (add_settings_arg, add_store_args, check_output_path,
-                                 check_run_budget, settings_from_args, use_store)
+                                 settings_from_args, use_store)
 
 # Cost of one engine run [s] before the store has measured any (median of the
 # Fig. 5 threshold runs at the calibrated step on the 2-core target machine).

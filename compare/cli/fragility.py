@@ -320,7 +320,8 @@ def ida_settings(args) -> IDASettings:
 def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:
     """``trilith spectrum --record FILE``: the record's first overturning intensity
     (and islands) for each backend; ``--json`` prints them as one object."""
-    from compare.cli.options import print_json, scaled_record
+    from compare.cli.excitation_args import scaled_record
+    from compare.cli.options import print_json
     from scenes.ground_motion import load_record
     st = ida_settings(args)
     loaded = settings_from_args(args, backends[1:])

@@ -9,8 +9,9 @@ from compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, 
                            RecordSettings, check_output, default_duration, record,
                            resolve_engines)
 
-from compare.cli.options import (add_pulse_args, add_record_arg, add_scene_args, check_output_path,
-                      check_run_budget, excitation_from_args, scene_from_args)
+from compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
+                                         excitation_from_args)
+from compare.cli.options import add_scene_args, check_output_path, scene_from_args
 from compare.cli.options import add_settings_arg, file_options, settings_from_args
 
 

@@ -64,8 +64,8 @@ def _check_budget(config) -> None:
     from analytic.excitation import Pulse
     from scenes import POINTS
 
-    from compare.campaign.validation import backend_settings
-    from compare.cli.options import check_run_budget
+    from compare.campaign.config import backend_settings
+    from compare.cli.excitation_args import check_run_budget
 
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
     for name in config.engines:
@@ -100,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
     from compare.run import atomic
 
     from compare.run import runs
-    from compare.campaign.validation import CampaignConfig, run_campaign
+    from compare.campaign.config import CampaignConfig
+    from compare.campaign.validation import run_campaign
     from compare.run.provenance import collect
     from compare.report.html import write_report
 

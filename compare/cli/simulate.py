@@ -7,11 +7,12 @@ import math
 from analytic.contact_forces import violations
 
 from compare.cli.units import acceleration_text, frequency_text, velocity_text
-from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_pulse_args, add_record_arg,
-                                 add_scene_args, add_settings_arg, check_output_path,
-                                 check_run_budget, detail, envelope, excitation_from_args,
-                                 file_options, info, print_json, scene_from_args,
-                                 settings_from_args, settings_line, sig)
+from compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
+                                         excitation_from_args)
+from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_scene_args, add_settings_arg,
+                                 check_output_path, detail, envelope, file_options, info,
+                                 print_json, scene_from_args, settings_from_args, settings_line,
+                                 sig)
 from compare.run.jsonable import plain
 
 

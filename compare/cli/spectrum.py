@@ -15,6 +15,7 @@ from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_ar
                                  file_options, info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
                                  settings_line, use_store)
+from compare.cli.spectrum_plot import plot_spectrum
 from compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
@@ -158,45 +159,6 @@ def _settings(args: argparse.Namespace):
     return SpectrumSettings(**kw)
 
 
-def plot_spectrum(spec, path, validity: dict | None = None) -> None:
-    """Fig. 5 layout: both curves on top (dashed = without pendulum), Delta below;
-    the frequencies where the model is invalid on a curve's threshold run
-    (``validity``: :func:`analytic.threshold_validity.spectrum_validity`) hatched."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from compare.report.figures import shade_validity
-
-    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.4),
-                                   gridspec_kw={"height_ratios": [2, 1]})
-    for ax in (ax1, ax2):
-        shade_validity(ax, spec, validity, label=ax is ax1)
-    ax1.plot(spec.omega, spec.a_pendulum, "k-", label="with pendulum")
-    ax1.plot(spec.omega, spec.a_no_pendulum, "k--", label="without pendulum")
-    for k, jump in enumerate(spec.mode_jumps()):
-        ax1.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0,
-                    label="mode jump" if k == 0 else None)
-    ax1.set_ylabel(r"overturning amplitude $A_s$ [m/s$^2$]")
-    ax1.secondary_yaxis("right", functions=(lambda a: a / 9.80665,
-                                            lambda a: a * 9.80665)).set_ylabel("[g]")
-    ax1.secondary_xaxis("top", functions=(lambda w: w / (2 * math.pi),
-                                          lambda f: f * 2 * math.pi)).set_xlabel("f [Hz]")
-    sc = spec.scene
-    ax1.set_title(f"{spec.settings.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
-                  f"gamma={sc.gamma:g}, mu={sc.mu:g}; {spec.criterion.kind}, "
-                  f"t_max={spec.t_max}", fontsize=9)
-    ax1.legend(fontsize=8)
-    ax2.plot(spec.omega, spec.gain_percent, "k-")
-    ax2.axhline(0.0, color="0.6", lw=0.8)
-    ax2.set_xlabel(r"$\Omega$ [rad/s]")
-    ax2.set_ylabel(r"gain $\Delta$ [%]")
-    fig.tight_layout()
-    from compare.run.atomic import savefig
-    savefig(fig, path, dpi=150)
-    plt.close(fig)
-
-
 def _valid_text(validity: dict, i: int) -> str:
     """'yes', 'no' (both curves), 'no (np)' / 'no (yp)' (one), '-' (unchecked)."""
     v = {c: validity[c][i]["model_valid"] for c in ("no_pendulum", "pendulum")}
@@ -325,7 +287,7 @@ def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
     from analytic.pulses import pulse_of
     from engines import configure
 
-    from compare.cli.options import check_run_budget
+    from compare.cli.excitation_args import check_run_budget
 
     for name in names:
         settings = configure(name, **file_options(loaded, name))

@@ -54,7 +54,8 @@ import numpy as np
 
 from engines import configure, supports
 
-from compare.measure.thresholds import SEARCH, Search, ThresholdPoint, engine_threshold
+from compare.measure.threshold_point import ThresholdPoint
+from compare.measure.thresholds import SEARCH, Search, engine_threshold
 
 __all__ = ["Classification", "classify", "model_validity", "model_jump", "model_island",
            "explain_isolated", "sensitivity_detail", "PRIMARY_ORDER", "JUMP_REL"]

@@ -25,7 +25,8 @@ from engines import configure
 
 from compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
                                     sensitivity_detail)
-from compare.measure.thresholds import SEARCH, ThresholdPoint, engine_threshold
+from compare.measure.threshold_point import ThresholdPoint
+from compare.measure.thresholds import SEARCH, engine_threshold
 
 __all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "engine_points", "measure_point",
            "pulse_settings", "CAUSES", "DEFAULT_TOL", "DEFAULT_REL_TOL"]

@@ -26,6 +26,7 @@ from pathlib import Path
 from compare.run import atomic
 from compare.report import plots
 from compare.report import tables
+from compare.report import threshold_table
 from compare.report import units
 from compare.report.cells import unbroken
 from compare.report.recommend import recommendations
@@ -75,7 +76,8 @@ def render_markdown(doc: dict) -> str:
               *(f"- {r['conclusion']}" for r in doc["trust"].values()),
               "## Verdicts", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc), md=True),
               "## Overturning thresholds (away from mode jumps)",
-              tables.table(tables.HEADERS["thresholds"], tables.threshold_rows(doc), md=True)]
+              tables.table(tables.HEADERS["thresholds"], threshold_table.threshold_rows(doc),
+                           md=True)]
     if tables.jump_rows(doc):
         parts += ["## Mode-jump frequency shift", tables.table(tables.HEADERS["jumps"], tables.jump_rows(doc), md=True)]
     parts += ["## Restitution", tables.table(tables.HEADERS["restitution"], tables.restitution_rows(doc), md=True),
@@ -147,7 +149,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              f"<p class='small'>{esc(prov.get('date', 'date unknown'))}, commit "
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
              "end. Download: " + _download("trust.csv", tables.csv_text(header, rows)) + ", "
-             + _download("thresholds.csv", tables.threshold_csv(doc)) + ".</p>",
+             + _download("thresholds.csv", threshold_table.threshold_csv(doc)) + ".</p>",
              f"<p class='small'>{esc(AGREEMENT_RULE)}</p>",
              *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> "
                f"{unbroken(esc(r['conclusion']))}</p>" for r in doc["trust"].values()),
@@ -163,7 +165,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              "prints as |e| ≤ that width.</p>",
              figs((d, f"thresholds on the spectrum {case}, with error panel")
                   for case, d in plots.spectra_figures(doc)),
-             tables.table(tables.HEADERS["thresholds"], tables.threshold_rows(doc))]
+             tables.table(tables.HEADERS["thresholds"], threshold_table.threshold_rows(doc))]
     conv = plots.convergence_figure(doc)
     body.append("<h3>Step convergence of the failing points</h3>")
     body.append(figs([(conv, "threshold error vs time step")]) if conv else
@@ -254,6 +256,6 @@ def write_report(result, out_dir, provenance: dict | None = None,
     atomic.write_text(paths["json"], json.dumps(doc, indent=1, allow_nan=False))
     atomic.write_text(paths["md"], render_markdown(doc))
     atomic.write_text(paths["trust_csv"], tables.csv_text(*tables.trust_rows(doc)))
-    atomic.write_text(paths["thresholds_csv"], tables.threshold_csv(doc))
+    atomic.write_text(paths["thresholds_csv"], threshold_table.threshold_csv(doc))
     atomic.write_text(paths["html"], render_html(doc, result.histories, alphas))
     return paths

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["G", "accel", "freq", "rel_error", "resolution_pct", "period"]
+__all__ = ["G", "TWO_PI", "accel", "freq", "rel_error", "resolution_pct", "period"]
 
 G = 9.80665  # m/s^2: standard gravity, the unit of "g" beside an acceleration
+TWO_PI = 2.0 * math.pi  # rad per cycle: Hz beside an angular frequency
 
 
 def _finite(x) -> bool:
