@@ -186,6 +186,9 @@ def conclusion(engine: str, row: dict) -> str:
     name = f"{label(engine)} ({row.get('version', 'unknown')})"
     dt = row["settings"].get("dt")
     head = f"{name}" + (f" at dt = {fmt_sci(dt)} s" if dt is not None else "")
+    t_dt = row.get("threshold_dt")
+    if dt is not None and t_dt is not None and t_dt != dt:  # its calibrated threshold step
+        head += f" (threshold searches at {fmt_sci(t_dt)} s, docs/calibrate.md)"
     good, bad = [], []
     for key, what in (("restitution_eq20", "restitution against Eq. 20"),
                       ("restitution_eq19", "restitution against Eq. 19")):
