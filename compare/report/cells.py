@@ -17,8 +17,10 @@ def _cell(text: str, ok: bool | None = None, details: str = "") -> dict:
 # A cell's short text within a few words; the full sentence goes in its details.
 _CAUSES = {"agrees": "agrees", "model": "model invalid here (no engine to blame)",
            "no-bracket": "no overturn near the model's", "window": "model's overturning window",
-           "contact": "engine contact broke", "jump": "next to a mode jump",
-           "unknown": "cause not measured", "discretisation": "time step too coarse"}
+           "contact": "engine's contact model, not its step", "jump": "next to a mode jump",
+           "unknown": "cause not measured", "discretisation": "time step too coarse",
+           "iterations": "too few solver iterations", "collapse": "engine's frame broke",
+           "sensitivity": "flips under a 1e-4 nudge"}
 
 
 def cause_phrase(cause: str | None) -> str:

@@ -228,7 +228,7 @@ def test_recommendation_names_the_excluded_engine_with_its_number(synthetic):
     # Synthetic PyBullet misses a threshold by -6.6 % (cause contact): not recommended.
     assert "Pymunk at dt = 1e-4 s" in thresholds
     first = doc["trust"]["pybullet"]["thresholds"]["first_disagreement"]
-    assert (f"not PyBullet (-6.6 % at Ω = {first['omega']:g} rad/s, engine contact broke)"
+    assert (f"not PyBullet (-6.6 % at Ω = {first['omega']:g} rad/s, engine's contact model, not its step)"
             in thresholds)
     eq19 = next(line for line in lines if line.startswith("Restitution with the pendulum"))
     assert "not PyBullet (off by 0.6 %" in eq19
