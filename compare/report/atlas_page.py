@@ -18,7 +18,9 @@ import io
 import math
 from pathlib import Path
 
-__all__ = ["CAUSE_SYMBOL", "step_rows", "trusted_rows", "cost_rows", "heat_map_png", "atlas_html",
+from compare.report.trust import label
+
+__all__ = ["CAUSE_SYMBOL", "step_rows", "trusted_rows", "parts_of", "part_line", "cost_rows", "heat_map_png", "atlas_html",
            "write_page"]
 
 CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
@@ -86,6 +88,29 @@ def trusted_rows(doc: dict) -> list[list]:
                               f"not run (finer step disagreed or within {100 * tol:g} % "
                               f"nowhere)")])
     return out
+
+
+def parts_of(doc: dict) -> list[dict]:
+    """The separately measured parts of an atlas (one, when it was measured whole)."""
+    return doc.get("parts") or [{"engines": list(doc.get("steps", {})),
+                                 **{k: doc.get(k) for k in ("command", "provenance", "wall_s",
+                                                            "parent_cpu_s", "load_average",
+                                                            "workers")}}]
+
+
+def part_line(part: dict, code=("`", "`")) -> str:
+    """One part's engines, command (between ``code`` marks), date, commit, workers,
+    load average and cost."""
+    prov = part.get("provenance") or {}
+    load = part.get("load_average") or []
+    when = prov.get("date", "date not recorded")
+    commit = str(prov.get("commit") or "")[:12] or "not recorded"
+    return (f"{', '.join(label(e) for e in part['engines'])}: {code[0]}{part.get('command')}"
+            f"{code[1]}"
+            f" ({when}, commit {code[0]}{commit}{code[1]}, {part.get('workers', '?')} worker(s), load average "
+            + (" -> ".join(f"{x:.1f}" for x in load) or "?")
+            + f", {part.get('parent_cpu_s') or 0:.0f} CPU s in the process, "
+              f"{(part.get('wall_s') or 0) / 60:.0f} min wall)")
 
 
 def cost_rows(doc: dict) -> list[list]:
@@ -190,7 +215,6 @@ def _table(head: list[str], rows: list[list]) -> str:
 def atlas_html(doc: dict, level: int = 2) -> str:
     """The atlas as an HTML fragment (headings at ``level``): what was run, the heat
     maps, the trusted region and the cost."""
-    from compare.report.atlas_findings import part_line, parts_of
     h, sub = f"h{level}", f"h{level + 1}"
     cfg = doc.get("config", {})
     ran = ", ".join(doc.get("steps", {})) or "none"
