@@ -46,6 +46,8 @@ METRICS = ("restitution", "thresholds", "histories")
 # Multiples of an engine's calibrated step tried by default: thresholds were seen
 # to tolerate 10x (Pymunk's Fig. 5 spectrum at 1e-3 s kept 53 of 56 thresholds).
 DT_FACTORS = (1.0, 2.0, 5.0, 10.0)
+# Every candidate costs a whole validation set: a search is refused above this.
+MAX_CANDIDATES = 64
 
 
 @dataclass(frozen=True)
@@ -157,13 +159,16 @@ def pareto_front(evaluations) -> list:
     return front
 
 
-def default_space(engine: str) -> dict:
-    """``{'dt': [...]}``: the engine's calibrated step times :data:`DT_FACTORS`, plus
-    the engine's own declared search ranges (``calibration_space`` on its class)."""
+def default_space(engine: str, step_only: bool = False) -> dict:
+    """``{'dt': [...], ...}``: the engine's calibrated step times :data:`DT_FACTORS`,
+    plus (unless ``step_only``) the engine's own declared search ranges
+    (``calibration_space`` on its class: each includes the calibrated default)."""
     import engines
     base = engines.configure(engine)
     space = {"dt": [base.dt * f for f in DT_FACTORS]}
-    space.update(getattr(engines.get_backend(engine), "calibration_space", {}) or {})
+    if not step_only:
+        space.update({name: list(values) for name, values in
+                      (getattr(engines.get_backend(engine), "calibration_space", {}) or {}).items()})
     return space
 
 

@@ -39,7 +39,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              + ", ".join(f"{f:g}" for f in DT_FACTORS) + ")")
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=V1,V2,...",
                         help="another setting of the engine to try at these values (repeat "
-                             "for several; every combination is evaluated)")
+                             "for several; every combination is evaluated); replaces the "
+                             "engine's own declared range for that setting")
+    parser.add_argument("--step-only", action="store_true",
+                        help="search the time step only: leave out the engine's declared "
+                             "ranges of its other settings (docs/calibrate.md)")
     parser.add_argument("--omega", default=None, metavar="W1,W2,...",
                         help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18)")
     add_workers_arg(parser)
@@ -65,8 +69,8 @@ def _number(text: str, option: str) -> float | int:
 
 
 def _space(args, engine: str) -> dict:
-    from compare.campaign.calibrate import default_space
-    space = default_space(engine)
+    from compare.campaign.calibrate import MAX_CANDIDATES, default_space
+    space = default_space(engine, step_only=args.step_only)
     if args.dt is not None:
         space["dt"] = [float(_number(v.strip(), "--dt")) for v in args.dt.split(",") if v.strip()]
     for item in args.vary:
@@ -81,8 +85,9 @@ def _space(args, engine: str) -> dict:
     if any(not v for v in space.values()):
         raise ValueError("--dt/--vary: give at least one value")
     n = math.prod(len(v) for v in space.values())
-    if n > 64:
-        raise ValueError(f"--dt/--vary: {n} combinations; at most 64 per calibration")
+    if n > MAX_CANDIDATES:
+        raise ValueError(f"--dt/--vary: {n} combinations; at most {MAX_CANDIDATES} per "
+                         "calibration")
     return space
 
 
@@ -173,6 +178,8 @@ def _command(args, engine: str, scene: str) -> str:
     words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance")
               if getattr(args, k) is not None]
     words += [f"--vary {v}" for v in args.vary]
+    if args.step_only:
+        words.append("--step-only")
     return " ".join(words)
 
 

@@ -214,6 +214,9 @@ class MujocoEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    # `trilith calibrate`'s search beside the step: the contact time constant (solref),
+    # in steps; MuJoCo requires at least 2 for stability (default 3).
+    calibration_space = {"timeconst_steps": (2.0, 3.0, 5.0)}
     Settings = Settings
 
     @classmethod

@@ -162,6 +162,9 @@ class PyBulletEngine(Engine):
     # friction 1 lets the pivots slide by 7 mm before the trilith passes alpha,
     # the bound (2.55, times the margin) keeps it below 1 um.
     default_friction = 1.0
+    # `trilith calibrate`'s search beside the step: more solver iterations, a stiffer
+    # position correction (defaults first; both within Bullet's documented ranges).
+    calibration_space = {"solver_iterations": (50, 100), "contact_erp": (0.2, 0.4)}
     known_failures = {"restitution_eq19_lam7": "Eq. 19 at lam 7: ~1.2 % (first four impacts "
                       "from alpha/2, 2026-11-23): the two columns land one step apart "
                       "(docs/engine-trust.md)"}

@@ -108,6 +108,9 @@ class PymunkEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    # `trilith calibrate`'s search beside the step: more iterations, a ten times looser
+    # collision slop (defaults first).
+    calibration_space = {"iterations": (30, 60), "slop_fraction": (1e-4, 1e-3)}
     Settings = Settings
 
     @classmethod

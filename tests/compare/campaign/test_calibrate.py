@@ -66,8 +66,11 @@ def test_restitution_calibration_prefers_the_step_that_meets_eq20():
     (["--vary", "iterations"], "--vary must be NAME=V1,V2"),
     (["--dt", "1e-4,abc"], "--dt: 'abc' is not a number"),
     (["--vary", "bogus=1,2"], "has no option 'bogus'"),
+    (["--step-only", "--dt", "1e-4,2e-4,3e-4,4e-4,5e-4,6e-4,7e-4,8e-4,9e-4", "--vary",
+      "iterations=" + ",".join(str(i) for i in range(10, 18))], "72 combinations"),
+    # Pymunk's declared slop range doubles the search: 9 x 8 x 2.
     (["--dt", "1e-4,2e-4,3e-4,4e-4,5e-4,6e-4,7e-4,8e-4,9e-4", "--vary", "iterations=" +
-      ",".join(str(i) for i in range(10, 18))], "72 combinations"),
+      ",".join(str(i) for i in range(10, 18))], "144 combinations"),
 ])
 def test_calibrate_door(argv, words, capsys):
     assert main(["calibrate", "--engine", "pymunk", *argv]) == 2
@@ -85,3 +88,24 @@ def test_threshold_calibration_measures_its_cost_per_simulated_second():
     assert {label for label, _ in ev.errors} <= {"pendulum Omega 12", "no_pendulum Omega 12"}
     assert ev.runs >= 4 and ev.simulated_s > 0
     assert 0 < ev.engine_cpu_s < ev.cpu_s and math.isfinite(ev.real_time_factor)
+
+
+@pytest.mark.parametrize("engine", ["pybullet", "pymunk", "mujoco", "dart", "drake"])
+def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
+    # calibrate's default space: the step times 1, 2, 5, 10 and the engine's own
+    # declared ranges; each value must be one its Settings accept, the calibrated
+    # default among them (so the search can answer "keep the defaults").
+    import dataclasses
+
+    import engines
+    from compare.campaign.calibrate import MAX_CANDIDATES, default_space
+    space = default_space(engine)
+    defaults = engines.configure(engine)
+    for name, values in space.items():
+        if name == "dt":
+            continue
+        assert getattr(defaults, name) in values, (engine, name)
+        for v in values:
+            assert getattr(engines.configure(engine, **{name: v}), name) == v
+    assert math.prod(len(v) for v in space.values()) <= MAX_CANDIDATES
+    assert set(space) <= {f.name for f in dataclasses.fields(defaults)}

@@ -18,7 +18,7 @@ def doc() -> dict:
     return json.loads(ATLAS.read_text(encoding="utf-8"))
 
 
-@pytest.mark.parametrize("name", ["README.md", "docs/engine-trust.md"])
+@pytest.mark.parametrize("name", ["README.md", "docs/engine-trust.md", "docs/atlas.md"])
 def test_block_is_generated_from_the_stored_atlas(doc, name):
     text = (ROOT / name).read_text(encoding="utf-8")
     assert text.count(ATLAS_BEGIN) == 1 and text.count(ATLAS_END) == 1
@@ -26,7 +26,7 @@ def test_block_is_generated_from_the_stored_atlas(doc, name):
     assert block == render_atlas(doc), (
         f"{name} differs from docs/validation/atlas.json; run: python -m "
         "compare.report.atlas_findings docs/validation/atlas.json README.md "
-        "docs/engine-trust.md")
+        "docs/engine-trust.md docs/atlas.md")
 
 
 def test_block_counts_what_the_atlas_holds(doc):
