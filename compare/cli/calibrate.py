@@ -192,12 +192,13 @@ def _print(cal) -> None:
     load = ", ".join(f"{x:.2f}" for x in cal.load_average)
     print(f"{cal.engine} ({cal.version}), metric {cal.metric}, tolerance {cal.tolerance:g}, "
           f"load average {load}")
-    print(f"{'settings':<30} {'worst error':>11} {'engine CPU [s]':>14} {'CPU/sim s':>9} "
+    width = max([30] + [len(_label(e.options)) for e in cal.evaluations])
+    print(f"{'settings':<{width}} {'worst error':>11} {'engine CPU [s]':>14} {'CPU/sim s':>9} "
           f"{'all CPU [s]':>11} {'runs':>5}")
     for e in sorted(cal.evaluations, key=lambda e: e.engine_cpu_s):
         mark = ("<- recommended" if e is rec else "front" if id(e) in front else "")
         rtf = e.real_time_factor
-        print(f"{_label(e.options):<30} {e.worst_error:11.3g} {e.engine_cpu_s:14.3g} "
+        print(f"{_label(e.options):<{width}} {e.worst_error:11.3g} {e.engine_cpu_s:14.3g} "
               f"{(f'{rtf:.3g}' if math.isfinite(rtf) else '-'):>9} {e.cpu_s:11.3g} "
               f"{e.runs:5d}  {mark}")
     if rec is None:

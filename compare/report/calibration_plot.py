@@ -25,10 +25,13 @@ def pareto_plot(cal, path) -> None:
     if front:
         ax.plot([e.engine_cpu_s for e in front], [max(e.worst_error, 1e-6) for e in front], "-o",
                 color="C0", ms=5, lw=1.5, label="Pareto front", zorder=3)
-    for e in pts:
-        ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()), (e.engine_cpu_s,
-                    max(e.worst_error, 1e-6)), textcoords="offset points", xytext=(5, 4),
-                    fontsize=8, color="0.25")
+    # One setting per line; neighbours alternate above and below their point, so
+    # candidates that differ in one setting only keep readable labels.
+    for k, e in enumerate(sorted(pts, key=lambda e: e.engine_cpu_s)):
+        ax.annotate("\n".join(f"{name} {v:g}" for name, v in e.options.items()),
+                    (e.engine_cpu_s, max(e.worst_error, 1e-6)), textcoords="offset points",
+                    xytext=(5, 4) if k % 2 == 0 else (5, -4),
+                    va="bottom" if k % 2 == 0 else "top", fontsize=7, color="0.25")
     ax.axhline(cal.tolerance, color="C3", ls="--", lw=1.2,
                label=f"tolerance {cal.tolerance:g}")
     rec = cal.recommended
