@@ -148,8 +148,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     """Measure the atlas (module docstring); returns the ``atlas.json`` document.
 
     ``budget_s``: wall seconds after which no new chunk of engine jobs starts
-    (the model's references and validity are always complete); the jobs left are
-    counted in ``not_run`` per engine and step, and those points carry no row
+    (the model's references and validity are always complete); the points whose
+    job was left are counted in ``not_run`` per engine and step, and carry no row
     for that step (nor for any coarser one).
     """
     from compare.campaign.study import run_reference, run_threshold, threshold_description

@@ -73,9 +73,11 @@ def render_atlas(doc: dict) -> str:
         per_job, per_sim = row["cost"].get("cpu_s_per_point"), row["cost"].get("cpu_s_per_sim_s")
         causes = Counter((_figure(pt["scene"]), r.get("cause") or "error")
                          for pt, r in row["disagree"])
-        where = _causes_text(causes) + (f"; {row['not_run']} jobs not run (time budget)"
+        where = _causes_text(causes) + (f"; {row['not_run']} points not run (time budget)"
                                         if row["not_run"] else "")
-        share = f"{100 * row['agree'] / row['valid']:.0f} %" if row["valid"] else "-"
+        # A step where nothing ran has no share (not 0 %).
+        share = (f"{100 * row['agree'] / row['valid']:.0f} %" if row["valid"] and row["measured"]
+                 else "-")
         worst = "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %"
         lines.append(f"| {name} | {row['dt']:.3g}"
                      + (f" ({row['factor']:g}x)" if row["factor"] else "")

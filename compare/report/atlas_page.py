@@ -79,10 +79,10 @@ def trusted_rows(doc: dict) -> list[list]:
                for pt, r in row["disagree"]]
         shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
         if row["not_run"]:
-            shown = f"{row['not_run']} jobs not run (time budget); " + shown
+            shown = f"{row['not_run']} points not run (time budget); " + shown
         n = row["valid"]
         out.append([row["engine"], f"{row['dt']:.3g}", f"{row['agree']} / {n}",
-                    f"{100 * row['agree'] / n:.0f} %" if n else "-",
+                    f"{100 * row['agree'] / n:.0f} %" if n and row["measured"] else "-",
                     "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %",
                     shown or ("none" if row["measured"] else
                               f"not run (finer step disagreed or within {100 * tol:g} % "
@@ -212,6 +212,16 @@ def _table(head: list[str], rows: list[list]) -> str:
     return f"<div class='scroll'><table><tr>{h}</tr>{b}</table></div>"
 
 
+def budget_text(doc: dict) -> str:
+    """Whose time budget left points unmeasured: the atlas's, or (a joined atlas) its
+    parts'."""
+    if doc.get("budget_s") is not None:
+        return f"the time budget of {doc['budget_s'] / 60:.0f} min"
+    budgets = [p["budget_s"] / 60 for p in parts_of(doc) if p.get("budget_s") is not None]
+    return ("a part's time budget (" + ", ".join(f"{b:.0f}" for b in budgets) + " min)"
+            if budgets else "a time budget")
+
+
 def atlas_html(doc: dict, level: int = 2) -> str:
     """The atlas as an HTML fragment (headings at ``level``): what was run, the heat
     maps, the trusted region and the cost."""
@@ -219,7 +229,7 @@ def atlas_html(doc: dict, level: int = 2) -> str:
     cfg = doc.get("config", {})
     ran = ", ".join(doc.get("steps", {})) or "none"
     not_run = ", ".join(doc.get("engines_not_run", [])) or "none"
-    skipped = "; ".join(f"{e} at dt {dt}: {n} jobs" for e, by in doc.get("not_run", {}).items()
+    skipped = "; ".join(f"{e} at dt {dt}: {n} points" for e, by in doc.get("not_run", {}).items()
                         for dt, n in by.items())
     n_invalid = sum(pt["valid"] is False for pt in doc["points"])
     parts = [f"<{h} id='atlas'>Trust atlas</{h}>",
@@ -230,8 +240,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              f"{html.escape(not_run)}. Tolerance {100 * _tol(doc):g} %; steps "
              f"{html.escape(str(cfg.get('factors')))} x each engine's calibrated threshold "
              "step, a coarser one only where the finer one agreed."
-             + (f" Not run (time budget of {doc['budget_s'] / 60:.0f} min reached): "
-                f"{html.escape(skipped)}." if skipped else "") + "</p>"]
+             + (f" Not run ({budget_text(doc)} reached): {html.escape(skipped)}."
+                if skipped else "") + "</p>"]
     legend = ("Colour: threshold error at the calibrated step (black lines on the bar: the "
               "tolerance); grey: the model is invalid (no engine run); a digit: the coarsest "
               "step factor that still agrees; a letter: the cause of a disagreement ("

@@ -68,6 +68,13 @@ def test_cli_joins_files_and_refuses_a_bad_one(tmp_path, capsys):
     doc = json.loads(out.read_text())
     assert list(doc["steps"]) == ["pymunk", "mujoco"] and "--from" in doc["command"]
     assert "Trusted region" in (tmp_path / "all.html").read_text()
+    # A part's time budget left points unmeasured: the joined page says whose.
+    part = _part("dart", 0.0, 1.0)
+    part.update(budget_s=600.0, not_run={"dart": {"0.001": 1}})
+    b.write_text(json.dumps(part))
+    assert main(["atlas", "--from", str(a), "--from", str(b), "--html",
+                 str(tmp_path / "b.html")]) == 0
+    assert "a part's time budget (10 min) reached" in (tmp_path / "b.html").read_text()
     capsys.readouterr()
     (tmp_path / "c.json").write_text(json.dumps(_part("pymunk", 0.0, 1.0)))
     assert main(["atlas", "--from", str(a), "--from", str(tmp_path / "c.json"),
