@@ -144,6 +144,7 @@ def _grid(doc: dict, engine: str, case: str):
             text[i][j] = "·"  # no overturning in the model's range
             continue
         if not rows:
+            text[i][j] = "–"  # valid, but not measured (a time budget ran out)
             continue
         first = rows[0]
         if first.get("rel_error") is not None:
@@ -185,9 +186,10 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
         for i in range(len(labels)):
             for j in range(len(omegas)):
                 if text[i][j]:
-                    bad = not text[i][j][0].isdigit()
+                    bad = not text[i][j][0].isdigit() and text[i][j] != "–"
                     ax.text(j, i, text[i][j], ha="center", va="center", fontsize=6.5,
-                            color="black", fontweight="bold" if bad else "normal")
+                            color="0.55" if text[i][j] == "–" else "black",
+                            fontweight="bold" if bad else "normal")
         ax.set_xticks(range(len(omegas)), [f"{w:g}" for w in omegas], fontsize=7)
         ax.set_yticks(range(len(labels)), labels, fontsize=6.5)
         ax.set_xlabel("Ω [rad/s]")
@@ -246,7 +248,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
               "tolerance); grey: the model is invalid (no engine run); a digit: the coarsest "
               "step factor that still agrees; a letter: the cause of a disagreement ("
               + ", ".join(f"{s} {c}" for c, s in CAUSE_SYMBOL.items())
-              + "); a dot: the model does not overturn in its search range.")
+              + "); a dot: the model does not overturn in its search range; a dash: not "
+              "measured (a time budget ran out).")
     for engine in doc.get("steps", {}):
         png = base64.b64encode(heat_map_png(doc, engine)).decode()
         # Readable on a phone: the map keeps 600 px and scrolls sideways rather

@@ -151,3 +151,13 @@ def test_the_report_section_reads_the_stored_atlas(tmp_path):
     path.write_text(json.dumps(_synthetic()))
     text = stored_atlas_section(path)
     assert "id='atlas'" in text and text.count("data:image/png;base64,") == 1
+
+
+def test_a_point_left_by_the_budget_is_marked_not_measured():
+    # A valid point with no engine row was never measured: a dash, never read as
+    # an agreeing cell (blank white is the colour of a 0 % error).
+    from compare.report.atlas_page import _grid
+    doc = _synthetic()
+    doc["points"][0]["engines"]["pymunk"] = []
+    labels, omegas, err, text, invalid = _grid(doc, "pymunk", "pendulum")
+    assert text[0][0] == "–" and err[0, 0] != err[0, 0]  # NaN: nothing to colour
