@@ -144,13 +144,40 @@ def _compact(row: dict) -> dict:
     return out
 
 
+def _van_der_corput(n: int) -> list[int]:
+    """0..n-1 coarse to fine: each prefix spreads over the range (bit-reversed
+    order, e.g. 0, 8, 4, 12, 2, ... for 16)."""
+    bits = max(1, (n - 1).bit_length())
+    return sorted(range(n), key=lambda i: int(format(i, f"0{bits}b")[::-1], 2))
+
+
+def spread_order(indices: list[int], points: list[dict]) -> list[int]:
+    """``indices`` (into ``points``) reordered so that any prefix covers every scene,
+    case and pulse on a coarse Omega grid: round robin over the (scene, case,
+    pulse) groups, each group's Omegas coarse to fine.  A time budget then cuts the
+    resolution of the measured map, not whole figures."""
+    groups: dict[tuple, list[int]] = {}
+    for i in indices:
+        pt = points[i]
+        groups.setdefault((pt["scene"], pt["case"], pt["pulse"]), []).append(i)
+    queues = []
+    for members in groups.values():
+        members = sorted(members, key=lambda i: points[i]["omega"])
+        queues.append([members[k] for k in _van_der_corput(len(members))])
+    out = []
+    for rank in range(max((len(q) for q in queues), default=0)):
+        out.extend(q[rank] for q in queues if rank < len(q))
+    return out
+
+
 def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = None) -> dict:
     """Measure the atlas (module docstring); returns the ``atlas.json`` document.
 
     ``budget_s``: wall seconds after which no new chunk of engine jobs starts
     (the model's references and validity are always complete); the points whose
     job was left are counted in ``not_run`` per engine and step, and carry no row
-    for that step (nor for any coarser one).
+    for that step (nor for any coarser one).  Engine jobs run in
+    :func:`spread_order`, so a budget leaves a coarser Omega grid on every scene.
     """
     from compare.campaign.study import run_reference, run_threshold, threshold_description
     from compare.run.keys import backend_version, digest, project_version
@@ -172,7 +199,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     for i, v in zip(finite, checks):
         points[i].update(valid=v["model_valid"], model_reason=v["model_reason"])
     # Engines run where the model is valid (or its check had nothing to say).
-    todo = {e: [i for i in finite if points[i]["valid"] is not False] for e in config.engines}
+    valid = spread_order([i for i in finite if points[i]["valid"] is not False], points)
+    todo = {e: list(valid) for e in config.engines}
     steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
     not_run: dict = {e: {} for e in config.engines}
     for level, factor in enumerate(config.factors):

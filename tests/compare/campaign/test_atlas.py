@@ -73,7 +73,31 @@ def test_staged_deduplicated_resumable(store, monkeypatch):
     runs.STATS.clear()
     again = run_atlas(config)
     assert runs.STATS.get("computed", 0) == 0
-    assert [p["engines"] for p in again["points"]] == [p["engines"] for p in pts]
+    strip = [[{k: v for k, v in r.items() if k != "from_store"} for r in p["engines"]["pymunk"]]
+             for p in again["points"]]
+    assert strip == [[{k: v for k, v in r.items() if k != "from_store"}
+                      for r in p["engines"]["pymunk"]] for p in pts]
+    # The rows say who served them: computed first, the store on the rerun.
+    assert not any(r["from_store"] for p in pts for r in p["engines"]["pymunk"])
+    assert all(r["from_store"] for p in again["points"] for r in p["engines"]["pymunk"])
+
+
+def test_spread_order_covers_every_scene_before_refining_omega():
+    omegas = [4.0 + 2 * k for k in range(13)]
+    points = [{"scene": s, "case": c, "pulse": "sine", "omega": w}
+              for s in ("a", "b", "c") for c in ("pendulum", "no_pendulum") for w in omegas]
+    order = atlas.spread_order(list(range(len(points))), points)
+    assert sorted(order) == list(range(len(points)))  # a permutation: nothing lost
+    groups = {(p["scene"], p["case"]) for p in points}
+    # A budget that stops after one job per group has touched every scene and case ...
+    assert {(points[i]["scene"], points[i]["case"]) for i in order[:6]} == groups
+    # ... and after four per group each has Omegas spread over the range, not its
+    # four lowest (coarse to fine: the gaps are at most a quarter of the range plus).
+    for g in groups:
+        first = sorted(points[i]["omega"] for i in order[:24]
+                       if (points[i]["scene"], points[i]["case"]) == g)
+        assert len(first) == 4 and first[0] == 4.0 and first[-1] >= 20.0
+        assert max(b - a for a, b in zip(first, first[1:])) <= 8.0
 
 
 def test_a_time_budget_records_the_jobs_it_did_not_run(store, monkeypatch):
