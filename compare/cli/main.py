@@ -85,6 +85,8 @@ class _Parser(_OneLineErrors, argparse.ArgumentParser):
                            default=0, help="print only results and errors")
         group.add_argument("-v", "--verbose", dest="verbosity", action="store_const", const=1,
                            help="also print timings, engine versions and settings")
+        # The provenance block writes the run's command with this parser's flags.
+        self.set_defaults(_parser=self)
 
 
 class _TopParser(_OneLineErrors, argparse.ArgumentParser):

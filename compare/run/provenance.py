@@ -36,21 +36,46 @@ def git_commit(root: Path = _ROOT) -> str:
 def command_line(args: argparse.Namespace | None, prog: str = "trilith") -> str:
     """The equivalent command line of a parsed ``trilith`` command: every option
     with its value (defaults included), so the line reproduces the run even
-    when the defaults change later.  Without ``args``: this process's argv."""
+    when the defaults change later.  Without ``args``: this process's argv.
+
+    With the subcommand's parser on ``args._parser`` (the CLI puts it there) the
+    flags are the parser's own (``-q`` for a quiet run, ``--no-cache``); without
+    it each attribute ``name`` is written ``--name``.
+    """
     if args is None:
         return shlex.join([Path(sys.argv[0]).name, *sys.argv[1:]])
-    opts = {k: v for k, v in vars(args).items() if k not in ("command", "func")}
+    parser = getattr(args, "_parser", None)
     words = [prog, getattr(args, "command", None) or ""]
-    for key, value in opts.items():
-        flag = "--" + key.replace("_", "-")
-        if value is None or value is False:
+    if parser is None:
+        opts = {k: v for k, v in vars(args).items() if k not in ("command", "func")}
+        for key, value in opts.items():
+            words += _option_words("--" + key.replace("_", "-"), value)
+        return shlex.join(w for w in words if w)
+    for action in parser._actions:  # the parser's own record of its options
+        if isinstance(action, (argparse._HelpAction, argparse._VersionAction)):
             continue
-        if isinstance(value, list):  # a repeated option (action="append")
-            for item in value:
-                words += [flag, str(item)]
-        else:
-            words += [flag] if value is True else [flag, str(value)]
+        value = getattr(args, action.dest, None)
+        if not action.option_strings:  # a positional argument
+            words += [str(v) for v in value] if isinstance(value, list) else \
+                [] if value is None else [str(value)]
+            continue
+        flag = max(action.option_strings, key=len)
+        if isinstance(action, argparse._StoreConstAction):  # also store_true/false
+            if value == action.const and value != action.default:
+                words.append(flag)
+            continue
+        words += _option_words(flag, value)
     return shlex.join(w for w in words if w)
+
+
+def _option_words(flag: str, value) -> list[str]:
+    if value is None or value is False:
+        return []
+    if value is True:
+        return [flag]
+    if isinstance(value, list):  # a repeated option (action="append") or nargs
+        return [w for item in value for w in (flag, str(item))]
+    return [flag, str(value)]
 
 
 def _version(module: str) -> str:
