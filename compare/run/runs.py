@@ -271,10 +271,23 @@ def _connect(address: str):
     """A Dask client of ``address``; ``ValueError`` when no scheduler answers within
     :data:`CONNECT_TIMEOUT_S` (something else listening there can hold a
     connection open without ever answering, so the wait is bounded here)."""
+    import socket
     import threading
+    from urllib.parse import urlsplit
 
     from distributed import Client
 
+    # A refused TCP connection is final: say so at once rather than after the
+    # client's retries have used up the timeout.
+    where = urlsplit(address)
+    if where.scheme in ("tcp", "") and where.hostname and where.port:
+        try:
+            socket.create_connection((where.hostname, where.port), timeout=2.0).close()
+        except ConnectionRefusedError as exc:
+            raise ValueError(f"--scheduler: no Dask scheduler at {address!r} "
+                             f"(connection refused: {exc.strerror})") from None
+        except OSError:  # unreachable or slow: the client's bounded wait decides
+            pass
     box: dict = {}
 
     def connect():
