@@ -4,7 +4,10 @@
 measures every engine's first-overturning amplitude against the model's on the
 scenes of Figs. 8-11, Omega 4..28 rad/s by 2, at each engine's calibrated
 threshold step and 2x, 5x, 10x coarser, through the run store (killed, it
-resumes).  ``--from FILE`` renders a stored atlas without running anything;
+resumes).  The default engines leave out DART and Drake, whose calibrated
+threshold steps are fine enough that their atlas costs hours of CPU (measured in
+docs/atlas.md): name them (``--engine dart,drake`` or ``--engine all``),
+best with ``--time-budget`` or ``--scheduler``.  ``--from FILE`` renders a stored atlas without running anything;
 repeated, it joins atlases of different engines measured separately
 (``compare/campaign/atlas_merge.py``).
 """
