@@ -23,7 +23,9 @@ per engine and per *metric*, on a stated validation set:
 
 Every candidate (the product of the values in the search space) is evaluated on
 the whole set with the store bypassed, so that every cost is what the runs cost on
-this machine now.  Two costs are kept: the engine's own (``engine_cpu_s``, the CPU
+the machine that ran them.  Each finished candidate is then kept in the run store
+(when one is active): a killed calibration resumes at the next candidate, and a
+served candidate (``from_store``) keeps the costs measured when it ran.  Two costs are kept: the engine's own (``engine_cpu_s``, the CPU
 seconds each engine run measured inside its stepping loop, summed: what a user of
 these settings pays) and the whole evaluation's (``cpu_s``: this process and the
 workers it reaped, including the model's reference runs and the measurement).  The
@@ -32,6 +34,7 @@ candidate within the tolerance.
 """
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import os
@@ -94,6 +97,7 @@ class Evaluation:
     cpu_s: float  # the whole evaluation, reference runs and measurement included
     simulated_s: float  # simulated seconds of every engine run of the evaluation
     runs: int
+    from_store: bool = False  # served by the run store: its costs are those measured then
 
     @property
     def real_time_factor(self) -> float:
@@ -105,7 +109,7 @@ class Evaluation:
                 "errors": [list(e) for e in self.errors], "engine_cpu_s": self.engine_cpu_s,
                 "cpu_s": self.cpu_s,
                 "simulated_s": self.simulated_s, "real_time_factor": self.real_time_factor,
-                "runs": self.runs}
+                "runs": self.runs, "from_store": self.from_store}
 
 
 @dataclass
@@ -279,25 +283,47 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         engines.configure(engine, **cand)
     cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
                       load_average=os.getloadavg())
-    with runs.using(None):  # measured costs: nothing served from a store
-        reference = None
-        if metric == "thresholds":  # the model's spectrum, once for every candidate
-            from analytic.spectrum import overturning_spectrum
-            reference = overturning_spectrum(scene, list(vs.omegas))
-        for i, cand in enumerate(candidates):
+    reference: list = []  # the model's spectrum, once, only if a candidate needs it
+
+    def evaluate(cand: dict) -> Evaluation:
+        with runs.using(None):  # measured costs: no run inside served from a store
+            if metric == "thresholds" and not reference:
+                from analytic.spectrum import overturning_spectrum
+                reference.append(overturning_spectrum(scene, list(vs.omegas)))
             cpu0 = cpu_seconds()
             if metric == "restitution":
                 errors, engine_cpu, simulated, n = _restitution(engine, scene, vs, cand)
             elif metric == "thresholds":
-                errors, engine_cpu, simulated, n = _thresholds(engine, scene, reference, cand,
-                                                               workers)
+                errors, engine_cpu, simulated, n = _thresholds(engine, scene, reference[0],
+                                                               cand, workers)
             else:
                 errors, engine_cpu, simulated, n = _histories(engine, scene, vs, cand)
             values = [e for _, e in errors]
-            worst = max(values) if values and all(math.isfinite(v) for v in values) else math.inf
-            ev = Evaluation(dict(cand), worst, tuple(errors), engine_cpu, cpu_seconds() - cpu0,
-                            simulated, n)
-            cal.evaluations.append(ev)
-            if progress is not None:
-                progress(i + 1, len(candidates), ev)
+            worst = max(values) if values and all(math.isfinite(v) for v in values) \
+                else math.inf
+            return Evaluation(dict(cand), worst, tuple(errors), engine_cpu,
+                              cpu_seconds() - cpu0, simulated, n)
+
+    for i, cand in enumerate(candidates):
+        # Each finished candidate is kept whole in the run store, so a killed
+        # calibration resumes at the next one; a served candidate keeps the costs
+        # measured when it ran.
+        description = _candidate_description(engine, metric, vs, scene, cand)
+        ev = runs.lookup("calibration-candidate", description, code=runs.ALL_CODE)
+        if ev is not None:
+            ev = dataclasses.replace(ev, from_store=True)
+        else:
+            ev = runs.memo("calibration-candidate", description, lambda: evaluate(cand),
+                           label=f"calibrate {engine} {metric}", code=runs.ALL_CODE)
+        cal.evaluations.append(ev)
+        if progress is not None:
+            progress(i + 1, len(candidates), ev)
     return cal
+
+
+def _candidate_description(engine: str, metric: str, vs: ValidationSet, scene, cand: dict) -> dict:
+    """Everything that determines one candidate's evaluation (its store key)."""
+    from compare.run.keys import backend_version, scene_dict
+    return {"engine": engine, "version": backend_version(engine), "metric": metric,
+            "validation": dataclasses.asdict(vs), "scene": scene_dict(scene),
+            "candidate": dict(sorted(cand.items()))}

@@ -9,8 +9,9 @@ from analytic.options import MAX_ENGINE_DT
 
 from compare.cli import options as _common
 from compare.cli.excitation_args import check_run_budget
-from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_workers_arg, check_output_path,
-                                 envelope, info, print_json, resolve_workers, sig)
+from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_store_args, add_workers_arg,
+                                 check_output_path, envelope, info, print_json, resolve_workers,
+                                 sig, use_store)
 from compare.run.jsonable import plain
 
 
@@ -47,6 +48,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--omega", default=None, metavar="W1,W2,...",
                         help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18)")
     add_workers_arg(parser)
+    add_store_args(parser)
     parser.add_argument("--json", metavar="FILE", help="write every evaluation as JSON")
     parser.add_argument("--csv", metavar="FILE", help="write every evaluation as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the Pareto front plot")
@@ -130,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
             check_output_path(path, option)
     if args.plot is not None:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    use_store(args)
     bar = None
     if sys.stderr.isatty() and _common.VERBOSITY >= 0:
         from tqdm import tqdm
@@ -201,6 +204,10 @@ def _print(cal) -> None:
         print(f"{_label(e.options):<{width}} {e.worst_error:11.3g} {e.engine_cpu_s:14.3g} "
               f"{(f'{rtf:.3g}' if math.isfinite(rtf) else '-'):>9} {e.cpu_s:11.3g} "
               f"{e.runs:5d}  {mark}")
+    served = sum(e.from_store for e in cal.evaluations)
+    if served:
+        print(f"{served} of {len(cal.evaluations)} candidates served by the run store, with "
+              "the costs measured when they ran (--no-cache measures every one now)")
     if rec is None:
         print(f"no candidate meets {cal.tolerance:g}: widen the search (--dt, --vary) "
               f"or the tolerance")
@@ -210,11 +217,13 @@ def _csv(cal) -> str:
     names = list(cal.evaluations[0].options) if cal.evaluations else []
     front = {id(e) for e in cal.front}
     lines = [",".join([*names, "worst_error", "engine_cpu_s", "cpu_s", "simulated_s",
-                       "engine_cpu_per_simulated_s", "runs", "on_front", "recommended"])]
+                       "engine_cpu_per_simulated_s", "runs", "on_front", "recommended",
+                       "from_store"])]
     for e in cal.evaluations:
         lines.append(",".join([*(repr(e.options[n]) for n in names), repr(e.worst_error),
                                repr(e.engine_cpu_s), repr(e.cpu_s), repr(e.simulated_s),
                                repr(e.real_time_factor),
                                str(e.runs), str(id(e) in front).lower(),
-                               str(e is cal.recommended).lower()]))
+                               str(e is cal.recommended).lower(),
+                               str(e.from_store).lower()]))
     return "\n".join(lines) + "\n"

@@ -90,6 +90,33 @@ def test_threshold_calibration_measures_its_cost_per_simulated_second():
     assert 0 < ev.engine_cpu_s < ev.cpu_s and math.isfinite(ev.real_time_factor)
 
 
+def test_a_calibration_resumes_from_the_store_with_its_measured_costs(tmp_path, monkeypatch):
+    from compare.campaign import calibrate as module
+    from compare.run import runs
+    from compare.run.store import RunStore
+
+    vs = ValidationSet(omegas=(12.0,))
+    space = {"dt": [2e-3, 1e-3]}
+    previous = runs.activate(RunStore(tmp_path / "store"))
+    try:
+        first = calibrate("pymunk", "thresholds", validation=vs, space=space)
+        assert not any(e.from_store for e in first.evaluations)
+
+        # A rerun (e.g. after kill -9) evaluates nothing again ...
+        def no_engine(*args, **kwargs):
+            raise AssertionError("a stored candidate was evaluated again")
+        monkeypatch.setattr(module, "_thresholds", no_engine)
+        again = calibrate("pymunk", "thresholds", validation=vs, space=space)
+    finally:
+        runs.activate(previous)
+    # ... and reports the errors and the costs that were measured, saying so.
+    assert all(e.from_store for e in again.evaluations)
+    keep = ("options", "worst_error", "errors", "engine_cpu_s", "cpu_s", "simulated_s", "runs")
+    assert [[getattr(e, k) for k in keep] for e in again.evaluations] == \
+        [[getattr(e, k) for k in keep] for e in first.evaluations]
+    assert again.recommended.options == first.recommended.options
+
+
 @pytest.mark.parametrize("engine", ["pybullet", "pymunk", "mujoco", "dart", "drake"])
 def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
     # calibrate's default space: the step times 1, 2, 5, 10 and the engine's own
