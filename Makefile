@@ -15,8 +15,11 @@ $(STAMP): pyproject.toml
 report: $(STAMP)
 	$(VENV)/bin/trilith report --out report
 
+# Test files are shared among TEST_WORKERS processes (pytest-xdist), a file's
+# tests on one of them so its module fixtures are computed once.
+TEST_WORKERS ?= 2
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 bench: $(STAMP)
 	$(PY) -m benchmarks.run
