@@ -137,7 +137,7 @@ def _write_json(path: str, doc: dict) -> None:
 def _print(doc: dict) -> None:
     """The trusted region per engine and step, one line each."""
     from compare.report.atlas_page import trusted_rows
-    print("engine, step [s]: points that agree / valid points (share), worst |error|; "
+    print("engine, step [s]: points that agree / valid points reached (share), worst |error|; "
           "where not", file=sys.stdout)
     for engine, dt, agree, share, worst, where in trusted_rows(doc):
         print(f"{engine}, {dt}: {agree} ({share}), {worst}; {where}", file=sys.stdout)

@@ -17,7 +17,7 @@ from collections import Counter
 from pathlib import Path
 
 from compare.campaign.atlas import FIGURE
-from compare.report.atlas_page import part_line, parts_of, step_rows
+from compare.report.atlas_page import part_line, parts_of, reached_text, step_rows
 from compare.report.trust import label
 
 __all__ = ["render_atlas", "ATLAS_BEGIN", "ATLAS_END", "main"]
@@ -63,8 +63,9 @@ def render_atlas(doc: dict) -> str:
              f"its search range at {n_valid} valid points. An engine agrees at a point when "
              f"its robust threshold bracket is within {100 * tol:g} % of the model's, at that "
              "step and every finer one (a coarser step runs only where the finer one "
-             "agreed).", "",
-             "| engine | step [s] | agree / valid points | share | worst \\|error\\| at the "
+             "agreed); the share counts the valid points the run reached (a time budget "
+             "can leave some, stated per row).", "",
+             "| engine | step [s] | agree / valid points reached | share | worst \\|error\\| at the "
              "step | disagreements (figure: cause count) | CPU s per threshold job | CPU s "
              "per simulated s |",
              "|---|---|---|---|---|---|---|---|"]
@@ -76,12 +77,12 @@ def render_atlas(doc: dict) -> str:
         where = _causes_text(causes) + (f"; {row['not_run']} points not run (time budget)"
                                         if row["not_run"] else "")
         # A step where nothing ran has no share (not 0 %).
-        share = (f"{100 * row['agree'] / row['valid']:.0f} %" if row["valid"] and row["measured"]
-                 else "-")
+        share = (f"{100 * row['agree'] / row['reached']:.0f} %"
+                 if row["reached"] and row["measured"] else "-")
         worst = "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %"
         lines.append(f"| {name} | {row['dt']:.3g}"
                      + (f" ({row['factor']:g}x)" if row["factor"] else "")
-                     + f" | {row['agree']} / {row['valid']} | {share} | {worst} | "
+                     + f" | {reached_text(row)} | {share} | {worst} | "
                      + (where if row["measured"] else "not run") + " | "
                      + ("-" if per_job is None else f"{per_job:.3g}") + " | "
                      + ("-" if per_sim is None else f"{per_sim:.3g}") + " |")

@@ -20,13 +20,13 @@ from pathlib import Path
 
 from compare.report.trust import label
 
-__all__ = ["CAUSE_SYMBOL", "step_rows", "trusted_rows", "parts_of", "part_line", "cost_rows", "heat_map_png", "atlas_html",
+__all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line", "cost_rows", "heat_map_png", "atlas_html",
            "write_page"]
 
 CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
                 "discretisation": "D", "iterations": "I", "contact": "K", "sensitivity": "S",
                 "unknown": "?"}
-TRUSTED_HEAD = ["engine", "step [s]", "agree / valid points", "share", "worst |error|",
+TRUSTED_HEAD = ["engine", "step [s]", "agree / valid points reached", "share", "worst |error|",
                 "where not (scene Ω: cause)"]
 COST_HEAD = ["engine", "step [s]", "points (jobs)", "CPU s per threshold job",
              "CPU s per simulated s", "CPU s in all"]
@@ -45,14 +45,19 @@ def step_rows(doc: dict):
     (the points where the model is valid and overturns), ``measured`` (``(point,
     row)`` measured at that step: those that agreed at every finer one), ``agree``,
     ``worst`` (largest finite |error| measured at it, or None), ``disagree``
-    (``(point, row)`` that do not agree), ``cost`` (its ``cost`` entry) and
-    ``not_run`` (jobs the time budget left)."""
+    (``(point, row)`` that do not agree), ``cost`` (its ``cost`` entry),
+    ``not_run`` (points the time budget left at that step) and ``reached`` (the
+    valid points less those a budget left at that step or a finer one: the
+    points the step could be judged on)."""
     valid = [pt for pt in doc["points"] if pt["a_reference"] is not None
              and pt["valid"] is not False]
     cost = {(c["engine"], c["dt"]): c for c in doc.get("cost", [])}
     factors = doc.get("config", {}).get("factors", [])
     for engine, steps in doc.get("steps", {}).items():
+        left = 0
         for level, dt in enumerate(steps):
+            not_run = doc.get("not_run", {}).get(engine, {}).get(repr(dt))
+            left += not_run or 0
             at = [(pt, pt["engines"][engine][level]) for pt in valid
                   if len(pt["engines"].get(engine, [])) > level]
             errs = [abs(r["rel_error"]) for _, r in at if r.get("rel_error") is not None
@@ -64,7 +69,7 @@ def step_rows(doc: dict):
                    "worst": max(errs) if errs else None,
                    "disagree": [(pt, r) for pt, r in at if r.get("cause") != "agrees"],
                    "cost": cost.get((engine, dt), {}),
-                   "not_run": doc.get("not_run", {}).get(engine, {}).get(repr(dt))}
+                   "not_run": not_run, "reached": len(valid) - left}
 
 
 def trusted_rows(doc: dict) -> list[list]:
@@ -80,14 +85,23 @@ def trusted_rows(doc: dict) -> list[list]:
         shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
         if row["not_run"]:
             shown = f"{row['not_run']} points not run (time budget); " + shown
-        n = row["valid"]
-        out.append([row["engine"], f"{row['dt']:.3g}", f"{row['agree']} / {n}",
+        n = row["reached"]
+        out.append([row["engine"], f"{row['dt']:.3g}", reached_text(row),
                     f"{100 * row['agree'] / n:.0f} %" if n and row["measured"] else "-",
                     "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %",
                     shown or ("none" if row["measured"] else
                               f"not run (finer step disagreed or within {100 * tol:g} % "
                               f"nowhere)")])
     return out
+
+
+def reached_text(row: dict) -> str:
+    """``'agree / reached'``, and ``'of valid'`` when a budget left points; a dash
+    for a step where nothing was measured after a budget left points."""
+    if not row["measured"] and row["reached"] < row["valid"]:
+        return "-"
+    text = f"{row['agree']} / {row['reached']}"
+    return text if row["reached"] == row["valid"] else f"{text} (of {row['valid']})"
 
 
 def parts_of(doc: dict) -> list[dict]:

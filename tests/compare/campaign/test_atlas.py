@@ -158,6 +158,18 @@ def test_trusted_region_counts_only_valid_points():
     assert "fig8_a 10: window" in rows[1][5]
 
 
+def test_the_share_counts_the_points_a_budget_reached():
+    from compare.report.atlas_page import trusted_rows
+    doc = _synthetic()
+    doc["points"][2]["engines"]["pymunk"] = []  # fig9_c: left by the budget at 2e-3 s
+    doc["not_run"] = {"pymunk": {repr(2e-3): 1}}
+    rows = trusted_rows(doc)
+    # One valid point reached, and it agrees at 2e-3 s: 100 % of what was measured,
+    # with the valid points it was not judged on stated beside.
+    assert rows[0][2:4] == ["1 / 1 (of 2)", "100 %"]
+    assert "1 points not run" in rows[0][5]
+
+
 def test_page_shows_maps_tables_and_what_was_not_run(tmp_path):
     from compare.report.atlas_page import write_page
     path = write_page(_synthetic(), tmp_path / "atlas.html")
