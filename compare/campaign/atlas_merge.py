@@ -11,7 +11,7 @@ CPU, load) is kept in ``parts``, in the order given.
 """
 from __future__ import annotations
 
-__all__ = ["merge_atlases", "SAME_CONFIG"]
+__all__ = ["merge_atlases", "runnable_command", "SAME_CONFIG"]
 
 # The config fields that must agree for two parts to be one atlas.
 SAME_CONFIG = ("scenes", "omegas", "factors", "cases", "rel_bracket", "rel_tol", "tol")
@@ -28,11 +28,35 @@ def _model(pt: dict) -> tuple:
     return pt["a_reference"], pt["mode"], pt["valid"], pt["model_reason"]
 
 
+# Commands recorded before the provenance took its flags from the parser wrote
+# the -q/-v switches as '--verbosity N', which trilith refuses; same meaning.
+_VERBOSITY = {"--verbosity 0": "", "--verbosity -1": "--quiet", "--verbosity 1": "--verbose"}
+
+
+def runnable_command(command: str | None) -> str | None:
+    """``command`` as trilith accepts it (a legacy ``--verbosity N`` as its switch)."""
+    if not command:
+        return command
+    for legacy, switch in _VERBOSITY.items():
+        command = command.replace(f" {legacy} ", f" {switch} " if switch else " ")
+        if command.endswith(f" {legacy}"):
+            command = command[:-len(legacy) - 1] + (f" {switch}" if switch else "")
+    return command
+
+
 def _parts_of(doc: dict) -> list[dict]:
-    """A document's own parts (a merged atlas keeps them), or itself as one part."""
-    if "parts" in doc:
-        return list(doc["parts"])
-    return [{"engines": list(doc.get("steps", {})), **{k: doc.get(k) for k in PART_FIELDS}}]
+    """A document's own parts (a merged atlas keeps them), or itself as one part,
+    each with a command trilith accepts."""
+    parts = list(doc["parts"]) if "parts" in doc else [
+        {"engines": list(doc.get("steps", {})), **{k: doc.get(k) for k in PART_FIELDS}}]
+    out = []
+    for part in parts:
+        part = {**part, "command": runnable_command(part.get("command"))}
+        if isinstance(part.get("provenance"), dict):
+            prov = part["provenance"]
+            part["provenance"] = {**prov, "command": runnable_command(prov.get("command"))}
+        out.append(part)
+    return out
 
 
 def merge_atlases(docs: list[dict], names: list[str] | None = None) -> dict:

@@ -82,3 +82,20 @@ def test_cli_joins_files_and_refuses_a_bad_one(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("error: engine 'pymunk' is in both") and err.count("\n") == 1
     assert not (tmp_path / "x.json").exists()
+
+
+def test_a_legacy_verbosity_in_a_recorded_command_becomes_its_switch():
+    import shlex
+
+    from compare.campaign.atlas_merge import runnable_command
+    from compare.cli.main import build_parser
+
+    parser, _ = build_parser()
+    for legacy, expect in (("--verbosity 0", 0), ("--verbosity -1", -1), ("--verbosity 1", 1)):
+        for line in (f"trilith atlas {legacy} --engine dart --workers 1",
+                     f"trilith atlas --engine dart {legacy}"):
+            fixed = runnable_command(line)
+            assert "--verbosity" not in fixed
+            args = parser.parse_args(shlex.split(fixed)[1:])  # trilith accepts it
+            assert args.verbosity == expect and args.engine == "dart"
+    assert runnable_command(None) is None
