@@ -59,8 +59,9 @@ class ValidationSet:
 
     Parameters
     ----------
-    scene : str
-        Scene name or file (default ``fig5``, the paper's Fig. 5 trilith).
+    scene : str or tuple of str
+        Scene name or file (default ``fig5``, the paper's Fig. 5 trilith), or a
+        tuple of them: the worst error is then over every scene's cases.
     releases : tuple of (lam, mu)
         Free-rocking cases for ``restitution`` (default lam 3 and 7 x mu 0.5 and
         2: the corners of the paper's range, where engines differ most), each
@@ -74,14 +75,21 @@ class ValidationSet:
         The paper's points for ``histories`` (default A-D).
     """
 
-    scene: str = "fig5"
+    scene: str | tuple = "fig5"
     releases: tuple = ((3.0, 0.5), (3.0, 2.0), (7.0, 0.5), (7.0, 2.0))
     n_impacts: int = 3
     omegas: tuple = (6.0, 12.0, 18.0)
     points: tuple = ("A", "B", "C", "D")
 
+    @property
+    def scene_label(self) -> str:
+        """The validation scenes as one short text (for titles)."""
+        names = [self.scene] if isinstance(self.scene, str) else list(self.scene)
+        return ", ".join(names) if len(names) <= 3 else f"{len(names)} scenes ({names[0]}, ...)"
+
     def describe(self) -> dict:
-        return {"scene": self.scene, "releases": [list(r) for r in self.releases],
+        return {"scene": self.scene if isinstance(self.scene, str) else list(self.scene),
+                "releases": [list(r) for r in self.releases],
                 "n_impacts": self.n_impacts, "omegas": list(self.omegas),
                 "points": list(self.points)}
 
@@ -258,8 +266,10 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         Processes for the threshold search.
     progress : callable, optional
         ``progress(done, total, evaluation)`` after each candidate.
-    scene : Scene, optional
-        The scene itself (e.g. with overrides); default ``load_scene(validation.scene)``.
+    scene : Scene or sequence of Scene, optional
+        The scenes themselves (e.g. with overrides); default each of
+        ``validation.scene`` loaded.  With several, each error is labelled with
+        its scene's name and the worst is over all.
 
     Returns
     -------
@@ -276,28 +286,40 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
                                             and 0.0 < tolerance <= 1.0):
         raise ValueError(f"tolerance must be in (0, 1], got {tolerance!r}")
     vs = validation or ValidationSet()
-    scene = load_scene(vs.scene) if scene is None else scene
+    names = (vs.scene,) if isinstance(vs.scene, str) else tuple(vs.scene)
+    if scene is None:
+        scenes = [load_scene(n) for n in names]
+    else:
+        scenes = list(scene) if isinstance(scene, (list, tuple)) else [scene]
+    if not scenes:
+        raise ValueError("scene: give at least one validation scene")
     space = default_space(engine) if space is None else dict(space)
     candidates = _candidates(space)
     for cand in candidates:  # every value checked before any run
         engines.configure(engine, **cand)
     cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
                       load_average=os.getloadavg())
-    reference: list = []  # the model's spectrum, once, only if a candidate needs it
+    reference: dict = {}  # the model's spectra, once, only if a candidate needs them
+
+    def one_scene(sc, cand: dict):
+        if metric == "restitution":
+            return _restitution(engine, sc, vs, cand)
+        if metric == "thresholds":
+            if id(sc) not in reference:
+                from analytic.spectrum import overturning_spectrum
+                reference[id(sc)] = overturning_spectrum(sc, list(vs.omegas))
+            return _thresholds(engine, sc, reference[id(sc)], cand, workers)
+        return _histories(engine, sc, vs, cand)
 
     def evaluate(cand: dict) -> Evaluation:
         with runs.using(None):  # measured costs: no run inside served from a store
-            if metric == "thresholds" and not reference:
-                from analytic.spectrum import overturning_spectrum
-                reference.append(overturning_spectrum(scene, list(vs.omegas)))
             cpu0 = cpu_seconds()
-            if metric == "restitution":
-                errors, engine_cpu, simulated, n = _restitution(engine, scene, vs, cand)
-            elif metric == "thresholds":
-                errors, engine_cpu, simulated, n = _thresholds(engine, scene, reference[0],
-                                                               cand, workers)
-            else:
-                errors, engine_cpu, simulated, n = _histories(engine, scene, vs, cand)
+            errors, engine_cpu, simulated, n = [], 0.0, 0.0, 0
+            for sc in scenes:
+                e, c, t, k = one_scene(sc, cand)
+                errors += [(f"{sc.name}: {label}" if len(scenes) > 1 else label, err)
+                           for label, err in e]
+                engine_cpu, simulated, n = engine_cpu + c, simulated + t, n + k
             values = [e for _, e in errors]
             worst = max(values) if values and all(math.isfinite(v) for v in values) \
                 else math.inf
@@ -308,7 +330,7 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         # Each finished candidate is kept whole in the run store, so a killed
         # calibration resumes at the next one; a served candidate keeps the costs
         # measured when it ran.
-        description = _candidate_description(engine, metric, vs, scene, cand)
+        description = _candidate_description(engine, metric, vs, scenes, cand)
         ev = runs.lookup("calibration-candidate", description, code=runs.ALL_CODE)
         if ev is not None:
             ev = dataclasses.replace(ev, from_store=True)
@@ -321,9 +343,10 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     return cal
 
 
-def _candidate_description(engine: str, metric: str, vs: ValidationSet, scene, cand: dict) -> dict:
+def _candidate_description(engine: str, metric: str, vs: ValidationSet, scenes,
+                           cand: dict) -> dict:
     """Everything that determines one candidate's evaluation (its store key)."""
     from compare.run.keys import backend_version, scene_dict
     return {"engine": engine, "version": backend_version(engine), "metric": metric,
-            "validation": dataclasses.asdict(vs), "scene": scene_dict(scene),
+            "validation": dataclasses.asdict(vs), "scenes": [scene_dict(sc) for sc in scenes],
             "candidate": dict(sorted(cand.items()))}

@@ -29,7 +29,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "the cheapest within the tolerance.")
     parser.add_argument("--engine", required=True, metavar="NAME",
                         help=f"the engine to calibrate: {', '.join(engine_names())}")
-    add_scene_args(parser)
+    add_scene_args(parser, several=True)
     parser.add_argument("--metric", choices=METRICS, default="thresholds",
                         help="what must agree")
     parser.add_argument("--tolerance", type=float, default=None, metavar="X",
@@ -119,11 +119,13 @@ def run(args: argparse.Namespace) -> int:
     if len(engine) != 1:
         raise ValueError("--engine: calibrate one engine at a time")
     engine = engine[0]
-    scene = _common.scene_from_args(args)
+    scenes = _common.scenes_from_args(args)
     space = _space(args, engine)
-    vs = ValidationSet(scene=scene.name) if args.omega is None else ValidationSet(
-        scene=scene.name, omegas=tuple(float(_number(v.strip(), "--omega"))
-                                       for v in args.omega.split(",") if v.strip()))
+    names = tuple(sc.name for sc in scenes)
+    name = names[0] if len(names) == 1 else names
+    vs = ValidationSet(scene=name) if args.omega is None else ValidationSet(
+        scene=name, omegas=tuple(float(_number(v.strip(), "--omega"))
+                                 for v in args.omega.split(",") if v.strip()))
     _check_budget(engine, space, vs)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
@@ -144,16 +146,18 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
 
     cal = calibrate(engine, args.metric, validation=vs, space=space, tolerance=args.tolerance,
-                    workers=workers, progress=progress, scene=scene)
+                    workers=workers, progress=progress, scene=scenes)
     if bar is not None:
         bar.close()
     _print(cal)
     body = plain(cal.to_dict())
     if args.json is not None:
         import json
-        atomic.write_text(args.json, json.dumps(envelope("calibrate", {
-            "engine": engine, "metric": args.metric, "scene": scene.to_dict()}, body, {}),
-            indent=1) + "\n")
+        inputs = {"engine": engine, "metric": args.metric,
+                  "scene": [sc.to_dict() for sc in scenes] if len(scenes) > 1
+                  else scenes[0].to_dict()}
+        atomic.write_text(args.json, json.dumps(envelope("calibrate", inputs, body, {}),
+                                                indent=1) + "\n")
         info(f"wrote {args.json}")
     if args.csv is not None:
         atomic.write_text(args.csv, _csv(cal))
@@ -168,16 +172,21 @@ def run(args: argparse.Namespace) -> int:
             info(f"no candidate met the tolerance: {args.settings_out} not written")
         else:
             atomic.write_text(args.settings_out, settings_toml(engine, rec.options, (
-                f"{_command(args, engine, scene.name)}\nworst error {rec.worst_error:.3g} "
+                f"{_command(args, engine)}\nworst error {rec.worst_error:.3g} "
                 f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the validation "
                 f"set")))
             info(f"wrote {args.settings_out}")
     return 0 if rec is not None else 1
 
 
-def _command(args, engine: str, scene: str) -> str:
+def _command(args, engine: str) -> str:
     """The calibrate command that regenerates a settings file (what it varied)."""
-    words = [f"trilith calibrate --engine {engine} --metric {args.metric} --scene {scene}"]
+    import shlex
+    words = [f"trilith calibrate --engine {engine} --metric {args.metric}"]
+    words += [f"--scene {shlex.quote(item)}" for item in args.scene or ["fig5"]]
+    words += [f"--set {shlex.quote(item)}" for item in args.overrides]
+    if args.no_pendulum:
+        words.append("--no-pendulum")
     words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance")
               if getattr(args, k) is not None]
     words += [f"--vary {v}" for v in args.vary]

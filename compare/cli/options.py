@@ -48,10 +48,19 @@ def detail(message: str) -> None:
         print(message)
 
 
-def add_scene_args(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scene", default="fig5",
-                        help="scene name (scenes/data/*.toml, see 'trilith scenes') or path "
-                             "to a TOML file")
+def add_scene_args(parser: argparse.ArgumentParser, several: bool = False) -> None:
+    """``--scene`` (with ``several``: repeatable, globs allowed, default fig5),
+    ``--set NAME=VALUE`` and ``--no-pendulum``."""
+    if several:
+        parser.add_argument("--scene", action="append", default=None,
+                            metavar="NAME|FILE|GLOB",
+                            help="scene name (see 'trilith scenes'), path to a TOML file, or a "
+                                 "glob of names such as 'fig8_*'; repeat for several "
+                                 "(default: fig5)")
+    else:
+        parser.add_argument("--scene", default="fig5",
+                            help="scene name (scenes/data/*.toml, see 'trilith scenes') or "
+                                 "path to a TOML file")
     parser.add_argument("--set", dest="overrides", action="append", default=[],
                         metavar="NAME=VALUE",
                         help=f"override a scene value; NAME in {', '.join(SETTABLE)}")
@@ -75,6 +84,26 @@ def parse_overrides(items: list[str]) -> dict[str, float]:
             raise ValueError(f"--set {name}: must be finite, got {value!r}")
         out[name] = number
     return out
+
+
+def scenes_from_args(args: argparse.Namespace) -> list[Scene]:
+    """Every scene of a repeatable ``--scene`` (``add_scene_args(several=True)``):
+    names, files and globs of names, in the order given, each once; each with
+    the ``--set`` overrides and ``--no-pendulum``."""
+    import fnmatch
+
+    from scenes import scene_names
+    names: list[str] = []
+    for item in args.scene or ["fig5"]:
+        if any(c in item for c in "*?[") and not Path(item).exists():
+            hits = [n for n in scene_names() if fnmatch.fnmatchcase(n, item)]
+            if not hits:
+                raise ValueError(f"--scene: {item!r} matches no scene; allowed: "
+                                 f"{', '.join(scene_names())}, a file or a glob of names")
+        else:
+            hits = [item]
+        names += [n for n in hits if n not in names]
+    return [scene_from_args(argparse.Namespace(**{**vars(args), "scene": n})) for n in names]
 
 
 def scene_from_args(args: argparse.Namespace) -> Scene:

@@ -67,7 +67,7 @@ def pareto_plot(cal, path) -> None:
     ax.set_xlabel("engine CPU time on the validation set [s]")
     ax.set_ylabel(f"worst error ({unit})")
     load = ", ".join(f"{x:.2f}" for x in cal.load_average)
-    ax.set_title(f"{cal.engine}: {cal.metric}, {cal.validation.scene} (load {load})",
+    ax.set_title(f"{cal.engine}: {cal.metric}, {cal.validation.scene_label} (load {load})",
                  fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="best")

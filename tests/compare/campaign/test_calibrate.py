@@ -117,6 +117,30 @@ def test_a_calibration_resumes_from_the_store_with_its_measured_costs(tmp_path, 
     assert again.recommended.options == first.recommended.options
 
 
+def test_a_validation_set_of_several_scenes_takes_the_worst_over_all(tmp_path, capsys):
+    import json
+    out = tmp_path / "cal.json"
+    # A glob and a name it already matched: two scenes, each once, in order.
+    code = main(["calibrate", "--engine", "pymunk", "--scene", "fig11_mu[12]", "--scene",
+                 "fig11_mu1", "--metric", "histories", "--dt", "2e-3", "--step-only",
+                 "--no-cache", "--json", str(out)])
+    assert code in (0, 1)  # 1: no candidate met the tolerance (a verdict, not an error)
+    doc = json.loads(out.read_text())
+    assert doc["validation"]["scene"] == ["fig11_mu1", "fig11_mu2"]
+    (ev,) = doc["evaluations"]
+    labels = [label for label, _ in ev["errors"]]
+    assert {label.split(":")[0] for label in labels} == {"fig11_mu1", "fig11_mu2"}
+    assert len(labels) == 16  # A-D, with and without the pendulum, per scene
+    assert ev["worst_error"] == max(err for _, err in ev["errors"])
+    assert ev["runs"] == 16
+
+
+def test_a_scene_glob_that_matches_nothing_is_refused(capsys):
+    assert main(["calibrate", "--engine", "pymunk", "--scene", "fig99_*", "--no-cache"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--scene: 'fig99_*' matches no scene" in err[0]
+
+
 @pytest.mark.parametrize("engine", ["pybullet", "pymunk", "mujoco", "dart", "drake"])
 def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
     # calibrate's default space: the step times 1, 2, 5, 10 and the engine's own
