@@ -131,6 +131,7 @@ class Calibration:
     validation: ValidationSet
     evaluations: list = field(default_factory=list)
     load_average: tuple = ()
+    base: dict = field(default_factory=dict)  # settings every candidate starts from
 
     @property
     def front(self) -> list:
@@ -146,6 +147,7 @@ class Calibration:
         rec = self.recommended
         return {"engine": self.engine, "version": self.version, "metric": self.metric,
                 "tolerance": self.tolerance, "validation": self.validation.describe(),
+                "base": dict(self.base),
                 "load_average": list(self.load_average),
                 "recommended": rec.to_dict() if rec else None,
                 "front": [e.to_dict() for e in self.front],
@@ -171,12 +173,13 @@ def pareto_front(evaluations) -> list:
     return front
 
 
-def default_space(engine: str, step_only: bool = False) -> dict:
-    """``{'dt': [...], ...}``: the engine's calibrated step times :data:`DT_FACTORS`,
-    plus (unless ``step_only``) the engine's own declared search ranges
-    (``calibration_space`` on its class: each includes the calibrated default)."""
+def default_space(engine: str, step_only: bool = False, base: dict | None = None) -> dict:
+    """``{'dt': [...], ...}``: the engine's calibrated step (or ``base``'s) times
+    :data:`DT_FACTORS`, plus (unless ``step_only``) the engine's own declared
+    search ranges (``calibration_space`` on its class: each includes the
+    calibrated default)."""
     import engines
-    base = engines.configure(engine)
+    base = engines.configure(engine, **(base or {}))
     space = {"dt": [base.dt * f for f in DT_FACTORS]}
     if not step_only:
         space.update({name: list(values) for name, values in
@@ -244,7 +247,7 @@ def _histories(engine, scene, vs: ValidationSet, options):
 
 def calibrate(engine: str, metric: str = "thresholds", *, validation: ValidationSet | None = None,
               space: dict | None = None, tolerance: float | None = None, workers: int = 1,
-              progress=None, scene=None) -> Calibration:
+              progress=None, scene=None, base: dict | None = None) -> Calibration:
     """Evaluate every candidate of ``space`` on ``validation`` for ``metric``.
 
     Parameters
@@ -270,6 +273,10 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         The scenes themselves (e.g. with overrides); default each of
         ``validation.scene`` loaded.  With several, each error is labelled with
         its scene's name and the worst is over all.
+    base : dict, optional
+        Settings every candidate starts from (e.g. a settings file's table for
+        ``engine``); a candidate's own values replace them.  Default: none (the
+        engine's calibrated defaults).
 
     Returns
     -------
@@ -293,15 +300,17 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         scenes = list(scene) if isinstance(scene, (list, tuple)) else [scene]
     if not scenes:
         raise ValueError("scene: give at least one validation scene")
-    space = default_space(engine) if space is None else dict(space)
+    base = dict(base or {})
+    space = default_space(engine, base=base) if space is None else dict(space)
     candidates = _candidates(space)
     for cand in candidates:  # every value checked before any run
-        engines.configure(engine, **cand)
+        engines.configure(engine, **{**base, **cand})
     cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
-                      load_average=os.getloadavg())
+                      load_average=os.getloadavg(), base=base)
     reference: dict = {}  # the model's spectra, once, only if a candidate needs them
 
-    def one_scene(sc, cand: dict):
+    def one_scene(sc, varied: dict):
+        cand = {**base, **varied}
         if metric == "restitution":
             return _restitution(engine, sc, vs, cand)
         if metric == "thresholds":
@@ -330,7 +339,7 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         # Each finished candidate is kept whole in the run store, so a killed
         # calibration resumes at the next one; a served candidate keeps the costs
         # measured when it ran.
-        description = _candidate_description(engine, metric, vs, scenes, cand)
+        description = _candidate_description(engine, metric, vs, scenes, {**base, **cand})
         ev = runs.lookup("calibration-candidate", description, code=runs.ALL_CODE)
         if ev is not None:
             ev = dataclasses.replace(ev, from_store=True)

@@ -9,9 +9,10 @@ from analytic.options import MAX_ENGINE_DT
 
 from compare.cli import options as _common
 from compare.cli.excitation_args import check_run_budget
-from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_store_args, add_workers_arg,
-                                 check_output_path, envelope, info, print_json, resolve_workers,
-                                 sig, use_store)
+from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_settings_arg,
+                                 add_store_args, add_workers_arg, check_output_path, envelope,
+                                 file_options, info, print_json, resolve_workers,
+                                 settings_from_args, settings_line, sig, use_store)
 from compare.run.jsonable import plain
 
 
@@ -47,6 +48,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              "ranges of its other settings (docs/calibrate.md)")
     parser.add_argument("--omega", default=None, metavar="W1,W2,...",
                         help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18)")
+    add_settings_arg(parser)
     add_workers_arg(parser)
     add_store_args(parser)
     parser.add_argument("--json", metavar="FILE", help="write every evaluation as JSON")
@@ -70,9 +72,9 @@ def _number(text: str, option: str) -> float | int:
     return value
 
 
-def _space(args, engine: str) -> dict:
+def _space(args, engine: str, base: dict) -> dict:
     from compare.campaign.calibrate import MAX_CANDIDATES, default_space
-    space = default_space(engine, step_only=args.step_only)
+    space = default_space(engine, step_only=args.step_only, base=base)
     if args.dt is not None:
         space["dt"] = [float(_number(v.strip(), "--dt")) for v in args.dt.split(",") if v.strip()]
     for item in args.vary:
@@ -93,15 +95,15 @@ def _space(args, engine: str) -> dict:
     return space
 
 
-def _check_budget(engine: str, space: dict, vs) -> None:
+def _check_budget(engine: str, space: dict, vs, base: dict) -> None:
     """Refuse before any work a step that is not positive or whose longest run
     (the lowest validation frequency's pulse) is over the run budget."""
     import dataclasses
 
     from analytic.excitation import Pulse
-    from engines import get_backend
+    from engines import configure
 
-    settings = get_backend(engine).Settings()
+    settings = configure(engine, **base)
     for dt in space.get("dt", [settings.dt]):
         if not 0.0 < dt <= MAX_ENGINE_DT:
             raise ValueError(f"--dt: each step must be in (0, {MAX_ENGINE_DT:g}] s, got {dt!r}")
@@ -110,7 +112,6 @@ def _check_budget(engine: str, space: dict, vs) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import engines
     from compare.campaign.calibrate import ValidationSet, calibrate
     from compare.campaign.settings_file import settings_toml
     from compare.run import atomic
@@ -120,13 +121,15 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--engine: calibrate one engine at a time")
     engine = engine[0]
     scenes = _common.scenes_from_args(args)
-    space = _space(args, engine)
+    loaded = settings_from_args(args, (engine,))
+    base = file_options(loaded, engine)
+    space = _space(args, engine, base)
     names = tuple(sc.name for sc in scenes)
     name = names[0] if len(names) == 1 else names
     vs = ValidationSet(scene=name) if args.omega is None else ValidationSet(
         scene=name, omegas=tuple(float(_number(v.strip(), "--omega"))
                                  for v in args.omega.split(",") if v.strip()))
-    _check_budget(engine, space, vs)
+    _check_budget(engine, space, vs, base)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
     for option, path in outputs.items():
@@ -135,6 +138,8 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     use_store(args)
+    if loaded is not None:
+        info(settings_line(loaded, engine) + " (every candidate starts from them)")
     bar = None
     if sys.stderr.isatty() and _common.VERBOSITY >= 0:
         from tqdm import tqdm
@@ -146,7 +151,7 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
 
     cal = calibrate(engine, args.metric, validation=vs, space=space, tolerance=args.tolerance,
-                    workers=workers, progress=progress, scene=scenes)
+                    workers=workers, progress=progress, scene=scenes, base=base)
     if bar is not None:
         bar.close()
     _print(cal)
@@ -171,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
         if rec is None:
             info(f"no candidate met the tolerance: {args.settings_out} not written")
         else:
-            atomic.write_text(args.settings_out, settings_toml(engine, rec.options, (
+            atomic.write_text(args.settings_out, settings_toml(engine, {**base, **rec.options}, (
                 f"{_command(args, engine)}\nworst error {rec.worst_error:.3g} "
                 f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the validation "
                 f"set")))
@@ -187,6 +192,8 @@ def _command(args, engine: str) -> str:
     words += [f"--set {shlex.quote(item)}" for item in args.overrides]
     if args.no_pendulum:
         words.append("--no-pendulum")
+    if args.settings is not None:
+        words.append(f"--settings {shlex.quote(args.settings)}")
     words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance")
               if getattr(args, k) is not None]
     words += [f"--vary {v}" for v in args.vary]

@@ -135,6 +135,25 @@ def test_a_validation_set_of_several_scenes_takes_the_worst_over_all(tmp_path, c
     assert ev["runs"] == 16
 
 
+def test_a_settings_file_is_the_base_every_candidate_starts_from(tmp_path, capsys):
+    base = tmp_path / "base.toml"
+    base.write_text(settings_toml("pymunk", {"iterations": 60}, "a base"))
+    out = tmp_path / "out.toml"
+    code = main(["calibrate", "--engine", "pymunk", "--settings", str(base), "--metric",
+                 "histories", "--dt", "2e-3", "--step-only", "--tolerance", "1", "--no-cache",
+                 "--settings-out", str(out)])
+    assert code == 0  # tolerance 1: every candidate is acceptable, one is written
+    # The file written is complete: the base's value kept beside the step searched,
+    # and the command that regenerates it names the base.
+    assert load_settings_file(out) == {"pymunk": {"iterations": 60, "dt": 2e-3}}
+    assert f"--settings {base}" in out.read_text()
+    # A file with nothing for the engine calibrated changes nothing: refused.
+    other = tmp_path / "other.toml"
+    other.write_text(settings_toml("mujoco", {"dt": 1e-3}, "not pymunk"))
+    assert main(["calibrate", "--engine", "pymunk", "--settings", str(other), "--no-cache"]) == 2
+    assert "has no table for pymunk" in capsys.readouterr().err
+
+
 def test_a_scene_glob_that_matches_nothing_is_refused(capsys):
     assert main(["calibrate", "--engine", "pymunk", "--scene", "fig99_*", "--no-cache"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

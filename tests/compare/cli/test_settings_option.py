@@ -32,6 +32,7 @@ COMMANDS = {
     "record": ["record", "--engine", "pymunk", "--out", "{gif}"],
     "view": ["view", "--engine", "pymunk"],
     "atlas": ["atlas", "--engine", "pymunk"],
+    "calibrate": ["calibrate", "--engine", "pymunk"],
 }
 
 
