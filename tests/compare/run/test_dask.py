@@ -73,6 +73,27 @@ def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
     assert spectrum("--scheduler", cluster.scheduler_address) == spectrum("--workers", "2")
 
 
+def test_the_atlas_on_the_cluster_equals_the_local_one(cluster):
+    from compare.campaign.atlas import AtlasConfig, run_atlas
+    config = AtlasConfig(engines=("pymunk",), scenes=(("fig8_lam5_gamma0.1", "sine"),),
+                         omegas=(12.0, 18.0), factors=(1.0, 2.0), cases=("no_pendulum",))
+
+    def rows(doc):  # the measurement, without what differs by where it ran
+        drop = ("cpu_s", "from_store")
+        return [(pt["omega"], pt["a_reference"], pt["valid"],
+                 [{k: v for k, v in r.items() if k not in drop} for r in pt["engines"]["pymunk"]])
+                for pt in doc["points"]]
+    with runs.using(None):
+        local = run_atlas(config, workers=1)
+        runs.set_scheduler(cluster.scheduler_address)
+        try:
+            remote = run_atlas(config)
+        finally:
+            runs.set_scheduler(None)
+    assert any(pt["engines"]["pymunk"] for pt in local["points"])  # something was measured
+    assert rows(remote) == rows(local)
+
+
 def test_unreachable_scheduler_is_a_usage_error():
     proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10",
                            "--no-cache", "--scheduler", "tcp://127.0.0.1:9"], cwd=ROOT,
