@@ -84,14 +84,19 @@ def trusted_rows(doc: dict) -> list[list]:
                for pt, r in row["disagree"]]
         shown = "; ".join(bad[:6]) + (f"; ... {len(bad) - 6} more" if len(bad) > 6 else "")
         if row["not_run"]:
-            shown = f"{row['not_run']} points not run (time budget); " + shown
+            shown = "; ".join(filter(None, [f"{row['not_run']} points not run (time budget)",
+                                            shown]))
         n = row["reached"]
+        if row["measured"]:
+            why_empty = "none"
+        elif n < row["valid"]:
+            why_empty = "not run (the time budget ended at a finer step)"
+        else:
+            why_empty = f"not run (finer step disagreed or within {100 * tol:g} % nowhere)"
         out.append([row["engine"], f"{row['dt']:.3g}", reached_text(row),
                     f"{100 * row['agree'] / n:.0f} %" if n and row["measured"] else "-",
                     "-" if row["worst"] is None else f"{100 * row['worst']:.2g} %",
-                    shown or ("none" if row["measured"] else
-                              f"not run (finer step disagreed or within {100 * tol:g} % "
-                              f"nowhere)")])
+                    shown or why_empty])
     return out
 
 
@@ -254,7 +259,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              f"{max(cfg.get('omegas', [0])):g} rad/s); the model is invalid at {n_invalid} "
              f"of them (no engine run there). Engines run: {html.escape(ran)}; not run: "
              f"{html.escape(not_run)}. Tolerance {100 * _tol(doc):g} %; steps "
-             f"{html.escape(str(cfg.get('factors')))} x each engine's calibrated threshold "
+             f"{html.escape(', '.join(f'{f:g}' for f in cfg.get('factors') or []))} x each "
+             "engine's calibrated threshold "
              "step, a coarser one only where the finer one agreed."
              + (f" Not run ({budget_text(doc)} reached): {html.escape(skipped)}."
                 if skipped else "") + "</p>"]
