@@ -25,9 +25,10 @@ Every candidate (the product of the values in the search space) is evaluated on
 the whole set with the store bypassed, so that every cost is what the runs cost on
 the machine that ran them.  Each finished candidate is then kept in the run store
 (when one is active): a killed calibration resumes at the next candidate, and a
-served candidate (``from_store``) keeps the costs measured when it ran.  Two costs are kept: the engine's own (``engine_cpu_s``, the CPU
-seconds each engine run measured inside its stepping loop, summed: what a user of
-these settings pays) and the whole evaluation's (``cpu_s``: this process and the
+served candidate (``from_store``) keeps the costs measured when it ran.  Two
+costs are kept: the engine's own (``engine_cpu_s``, the CPU seconds each engine
+run measured inside its stepping loop, summed: what a user of these settings
+pays) and the whole evaluation's (``cpu_s``: this process and the
 workers it reaped, including the model's reference runs and the measurement).  The
 result is the Pareto front of engine cost against worst error and the cheapest
 candidate within the tolerance.
