@@ -7,8 +7,8 @@ threshold step and 2x, 5x, 10x coarser, through the run store (killed, it
 resumes).  The default engines leave out DART and Drake, whose calibrated
 threshold steps are fine enough that their atlas costs hours of CPU (measured in
 docs/atlas.md): name them (``--engine dart,drake`` or ``--engine all``),
-best with ``--time-budget`` or ``--scheduler``.  ``--from FILE`` renders a stored atlas without running anything;
-repeated, it joins atlases of different engines measured separately
+best with ``--time-budget`` or ``--scheduler``.  ``--from FILE`` renders a
+stored atlas without running anything; repeated, it joins atlases of different engines measured separately
 (``compare/campaign/atlas_merge.py``).
 """
 from __future__ import annotations

@@ -65,7 +65,8 @@ def render_atlas(doc: dict) -> str:
              "step and every finer one (a coarser step runs only where the finer one "
              "agreed); the share counts the valid points the run reached (a time budget "
              "can leave some, stated per row).", "",
-             "| engine | step [s] | agree / valid points reached | share | worst \\|error\\| at the "
+             "| engine | step [s] | agree / valid points reached | share | worst \\|error\\| "
+             "at the "
              "step | disagreements (figure: cause count) | CPU s per threshold job | CPU s "
              "per simulated s |",
              "|---|---|---|---|---|---|---|---|"]

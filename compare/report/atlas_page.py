@@ -20,8 +20,8 @@ from pathlib import Path
 
 from compare.report.trust import label
 
-__all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line", "cost_rows", "heat_map_png", "atlas_html",
-           "write_page"]
+__all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line",
+           "cost_rows", "heat_map_png", "atlas_html", "write_page"]
 
 CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
                 "discretisation": "D", "iterations": "I", "contact": "K", "sensitivity": "S",
