@@ -148,7 +148,7 @@ def test_resume_after_sigkill(tmp_path):
 
 def _start_busy_campaign(tmp_path: Path, cache: Path) -> subprocess.Popen:
     """A two-worker campaign, returned once both workers exist and a run is stored."""
-    proc = _start(["campaign", str(_study(tmp_path, '"6:16:2"')), "--workers", "2",
+    proc = _start(["campaign", str(_study(tmp_path, '"6:26:1"')), "--workers", "2",
                    "--cache", str(cache), "--out", str(tmp_path / "o")])
     try:
         _wait_for(lambda: len(_children(proc.pid)) >= 2 and _runs(cache) >= 1
@@ -194,7 +194,7 @@ def test_ctrl_c_cancels_promptly_with_one_line(tmp_path):
                   timeout=LIVENESS_S)
         assert took < LIVENESS_S
         # The work was cancelled, not finished: far fewer runs than the study needs
-        # (6 frequencies x ~6 runs).
+        # (21 frequencies x ~6 runs).
         assert _runs(cache) < n_runs + 10
     finally:
         _cleanup(proc)
