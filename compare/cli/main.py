@@ -140,10 +140,22 @@ def main(argv: list[str] | None = None) -> int:
     """Run the ``trilith`` command line ``argv`` (default ``sys.argv[1:]``);
     returns the exit code."""
     try:
-        return _main(argv)
+        code = _main(argv)
     finally:
         if argv is None:  # the program itself: nothing runs after this but the exit
             gc.freeze()
+    if argv is None and code == 130:
+        # Interrupted: the run store is closed and the workers killed.  The exit
+        # handlers of a process pool whose workers were killed can still write to
+        # its closed wake-up pipe and print a traceback after the one-line message,
+        # so the program leaves without running them.
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError, AttributeError):
+                pass
+        os._exit(130)
+    return code
 
 
 def _main(argv: list[str] | None) -> int:
