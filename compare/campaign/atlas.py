@@ -23,6 +23,7 @@ from __future__ import annotations
 import fnmatch
 import math
 import os
+import resource
 import time
 from dataclasses import dataclass
 
@@ -183,6 +184,7 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     from compare.run.keys import backend_version, digest, project_version
 
     t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
+    w0 = _workers_cpu_s()
     deadline = None if budget_s is None else t0 + budget_s
     pairs = atlas_scenes(config)
     ref_jobs = [(n, c, p, w) for n, p in pairs for c in config.cases for w in config.omegas]
@@ -240,7 +242,16 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
             "budget_s": budget_s,
             "not_run": {e: n for e, n in not_run.items() if n},
             "wall_s": time.perf_counter() - t0, "parent_cpu_s": time.process_time() - c0,
+            "local_cpu_s": time.process_time() - c0 + _workers_cpu_s() - w0,
             "load_average": [load0, os.getloadavg()[0]], "workers": workers}
+
+
+def _workers_cpu_s() -> float:
+    """CPU seconds of this process's finished child processes: the local workers,
+    each pool of which is joined when its chunk ends (a Dask cluster's workers are
+    not children and are not counted)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def cost_table(points: list[dict], engines) -> list[dict]:

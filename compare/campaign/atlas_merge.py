@@ -16,8 +16,8 @@ __all__ = ["merge_atlases", "runnable_command", "SAME_CONFIG"]
 # The config fields that must agree for two parts to be one atlas.
 SAME_CONFIG = ("scenes", "omegas", "factors", "cases", "rel_bracket", "rel_tol", "tol")
 # Per part: what describes how and when it was measured.
-PART_FIELDS = ("command", "provenance", "wall_s", "parent_cpu_s", "load_average", "workers",
-               "budget_s", "settings_file", "versions")
+PART_FIELDS = ("command", "provenance", "wall_s", "parent_cpu_s", "local_cpu_s", "load_average",
+               "workers", "budget_s", "settings_file", "versions")
 
 
 def _point_id(pt: dict) -> tuple:

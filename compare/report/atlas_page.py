@@ -110,11 +110,27 @@ def reached_text(row: dict) -> str:
 
 
 def parts_of(doc: dict) -> list[dict]:
-    """The separately measured parts of an atlas (one, when it was measured whole)."""
-    return doc.get("parts") or [{"engines": list(doc.get("steps", {})),
-                                 **{k: doc.get(k) for k in ("command", "provenance", "wall_s",
-                                                            "parent_cpu_s", "load_average",
-                                                            "workers")}}]
+    """The separately measured parts of an atlas (one, when it was measured whole),
+    each with ``engine_cpu_s``: the CPU seconds of its engines' threshold jobs."""
+    parts = doc.get("parts") or [{"engines": list(doc.get("steps", {})),
+                                  **{k: doc.get(k) for k in ("command", "provenance", "wall_s",
+                                                             "parent_cpu_s", "local_cpu_s",
+                                                             "load_average", "workers")}}]
+    return [{**part, "engine_cpu_s": math.fsum(
+        c["cpu_s"] or 0.0 for c in doc.get("cost", ()) if c["engine"] in part["engines"])}
+        for part in parts]
+
+
+def _cpu_text(part: dict) -> str:
+    """The part's CPU: the process and its local workers when recorded; with one
+    worker the process alone is all of it; else only the engine jobs' own CPU is
+    known (older atlases did not record the workers')."""
+    if part.get("local_cpu_s") is not None:
+        return f"{part['local_cpu_s']:.0f} CPU s (the process and its workers)"
+    if part.get("workers") == 1:
+        return f"{part.get('parent_cpu_s') or 0:.0f} CPU s in the process"
+    return (f"{part.get('engine_cpu_s') or 0:.0f} CPU s in the engine jobs (the workers' "
+            f"whole CPU was not recorded)")
 
 
 def part_line(part: dict, code=("`", "`")) -> str:
@@ -128,8 +144,7 @@ def part_line(part: dict, code=("`", "`")) -> str:
             f"{code[1]}"
             f" ({when}, commit {code[0]}{commit}{code[1]}, {part.get('workers', '?')} worker(s), load average "
             + (" -> ".join(f"{x:.1f}" for x in load) or "?")
-            + f", {part.get('parent_cpu_s') or 0:.0f} CPU s in the process, "
-              f"{(part.get('wall_s') or 0) / 60:.0f} min wall)")
+            + f", {_cpu_text(part)}, {(part.get('wall_s') or 0) / 60:.0f} min wall)")
 
 
 def cost_rows(doc: dict) -> list[list]:

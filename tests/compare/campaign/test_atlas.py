@@ -197,3 +197,32 @@ def test_a_point_left_by_the_budget_is_marked_not_measured():
     doc["points"][0]["engines"]["pymunk"] = []
     labels, omegas, err, text, invalid = _grid(doc, "pymunk", "pendulum")
     assert text[0][0] == "–" and err[0, 0] != err[0, 0]  # NaN: nothing to colour
+
+
+@pytest.mark.slow
+def test_the_cost_counts_the_workers_cpu():
+    # With a pool the engine jobs run in child processes: the parent's own CPU is
+    # a few per cent of the work, so the atlas records the workers' too.
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES[:1], omegas=(12.0, 18.0),
+                         factors=(1.0,), cases=("pendulum",))
+    doc = run_atlas(config, workers=2)
+    jobs_cpu = sum(c["cpu_s"] for c in doc["cost"])
+    assert jobs_cpu > 0
+    # Each job's CPU is measured inside a worker, so the workers' total holds it
+    # (1 % for the two clocks' rounding).
+    assert doc["local_cpu_s"] >= 0.99 * jobs_cpu
+    assert doc["local_cpu_s"] > doc["parent_cpu_s"]
+
+
+def test_a_part_line_never_calls_the_parents_cpu_the_whole_cost():
+    from compare.report.atlas_page import part_line, parts_of
+    doc = _synthetic()
+    doc.update(workers=2, parent_cpu_s=14.0, wall_s=600.0, load_average=[0.1, 1.9])
+    (part,) = parts_of(doc)
+    assert part["engine_cpu_s"] == pytest.approx(sum(c["cpu_s"] for c in doc["cost"]))
+    assert "in the engine jobs (the workers' whole CPU was not recorded)" in part_line(part)
+    assert "14 CPU s" not in part_line(part)
+    doc["local_cpu_s"] = 900.0
+    assert "900 CPU s (the process and its workers)" in part_line(parts_of(doc)[0])
+    doc.update(workers=1, local_cpu_s=None)
+    assert "14 CPU s in the process" in part_line(parts_of(doc)[0])
