@@ -60,6 +60,17 @@ def _factors(text: str) -> tuple[float, ...]:
         raise ValueError(f"--factors: {text!r} is not a comma-separated list of numbers") from None
 
 
+def _join_command(args: argparse.Namespace, sources: list) -> str:
+    """The command line of a join: only the options a join reads."""
+    import shlex
+
+    words = ["trilith", "atlas"] + [w for path in sources for w in ("--from", str(path))]
+    for flag, value in (("--json", args.json), ("--html", args.html)):
+        if value is not None:
+            words += [flag, str(value)]
+    return shlex.join(words)
+
+
 def run(args: argparse.Namespace) -> int:
     from compare.campaign.atlas import AtlasConfig, run_atlas
 
@@ -77,7 +88,8 @@ def run(args: argparse.Namespace) -> int:
             from compare.run.provenance import collect
             doc = merge_atlases(docs, [f"--from {p!r}" for p in sources])
             doc["provenance"] = collect(args)
-            doc["command"] = doc["provenance"]["command"]
+            # A join runs nothing: engines, grid, workers and store do not apply.
+            doc["command"] = doc["provenance"]["command"] = _join_command(args, sources)
         else:
             doc = docs[0]
         if args.json is not None:

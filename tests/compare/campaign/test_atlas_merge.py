@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+import shlex
 
 import pytest
 
@@ -66,7 +67,12 @@ def test_cli_joins_files_and_refuses_a_bad_one(tmp_path, capsys):
     assert main(["atlas", "--from", str(a), "--from", str(b), "--json", str(out),
                  "--html", str(tmp_path / "all.html")]) == 0
     doc = json.loads(out.read_text())
-    assert list(doc["steps"]) == ["pymunk", "mujoco"] and "--from" in doc["command"]
+    assert list(doc["steps"]) == ["pymunk", "mujoco"]
+    # The recorded command is the join itself: no engine list, grid or workers,
+    # which a join does not read (and which would name engines it does not hold).
+    assert shlex.split(doc["command"]) == ["trilith", "atlas", "--from", str(a), "--from", str(b),
+                                           "--json", str(out), "--html",
+                                           str(tmp_path / "all.html")]
     assert "Trusted region" in (tmp_path / "all.html").read_text()
     # A part's time budget left points unmeasured: the joined page says whose.
     part = _part("dart", 0.0, 1.0)
