@@ -86,6 +86,32 @@ def _wait_for(predicate, what: str, timeout: float = 120.0) -> None:
         time.sleep(0.05)
 
 
+def _state(pid: int) -> str:
+    """What the kernel says a process is doing (state, where it sleeps, its
+    pending, blocked, ignored and caught signals), for a failure message."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text().splitlines()
+        wchan = Path(f"/proc/{pid}/wchan").read_text()
+    except OSError as exc:
+        return f"pid {pid}: {exc}"
+    keep = ("State", "SigPnd", "ShdPnd", "SigBlk", "SigIgn", "SigCgt", "Threads")
+    return f"pid {pid} wchan={wchan} " + " ".join(
+        line.replace("\t", "") for line in status if line.split(":")[0] in keep)
+
+
+def _exit_after_ctrl_c(proc: subprocess.Popen) -> str:
+    """Send Ctrl-C to ``proc``'s group as a terminal does; its stderr once it
+    exits.  Still running after :data:`LIVENESS_S`: fail with what the kernel
+    says the parent and its workers were doing, and the machine's load."""
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        return proc.communicate(timeout=LIVENESS_S)[1]
+    except subprocess.TimeoutExpired:
+        states = "; ".join(_state(pid) for pid in [proc.pid, *_children(proc.pid)])
+        raise AssertionError(f"no exit {LIVENESS_S:g} s after Ctrl-C (load average "
+                             f"{os.getloadavg()}): {states}") from None
+
+
 def _runs(cache: Path) -> int:
     db = cache / "runs.sqlite"
     return RunStore(cache).count("run") if db.exists() else 0
@@ -180,9 +206,8 @@ def test_ctrl_c_cancels_promptly_with_one_line(tmp_path):
     try:
         assert proc.poll() is None, "finished before Ctrl-C"
         n_runs = _runs(cache)
-        os.killpg(proc.pid, signal.SIGINT)  # what a terminal does on Ctrl-C
         t0 = time.monotonic()
-        _, err = proc.communicate(timeout=LIVENESS_S)
+        err = _exit_after_ctrl_c(proc)
         took = time.monotonic() - t0
         assert proc.returncode == 130
         # The plan line printed at the start, then exactly one line: no traceback.
@@ -216,8 +241,7 @@ def test_map_workers_stop_with_the_parent(how):
         assert proc.poll() is None, "finished before it could be stopped"
         t0 = time.monotonic()
         if how == "Ctrl-C":
-            os.killpg(proc.pid, signal.SIGINT)  # what a terminal does
-            _, err = proc.communicate(timeout=LIVENESS_S)
+            err = _exit_after_ctrl_c(proc)
             assert proc.returncode == 130
             lines = [ln for ln in err.splitlines() if ln.strip()]
             assert len(lines) == 1 and lines[0].startswith("interrupted"), err
