@@ -52,10 +52,32 @@ def _env() -> dict:
     return {**os.environ, "PYTHONPATH": str(ROOT)}
 
 
+def _sigint_as_a_terminal_gives_it() -> None:
+    """In the child before exec: SIGINT at its default and unblocked.  An ignored
+    or blocked SIGINT is inherited across exec (and Python keeps an ignored one),
+    so a test process that carries one would start a CLI that can never see
+    Ctrl-C; a terminal's foreground job always starts with it default."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def _warn_if_this_process_hides_sigint() -> None:
+    # Seen in fresh-clone CI (pytest-xdist workers, order varies): the CLI ran on
+    # after Ctrl-C.  Say so where the test log shows it, so it can be traced.
+    ignored = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+    blocked = signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    if ignored or blocked:
+        import warnings
+        warnings.warn(f"SIGINT is {'ignored' if ignored else 'blocked'} in this test process "
+                      f"(pid {os.getpid()}); the CLI under test is started with it restored")
+
+
 def _start(args: list[str]) -> subprocess.Popen:
+    _warn_if_this_process_hides_sigint()
     # Own session: its pid is the process group id of everything it starts.
     return subprocess.Popen(_cli(*args), cwd=ROOT, env=_env(), stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_sigint_as_a_terminal_gives_it)
 
 
 def _group(pgid: int) -> list[int]:
