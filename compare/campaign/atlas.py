@@ -242,7 +242,9 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
             "budget_s": budget_s,
             "not_run": {e: n for e, n in not_run.items() if n},
             "wall_s": time.perf_counter() - t0, "parent_cpu_s": time.process_time() - c0,
-            "local_cpu_s": time.process_time() - c0 + _workers_cpu_s() - w0,
+            # On a Dask cluster the workers are not this process's children.
+            "local_cpu_s": (None if runs._SCHEDULER is not None
+                            else time.process_time() - c0 + _workers_cpu_s() - w0),
             "load_average": [load0, os.getloadavg()[0]], "workers": workers}
 
 

@@ -54,16 +54,17 @@ def _env() -> dict:
 
 def _sigint_as_a_terminal_gives_it() -> None:
     """In the child before exec: SIGINT at its default and unblocked.  An ignored
-    or blocked SIGINT is inherited across exec (and Python keeps an ignored one),
-    so a test process that carries one would start a CLI that can never see
-    Ctrl-C; a terminal's foreground job always starts with it default."""
+    or blocked SIGINT is inherited across exec (and Python keeps an ignored one):
+    a non-interactive shell ignores SIGINT in every command it starts with '&', so
+    a test suite launched in the background would start a CLI that can never see
+    Ctrl-C.  A terminal's foreground job always starts with it default."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def _warn_if_this_process_hides_sigint() -> None:
-    # Seen in fresh-clone CI (pytest-xdist workers, order varies): the CLI ran on
-    # after Ctrl-C.  Say so where the test log shows it, so it can be traced.
+    # E.g. `make test &` from a script: say so in the test log, since the CLI's
+    # own reaction to Ctrl-C is then tested only thanks to the restore above.
     ignored = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
     blocked = signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])
     if ignored or blocked:

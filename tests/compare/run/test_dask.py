@@ -92,6 +92,9 @@ def test_the_atlas_on_the_cluster_equals_the_local_one(cluster):
             runs.set_scheduler(None)
     assert any(pt["engines"]["pymunk"] for pt in local["points"])  # something was measured
     assert rows(remote) == rows(local)
+    # The cluster's workers are not this process's children: their CPU is not
+    # claimed as the run's whole cost (the engine jobs' own CPU is in the table).
+    assert remote["local_cpu_s"] is None and local["local_cpu_s"] > 0
 
 
 def test_unreachable_scheduler_is_a_usage_error():
