@@ -347,7 +347,7 @@ def _restitution_data(doc: dict, pend: bool, title: str, key: str) -> dict:
 
 
 def _draw_restitution(d: dict):
-    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.2))
+    fig, ax = _pyplot().subplots(figsize=(WIDTH, 3.8))
     tol = d["tol"]
     ax.axhspan(-tol, tol, color="tab:green", alpha=0.15, lw=0, label=f"±{tol:g} %")
     ax.axhline(0.0, color="0.5", lw=0.6)
@@ -362,7 +362,9 @@ def _draw_restitution(d: dict):
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("impact number")
     ax.set_ylabel("measured / predicted − 1 [%]")
-    ax.legend()
+    # Below the axes: with five engines' lines spread over the band, no corner
+    # of the axes is free of data.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3)
     fig.tight_layout()
     return fig
 

@@ -71,7 +71,7 @@ class DartEngine(Engine):
 
     name = "dart"
     label = "DART"
-    color = "tab:purple"
+    color = "tab:cyan"
     marker = "v"
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
     default_friction = 10.0

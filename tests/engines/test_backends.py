@@ -30,3 +30,10 @@ def test_configure_names_the_options_a_backend_has():
         engines.configure("bullet")
     s = engines.configure("pymunk", criterion="alpha")
     assert s.criterion.kind == "alpha" and s.criterion.topple_angle == 1.5
+
+
+def test_every_engine_has_its_own_colour():
+    # The report draws every engine on shared axes (spectra, restitution per
+    # impact, time histories) and tells them apart by colour first.
+    colours = {name: engines.get_backend(name).color for name in engines.ENGINES}
+    assert len(set(colours.values())) == len(colours), colours
