@@ -171,17 +171,56 @@ def spread_order(indices: list[int], points: list[dict]) -> list[int]:
     return out
 
 
+def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps: dict,
+               workers: int, deadline: float | None, done: dict, not_run: dict) -> None:
+    """Points ``todo0`` (indices) through every step of every engine, a coarser
+    step only where the finer one agreed; rows appended to the points.  A job left
+    by ``deadline`` is counted in ``not_run`` at its step (its coarser steps are
+    not run either); a job in ``done`` (an identical trick measured before) runs
+    once."""
+    from compare.campaign.study import run_threshold, threshold_description
+    from compare.run.keys import digest
+
+    for e in config.engines:
+        todo = list(todo0)
+        opts = tuple(sorted(config.options(e).items()))
+        for dt in steps[e]:
+            keys, fresh = [], {}
+            for i in todo:
+                pt = points[i]
+                job = (pt["scene"], pt["case"], pt["pulse"], pt["omega"], pt["a_reference"],
+                       pt["mode"], e, dt, config.rel_bracket, config.rel_tol, opts)
+                key = digest(threshold_description(job))
+                keys.append(key)
+                if key not in done:
+                    fresh.setdefault(key, job)
+            rows = _many(run_threshold, list(fresh.values()), workers,
+                         f"atlas: {e} dt={dt:g} s", deadline)
+            done.update((k, r) for k, r in zip(fresh, rows) if r is not None)
+            agreed = []
+            for i, key in zip(todo, keys):
+                if key not in done:
+                    not_run[e][repr(dt)] = not_run[e].get(repr(dt), 0) + 1
+                    continue
+                row = _compact(done[key])
+                points[i]["engines"][e].append(row)
+                if row.get("cause") == "agrees":
+                    agreed.append(i)
+            todo = agreed
+
+
 def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = None) -> dict:
     """Measure the atlas (module docstring); returns the ``atlas.json`` document.
 
     ``budget_s``: wall seconds after which no new chunk of engine jobs starts
     (the model's references and validity are always complete); the points whose
     job was left are counted in ``not_run`` per engine and step, and carry no row
-    for that step (nor for any coarser one).  Engine jobs run in
-    :func:`spread_order`, so a budget leaves a coarser Omega grid on every scene.
+    for that step (nor for any coarser one).  Points run in rounds in
+    :func:`spread_order`, each round through every step, so a budget leaves a
+    coarser Omega grid on every scene, measured at every step.
     """
-    from compare.campaign.study import run_reference, run_threshold, threshold_description
-    from compare.run.keys import backend_version, digest, project_version
+    from compare.campaign.study import run_reference
+    from compare.run.keys import backend_version, project_version
 
     t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
     w0 = _workers_cpu_s()
@@ -202,36 +241,21 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
         points[i].update(valid=v["model_valid"], model_reason=v["model_reason"])
     # Engines run where the model is valid (or its check had nothing to say).
     valid = spread_order([i for i in finite if points[i]["valid"] is not False], points)
-    todo = {e: list(valid) for e in config.engines}
     steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
     not_run: dict = {e: {} for e in config.engines}
-    for level, factor in enumerate(config.factors):
-        for e in config.engines:
-            dt = steps[e][level]
-            opts = tuple(sorted(config.options(e).items()))
-            jobs = [(points[i]["scene"], points[i]["case"], points[i]["pulse"],
-                     points[i]["omega"], points[i]["a_reference"], points[i]["mode"], e, dt,
-                     config.rel_bracket, config.rel_tol, opts) for i in todo[e]]
-            unique: dict[str, int] = {}
-            distinct, index = [], []
-            for job in jobs:
-                key = digest(threshold_description(job))
-                if key not in unique:
-                    unique[key] = len(distinct)
-                    distinct.append(job)
-                index.append(unique[key])
-            rows = _many(run_threshold, distinct, workers, f"atlas: {e} {factor:g}x step",
-                         deadline)
-            agreed = []
-            for i, k in zip(todo[e], index):
-                if rows[k] is None:
-                    not_run[e][repr(dt)] = not_run[e].get(repr(dt), 0) + 1
-                    continue
-                row = _compact(rows[k])
-                points[i]["engines"][e].append(row)
-                if row.get("cause") == "agrees":
-                    agreed.append(i)
-            todo[e] = agreed
+    done: dict[str, dict] = {}  # threshold key -> row: one job per identical trick
+    size = max(10, 4 * workers)
+    # Rounds of points, each through every step before the next round starts: a
+    # budget then leaves a coarser Omega grid measured at every step, never the
+    # calibrated step alone.
+    bar = _bar(len(valid), f"atlas: {', '.join(config.engines)}")
+    try:
+        for start in range(0, len(valid), size):
+            part = valid[start:start + size]
+            _run_round(part, points, config, steps, workers, deadline, done, not_run)
+            bar.update(len(part))
+    finally:
+        bar.close()
     return {"schema_version": 1,
             "what": "engine first-overturning amplitude vs the model over the paper's scenes",
             "config": config.describe(),

@@ -113,6 +113,35 @@ def test_a_time_budget_records_the_jobs_it_did_not_run(store, monkeypatch):
     assert doc["not_run"] == {"pymunk": {repr(base_step("pymunk", config)): 1}}
 
 
+def test_a_budget_leaves_points_measured_at_every_step(monkeypatch):
+    # Twelve points, rounds of ten: a budget that ends after the first round's
+    # two steps leaves ten points with both steps and two unmeasured, never
+    # twelve at the calibrated step and none at the coarser one.
+    config = AtlasConfig(engines=("pymunk",), scenes=SCENES,
+                         omegas=tuple(4.0 + 4 * k for k in range(6)), factors=(1.0, 2.0),
+                         cases=("pendulum",))
+    clock = [0.0]
+    calls = []
+
+    def fake_run_many(fn, items, workers=1, on_done=None):
+        if fn.__name__ == "run_reference":
+            return [(10.0 + job[3], "no-impact") for job in items]
+        if fn.__name__ == "_validity":
+            return [{"model_valid": True, "model_reason": "valid"} for _ in items]
+        clock[0] += 1.0  # each chunk of engine jobs takes one "second"
+        calls.append(len(items))
+        return [{"dt": job[7], "dt_used": job[7], "a_engine": job[4], "rel_error": 0.0,
+                 "cause": "agrees", "cpu_s": 1.0, "sim_s": 1.0} for job in items]
+    monkeypatch.setattr(atlas.runs, "run_many", fake_run_many)
+    monkeypatch.setattr(atlas.time, "perf_counter", lambda: clock[0])
+    doc = run_atlas(config, workers=1, budget_s=1.5)
+    dt = base_step("pymunk", config)
+    counts = sorted(len(pt["engines"]["pymunk"]) for pt in doc["points"])
+    assert counts == [0, 0] + [2] * 10
+    assert calls == [10, 10]
+    assert doc["not_run"] == {"pymunk": {repr(dt): 2}}
+
+
 def test_no_engine_runs_where_the_model_is_invalid(store, monkeypatch):
     config = AtlasConfig(engines=("pymunk",), scenes=SCENES[:1], omegas=(12.0,),
                          factors=(1.0,), cases=("pendulum",))
