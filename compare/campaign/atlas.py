@@ -121,7 +121,7 @@ def _bar(total: int, desc: str):
 def _many(fn, jobs: list, workers: int, desc: str, deadline: float | None = None) -> list:
     """``fn`` over ``jobs`` in order, in chunks; once ``deadline`` (``perf_counter``)
     has passed no new chunk starts and the jobs left are None (not run)."""
-    chunk = max(10, 4 * workers)
+    chunk = max(10, 4 * runs.parallel_slots(workers))
     out: list = [None] * len(jobs)
     bar = _bar(len(jobs), desc)
     try:
@@ -244,7 +244,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
     not_run: dict = {e: {} for e in config.engines}
     done: dict[str, dict] = {}  # threshold key -> row: one job per identical trick
-    size = max(10, 4 * workers)
+    # Four points per job slot (a local worker or a cluster thread), and at least ten.
+    size = max(10, 4 * runs.parallel_slots(workers))
     # Rounds of points, each through every step before the next round starts: a
     # budget then leaves a coarser Omega grid measured at every step, never the
     # calibrated step alone.

@@ -311,6 +311,21 @@ def check_scheduler(address: str) -> None:
     _connect(address).close()
 
 
+def parallel_slots(workers: int) -> int:
+    """How many jobs run at once: the cluster's worker threads when a scheduler is
+    set (:func:`set_scheduler`; at least 1, it may have none yet), else ``workers``.
+
+    For sizing batches so that every slot has work; not for correctness.
+    """
+    if _SCHEDULER is None:
+        return workers
+    client = _connect(_SCHEDULER)
+    try:
+        return max(1, sum(client.nthreads().values()))
+    finally:
+        client.close()
+
+
 class NoWorkers(ValueError):
     """The cluster had no worker for :data:`NO_WORKERS_TIMEOUT_S`."""
 
