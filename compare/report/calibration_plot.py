@@ -8,6 +8,19 @@ import math
 __all__ = ["pareto_plot"]
 
 
+def _varied(evaluations) -> list[str]:
+    """The option names whose values differ between ``evaluations`` (all of them
+    when there is only one candidate)."""
+    names = list(dict.fromkeys(k for e in evaluations for k in e.options))
+    varied = [k for k in names if len({e.options.get(k) for e in evaluations}) > 1]
+    return varied or names
+
+
+def _label(e, varied) -> str:
+    """``'dt 0.0005, solver_iterations 100'``: the candidate's varied settings."""
+    return ", ".join(f"{k} {e.options[k]:g}" for k in varied if k in e.options)
+
+
 def pareto_plot(cal, path) -> None:
     """Write the plot of :class:`compare.campaign.calibrate.Calibration` ``cal`` to
     ``path`` (PNG, PDF or SVG by suffix), atomically."""
@@ -19,19 +32,23 @@ def pareto_plot(cal, path) -> None:
 
     pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.engine_cpu_s > 0]
     front = [e for e in cal.front if e in pts]
-    fig, ax = plt.subplots(figsize=(7.0, 4.6), dpi=150, layout="constrained")
+    fig, ax = plt.subplots(figsize=(7.0, 5.4), dpi=150, layout="constrained")
     ax.scatter([e.engine_cpu_s for e in pts], [max(e.worst_error, 1e-6) for e in pts], s=28,
-               color="0.55", label="candidate", zorder=2)
+               color="0.55", label="candidate (settings: table, CSV)", zorder=2)
     if front:
         ax.plot([e.engine_cpu_s for e in front], [max(e.worst_error, 1e-6) for e in front], "-o",
                 color="C0", ms=5, lw=1.5, label="Pareto front", zorder=3)
-    # One setting per line; neighbours alternate above and below their point, so
-    # candidates that differ in one setting only keep readable labels.
-    for k, e in enumerate(sorted(pts, key=lambda e: e.engine_cpu_s)):
-        ax.annotate("\n".join(f"{name} {v:g}" for name, v in e.options.items()),
-                    (e.engine_cpu_s, max(e.worst_error, 1e-6)), textcoords="offset points",
-                    xytext=(5, 4) if k % 2 == 0 else (5, -4),
-                    va="bottom" if k % 2 == 0 else "top", fontsize=7, color="0.25")
+    # The front's points and the ones without an answer are numbered and keyed below
+    # the axes, naming only the settings that differ between candidates: labels
+    # beside points that nearly coincide in cost overprint one another.  Every
+    # candidate's settings are in the table and CSV.
+    varied = _varied(cal.evaluations)
+    keyed = []
+    for e in front:
+        keyed.append(e)
+        ax.annotate(str(len(keyed)), (e.engine_cpu_s, max(e.worst_error, 1e-6)),
+                    textcoords="offset points", xytext=(0, 7), ha="center",
+                    fontsize=8, fontweight="bold", color="C0")
     ax.axhline(cal.tolerance, color="C3", ls="--", lw=1.2,
                label=f"tolerance {cal.tolerance:g}")
     rec = cal.recommended
@@ -48,9 +65,11 @@ def pareto_plot(cal, path) -> None:
                    color="C3", transform=ax.get_xaxis_transform(), clip_on=False,
                    label="no answer at some point (no bracket)", zorder=3)
         for e in lost:
-            ax.annotate(", ".join(f"{k} {v:g}" for k, v in e.options.items()),
-                        (e.engine_cpu_s, 0.97), xycoords=ax.get_xaxis_transform(),
-                        textcoords="offset points", xytext=(4, -12), fontsize=8, color="C3")
+            keyed.append(e)
+            ax.annotate(str(len(keyed)), (e.engine_cpu_s, 0.97),
+                        xycoords=ax.get_xaxis_transform(), textcoords="offset points",
+                        xytext=(7, 0), ha="left", va="center", fontsize=8,
+                        fontweight="bold", color="C3")
     ax.margins(x=0.2, y=0.15)  # room for the labels at the ends
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -71,5 +90,11 @@ def pareto_plot(cal, path) -> None:
                  fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="best")
+    if keyed:
+        from matplotlib.lines import Line2D
+        fig.legend([Line2D([], [], ls="none")] * len(keyed),
+                   [f"{k}: {_label(e, varied)}" for k, e in enumerate(keyed, 1)],
+                   loc="outside lower center", ncols=1 if len(keyed) < 4 else 2,
+                   fontsize=8, frameon=False, handlelength=0, handletextpad=0)
     atomic.savefig(fig, path)
     plt.close(fig)

@@ -179,3 +179,22 @@ def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
             assert getattr(engines.configure(engine, **{name: v}), name) == v
     assert math.prod(len(v) for v in space.values()) <= MAX_CANDIDATES
     assert set(space) <= {f.name for f in dataclasses.fields(defaults)}
+
+
+def test_the_pareto_plot_keys_its_points_by_the_settings_that_vary(tmp_path):
+    from compare.campaign.calibrate import Calibration
+    from compare.report.calibration_plot import _label, _varied, pareto_plot
+
+    def ev(dt, iters, err, cpu):
+        return Evaluation({"dt": dt, "iterations": iters, "slop_fraction": 1e-4}, err, (),
+                          cpu, 2.0 * cpu, 1.0, 1)
+    evs = [ev(1e-4, 30, 0.004, 8.0), ev(5e-4, 30, 0.009, 2.0), ev(5e-4, 60, 0.008, 2.1),
+           ev(2e-3, 30, math.inf, 0.6)]  # the last: no bracket somewhere
+    cal = Calibration("pymunk", "test", "thresholds", 0.01, ValidationSet(omegas=(12.0,)), evs)
+    # slop_fraction is the same in every candidate: it would only lengthen each key
+    assert _varied(evs) == ["dt", "iterations"]
+    assert _label(evs[1], _varied(evs)) == "dt 0.0005, iterations 30"
+    assert _varied(evs[:1]) == ["dt", "iterations", "slop_fraction"]
+    out = tmp_path / "front.png"
+    pareto_plot(cal, out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
