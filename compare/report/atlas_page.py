@@ -18,6 +18,7 @@ import io
 import math
 from pathlib import Path
 
+from compare.report.cells import unbroken
 from compare.report.trust import label
 
 __all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line",
@@ -243,8 +244,9 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
 
 def _table(head: list[str], rows: list[list]) -> str:
     h = "".join(f"<th>{html.escape(c)}</th>" for c in head)
-    b = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
-                for r in rows)
+    # Causes such as "no-bracket" and numbers such as "1e-4" stay whole on a phone.
+    b = "".join("<tr>" + "".join(f"<td>{unbroken(html.escape(str(c)))}</td>" for c in r)
+                + "</tr>" for r in rows)
     return f"<div class='scroll'><table><tr>{h}</tr>{b}</table></div>"
 
 
@@ -307,7 +309,7 @@ STYLE = ("body{font-family:sans-serif;margin:1em;max-width:1300px}img{max-width:
          "height:auto}table{border-collapse:collapse;font-size:12px}td,th{border:1px solid "
          "#ccc;padding:2px 6px;text-align:left;vertical-align:top}.scroll{overflow-x:auto}"
          "@media (max-width:600px){body{margin:0.4em}table{font-size:11px}"
-         "td,th{padding:2px 3px}}")
+         "td,th{padding:2px 3px}}.nb{white-space:nowrap}")
 
 
 def write_page(doc: dict, path) -> Path:
