@@ -118,10 +118,11 @@ def _bar(total: int, desc: str):
                 leave=False)
 
 
-def _many(fn, jobs: list, workers: int, desc: str, deadline: float | None = None) -> list:
-    """``fn`` over ``jobs`` in order, in chunks; once ``deadline`` (``perf_counter``)
-    has passed no new chunk starts and the jobs left are None (not run)."""
-    chunk = max(10, 4 * runs.parallel_slots(workers))
+def _many(fn, jobs: list, workers: int, chunk: int, desc: str,
+          deadline: float | None = None) -> list:
+    """``fn`` over ``jobs`` in order, in chunks of ``chunk``; once ``deadline``
+    (``perf_counter``) has passed no new chunk starts and the jobs left are None
+    (not run)."""
     out: list = [None] * len(jobs)
     bar = _bar(len(jobs), desc)
     try:
@@ -172,7 +173,8 @@ def spread_order(indices: list[int], points: list[dict]) -> list[int]:
 
 
 def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps: dict,
-               workers: int, deadline: float | None, done: dict, not_run: dict) -> None:
+               workers: int, chunk: int, deadline: float | None, done: dict,
+               not_run: dict) -> None:
     """Points ``todo0`` (indices) through every step of every engine, a coarser
     step only where the finer one agreed; rows appended to the points.  A job left
     by ``deadline`` is counted in ``not_run`` at its step (its coarser steps are
@@ -194,7 +196,7 @@ def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps:
                 keys.append(key)
                 if key not in done:
                     fresh.setdefault(key, job)
-            rows = _many(run_threshold, list(fresh.values()), workers,
+            rows = _many(run_threshold, list(fresh.values()), workers, chunk,
                          f"atlas: {e} dt={dt:g} s", deadline)
             done.update((k, r) for k, r in zip(fresh, rows) if r is not None)
             agreed = []
@@ -227,9 +229,12 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     deadline = None if budget_s is None else t0 + budget_s
     pairs = atlas_scenes(config)
     ref_jobs = [(n, c, p, w) for n, p in pairs for c in config.cases for w in config.omegas]
-    refs = _many(run_reference, ref_jobs, workers, "atlas: model")
+    # Four jobs or points per job slot (a local worker or a cluster thread), at least
+    # ten; the cluster is asked once.
+    size = max(10, 4 * runs.parallel_slots(workers))
+    refs = _many(run_reference, ref_jobs, workers, size, "atlas: model")
     finite = [i for i, (a, _) in enumerate(refs) if math.isfinite(a)]
-    checks = _many(_validity, [(*ref_jobs[i], refs[i][0]) for i in finite], workers,
+    checks = _many(_validity, [(*ref_jobs[i], refs[i][0]) for i in finite], workers, size,
                    "atlas: validity")
     points = []
     for (n, c, p, w), (a_ref, mode) in zip(ref_jobs, refs):
@@ -244,8 +249,6 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     steps = {e: [f * base_step(e, config) for f in config.factors] for e in config.engines}
     not_run: dict = {e: {} for e in config.engines}
     done: dict[str, dict] = {}  # threshold key -> row: one job per identical trick
-    # Four points per job slot (a local worker or a cluster thread), and at least ten.
-    size = max(10, 4 * runs.parallel_slots(workers))
     # Rounds of points, each through every step before the next round starts: a
     # budget then leaves a coarser Omega grid measured at every step, never the
     # calibrated step alone.
@@ -253,7 +256,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     try:
         for start in range(0, len(valid), size):
             part = valid[start:start + size]
-            _run_round(part, points, config, steps, workers, deadline, done, not_run)
+            _run_round(part, points, config, steps, workers, size, deadline, done,
+                       not_run)
             bar.update(len(part))
     finally:
         bar.close()

@@ -106,7 +106,6 @@ def test_unreachable_scheduler_is_a_usage_error():
     assert proc.stderr.strip().splitlines()[-1].startswith("error: --scheduler")
 
 
-
 def test_parallel_slots_counts_the_clusters_threads_not_local_workers(cluster):
     # Two single-threaded workers: batches sized for the cluster, not for --workers.
     runs.set_scheduler(cluster.scheduler_address)
