@@ -1,6 +1,6 @@
 """An engine's whole Fig. 5 engine spectrum at its calibrated threshold settings
-(``docs/validation/settings/ENGINE-thresholds.toml``, what every threshold search
-starts from) against the engine's defaults (dt 1e-4 s): the CPU ratio and which
+(``engines/NAME_/thresholds.toml``, what every threshold search on a scene in
+its domain starts from) against the engine's defaults (dt 1e-4 s): the CPU ratio and which
 points stay within the 2 % tolerance.
 
 ``BENCH_ENGINES=pymunk,mujoco`` (default ``pymunk``, the cheapest; ``calibrated``:
@@ -38,7 +38,7 @@ def _engines() -> list[str]:
     from engines import engine_names
     text = os.environ.get("BENCH_ENGINES", DEFAULT_ENGINE)
     if text.strip() == "calibrated":
-        return [e for e in engine_names() if threshold_options(e)]
+        return [e for e in engine_names() if threshold_options(e, load_scene("fig5"))]
     names = [n.strip() for n in text.split(",") if n.strip()]
     unknown = [n for n in names if n not in engine_names()]
     if unknown or not names:
@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     ref = overturning_spectrum(scene, omegas)
     wrong = False
     for engine in engines:
-        calibrated = threshold_options(engine)
+        calibrated = threshold_options(engine, scene)
         if not calibrated:
             print(f"{engine}: no calibrated threshold settings stored; nothing to compare")
             continue

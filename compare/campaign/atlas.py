@@ -8,8 +8,11 @@ pendulum, Omega = 4..28 rad/s by 2.  At each point the model's threshold
 run (:func:`analytic.threshold_validity.point_validity`); then per engine the
 one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`
 through :func:`compare.campaign.study.run_threshold`) at the engine's calibrated
-threshold step (:func:`compare.campaign.settings_file.threshold_options`) and at
-2x, 5x and 10x that step.
+threshold step where every atlas scene lies in its domain, else its reference step
+(:func:`base_step`), and at 2x, 5x and 10x that step.  A point that fails at a
+step is first remeasured at finer steps down to the reference
+(:mod:`compare.measure.step_rule`); at the coarser steps those finer steps are the
+atlas's own, served by the run store.
 
 Nothing is simulated that a verdict does not need: a point where the model is
 invalid is recorded as such and no engine runs there (no engine is to blame);
@@ -89,12 +92,17 @@ def atlas_scenes(config: AtlasConfig) -> list[tuple[str, str]]:
 
 
 def base_step(engine: str, config: AtlasConfig) -> float:
-    """The engine's calibrated threshold step [s] (a settings file's over it)."""
+    """The engine's threshold step [s] for the atlas: its calibrated step when every
+    atlas scene lies in the calibration's domain, else its reference step (a
+    settings file's step over either)."""
     from engines import configure
 
     from compare.campaign.settings_file import threshold_options
-    return float(configure(engine, **{**threshold_options(engine),
-                                      **config.options(engine)}).dt)
+    from compare.campaign.study import _scene
+    per_scene = [threshold_options(engine, _scene(n, c)) for n, _ in atlas_scenes(config)
+                 for c in config.cases]
+    common = per_scene[0] if all(o == per_scene[0] for o in per_scene) else {}
+    return float(configure(engine, **{**common, **config.options(engine)}).dt)
 
 
 def _validity(job: tuple) -> dict:
@@ -139,8 +147,8 @@ def _many(fn, jobs: list, workers: int, chunk: int, desc: str,
 
 def _compact(row: dict) -> dict:
     """The numbers a map and a table need from a threshold job's row."""
-    keep = ("dt_used", "a_engine", "rel_error", "rel_resolution", "cause", "valid", "n_runs",
-            "isolated", "cpu_s", "sim_s", "from_store", "error")
+    keep = ("dt_used", "a_engine", "rel_error", "rel_resolution", "cause", "agreeing_dt",
+            "valid", "n_runs", "isolated", "cpu_s", "sim_s", "from_store", "error")
     out = {k: row[k] for k in keep if k in row}
     out["dt"] = out.pop("dt_used", row.get("dt"))
     return out

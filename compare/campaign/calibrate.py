@@ -217,10 +217,12 @@ def _thresholds(engine, scene, reference, options, workers):
     for curve, points in es.curves.items():
         for p in points:
             runs += p.n_runs
-            engine_cpu += p.cpu_s
+            engine_cpu += p.point.cpu_s  # the candidate's own search, not the step rule's
             if math.isfinite(p.point.sim_s):  # NaN: served by the store (bypassed here)
                 simulated += p.point.sim_s
-            if p.cause == "model":  # the model cannot judge the engine there
+            # The model cannot judge the engine there (named only after the step
+            # rule found no finer step that agrees).
+            if p.cause == "model":
                 continue
             errors.append((f"{curve} Omega {p.omega:g}", abs(p.rel_error)))
     return errors, engine_cpu, simulated, runs

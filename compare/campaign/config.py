@@ -124,13 +124,19 @@ class CampaignConfig:
         return plain(self)
 
 
-def engine_options(name: str, config: CampaignConfig, thresholds: bool = False) -> dict:
+def engine_options(name: str, config: CampaignConfig, thresholds: bool = False,
+                   scene=None) -> dict:
     """The options the campaign sets for backend ``name``: for a threshold search
-    (``thresholds``) the engine's calibrated threshold settings
+    (``thresholds``) on ``scene`` (default the campaign's) the engine's calibrated
+    threshold settings where the scene lies in their domain
     (:func:`compare.campaign.settings_file.threshold_options`) first, then its
     settings-file table, then ``engine_dt`` (engines only)."""
     from compare.campaign.settings_file import threshold_options
-    options = threshold_options(name) if thresholds and name in ENGINES else {}
+    options = {}
+    if thresholds and name in ENGINES:
+        from scenes import load_scene
+        options = threshold_options(name, scene if scene is not None
+                                    else load_scene(config.scene))
     options.update(config.engine_settings.get(name, {}))
     if config.engine_dt is not None and name in ENGINES:
         options["dt"] = config.engine_dt

@@ -6,10 +6,12 @@
     [pymunk]
     dt = 0.0005
 
-The calibrated threshold settings of each engine are stored in
-``docs/validation/settings/ENGINE-thresholds.toml`` (:func:`threshold_options`):
-every threshold search starts from them; restitution and time histories keep
-the engine's defaults, which are calibrated for them.
+The calibrated threshold settings of each engine ship in its folder with the
+domain they hold in (:mod:`engines.calibration`; :func:`threshold_options`):
+every threshold search on a scene inside that domain starts from them, outside
+it from the engine's reference settings; restitution and time histories keep the
+engine's defaults, which are calibrated for them.  A calibration file (with its
+``[domain]`` and ``[calibration]`` tables) is also a settings file.
 
 Every key is a field of that engine's ``Settings`` and is validated by it
 (:func:`engines.configure`), so a file is refused as a whole, before any run, with
@@ -18,7 +20,6 @@ evaluated.
 """
 from __future__ import annotations
 
-import functools
 import hashlib
 import math
 import tomllib
@@ -26,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["SettingsFile", "load_settings_file", "read_settings_file", "settings_toml",
-           "stored_settings", "threshold_options", "RUN_FIELDS", "SETTINGS_DIR"]
+           "threshold_options", "domain_notes", "RUN_FIELDS"]
 
 # Larger files are not settings files (a handful of keys per engine).
 MAX_BYTES = 64 * 1024
@@ -34,9 +35,6 @@ MAX_BYTES = 64 * 1024
 # window and stop rule of a verdict, the overturning criterion of a spectrum): a
 # settings file holding them would silently change what is measured, not how.
 RUN_FIELDS = ("theta0", "psi0", "t_max", "early_stop", "verdict_only", "criterion")
-# The calibrated settings per engine and metric, written by 'trilith calibrate'
-# (the command that regenerates each is the file's first comment).
-SETTINGS_DIR = Path(__file__).resolve().parents[2] / "docs" / "validation" / "settings"
 
 
 @dataclass(frozen=True)
@@ -95,9 +93,12 @@ def read_settings_file(path) -> SettingsFile:
 
 def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
     import engines
+    from engines.calibration import RESERVED_TABLES
     known = engines.engine_names()
     out = {}
     for name, table in doc.items():
+        if name in RESERVED_TABLES:  # a calibration's domain and record: not settings
+            continue
         if name not in known:
             raise ValueError(f"{where}: unknown engine table [{name}]; allowed: "
                              f"{', '.join(known)}")
@@ -118,19 +119,26 @@ def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
     return out
 
 
-@functools.lru_cache(maxsize=None)
-def stored_settings(engine: str, metric: str) -> SettingsFile | None:
-    """``SETTINGS_DIR/ENGINE-METRIC.toml`` as read (validated), or None when absent."""
-    path = SETTINGS_DIR / f"{engine}-{metric}.toml"
-    return read_settings_file(path) if path.is_file() else None
+def threshold_options(engine: str, scene) -> dict:
+    """The options a threshold search of ``engine`` on ``scene`` starts from: the
+    engine's calibrated threshold settings when ``scene`` lies in their domain,
+    else none (the reference settings; :func:`engines.calibration.threshold_choice`).
+    A ``--settings`` file and ``--dt`` go over them."""
+    from engines.calibration import threshold_choice
+    return threshold_choice(engine, scene).options
 
 
-def threshold_options(engine: str) -> dict:
-    """The options of ``engine``'s calibrated threshold settings (empty when none
-    are stored): the first layer of every threshold search's settings, under a
-    ``--settings`` file and ``--dt``."""
-    stored = stored_settings(engine, "thresholds")
-    return {} if stored is None else stored.options(engine)
+def domain_notes(engines, scenes) -> list[str]:
+    """One line per (engine, scene) whose calibrated threshold step does not hold
+    there (the reference step runs), for a command to print before it works."""
+    from engines.calibration import threshold_choice
+    out = []
+    for e in engines:
+        for sc in scenes:
+            note = threshold_choice(e, sc).note
+            if note and note not in out:
+                out.append(note)
+    return out
 
 
 def settings_toml(engine: str, options: dict, comment: str = "") -> str:

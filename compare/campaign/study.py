@@ -239,7 +239,7 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
     config = CampaignConfig(engines=(engine,), engine_dt=dt or None,
                             engine_settings={engine: dict(options)} if options else {})
     return pulse_settings(engine, scene, 2.0 * a_ref, omega,
-                          **engine_options(engine, config, thresholds=True))
+                          **engine_options(engine, config, thresholds=True, scene=scene))
 
 
 def threshold_description(job: tuple) -> dict:
@@ -284,6 +284,7 @@ def run_threshold(job: tuple) -> dict:
             "bracketed": point.bracketed, "mode_engine": point.mode_engine,
             "n_runs": point.n_runs, "irregular_runs": point.irregular_runs,
             "isolated": len(point.isolated), "cause": point.cause, "valid": point.valid,
+            "agreeing_dt": point.agreeing_dt,
             "cpu_s": point.cpu_s, "sim_s": point.point.sim_s,
             "cpu_s_spent": point.point.cpu_s_spent,
             "from_store": served or point.point.from_store}

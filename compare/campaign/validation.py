@@ -72,7 +72,8 @@ def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
     from compare.measure.engine_spectrum import measure_point
     return measure_point(name, scene, omega, a_ref, mode_ref, case=case,
                          tol=config.tolerances.threshold, rel_tol=config.rel_tol,
-                         convergence=True, **engine_options(name, config, thresholds=True))
+                         convergence=True,
+                         **engine_options(name, config, thresholds=True, scene=scene))
 
 
 def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
@@ -232,7 +233,8 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
     result = CampaignResult(
         config=config, scene=scene,
         settings={b: plain(backend_settings(b, config)) for b in backends},
-        threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True)))
+        threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True,
+                                                                  scene=scene)))
                             for e in config.engines},
         versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)})
 

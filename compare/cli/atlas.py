@@ -111,6 +111,11 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--time-budget must be in [0, 1e5] min, got {budget!r}")
         workers = resolve_workers(args.workers)
         use_store(args)
+        from compare.campaign.atlas import atlas_scenes
+        from compare.campaign.study import _scene
+        from compare.cli.options import step_notes
+        step_notes(engines, [_scene(n, c) for n, _ in atlas_scenes(config)
+                             for c in config.cases])
         doc = run_atlas(config, workers, None if budget is None else 60.0 * budget)
         from engines import engine_names
         doc["engines_not_run"] = [e for e in engine_names() if e not in engines]

@@ -76,9 +76,9 @@ def _run_cost(engine: str, dt: float, costs: dict) -> float:
     prior."""
     from engines import configure
 
-    from compare.campaign.settings_file import threshold_options
+    from engines.calibration import calibrated
 
-    dt = dt or getattr(configure(engine, **threshold_options(engine)), "dt", 1e-4)
+    dt = dt or getattr(configure(engine, **calibrated(engine).options), "dt", 1e-4)
     measured = {}
     for label, (mean, _n) in costs.items():
         name, _, step = label.partition(" dt=")
@@ -116,6 +116,10 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(out, "--out", directory=True, replace=True)
     loaded = settings_from_args(args, study.engines)
     check_budget(study, args.file, loaded)
+    if not study.steps or 0 in study.steps:  # a calibrated step is asked for
+        from compare.campaign.study import _scene
+        from compare.cli.options import step_notes
+        step_notes(study.engines, [_scene(n, c) for n in study.scenes for c in study.cases])
     store = use_store(args)
     t0 = time.perf_counter()
     # --estimate writes nothing: it leaves the output location (and its lock) alone.

@@ -172,11 +172,12 @@ def run(args: argparse.Namespace) -> int:
         from compare.campaign.settings_file import threshold_options
         from compare.measure.map_thresholds import map_thresholds, model_thresholds
         reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers)
+        _options.step_notes(engines, [scene])
         for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
             thresholds[name] = map_thresholds(name, scene, eng_grid[0], settings.pulse,
                                               workers=workers, convergence=args.convergence,
                                               t_max=args.t_max, reference=reference,
-                                              **{**threshold_options(name),
+                                              **{**threshold_options(name, scene),
                                                  **_options.file_options(loaded, name)})
     from analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)

@@ -42,6 +42,18 @@ def info(message: str) -> None:
         print(message)
 
 
+def step_notes(engines, scenes) -> None:
+    """One stderr line per engine whose calibrated threshold step does not hold on a
+    scene (outside its calibration's domain: the reference step runs); ``-q``
+    silences it."""
+    import sys
+
+    from compare.campaign.settings_file import domain_notes
+    if VERBOSITY >= 0:
+        for line in domain_notes(engines, scenes):
+            print(f"note: {line}", file=sys.stderr)
+
+
 def detail(message: str) -> None:
     """A line shown only with ``-v`` (timings, versions, settings)."""
     if VERBOSITY > 0:

@@ -110,6 +110,11 @@ def run(args: argparse.Namespace) -> int:
                    {k: v for k, v in loaded.tables.items() if k in engines})
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     _check_budget(config)
+    if args.dt is None:
+        from compare.cli.options import step_notes
+        from scenes import load_scene
+        sc = load_scene(config.scene)
+        step_notes(config.engines, [sc, sc.without_pendulum()] if sc.has_pendulum else [sc])
     use_store(args)
     t0 = time.perf_counter()
     provenance = collect(args, quick=args.quick)  # the code as it was when the run started

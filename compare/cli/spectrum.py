@@ -300,6 +300,7 @@ def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
 
 def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
     """Each engine's spectrum on the model's grid: its calibrated threshold settings
+    where the scene is in their domain, else its reference ones
     (:func:`compare.campaign.settings_file.threshold_options`), the ``--settings``
     file's table over them, ``--dt``/``--t-max`` over both."""
     from compare.campaign.settings_file import threshold_options
@@ -313,6 +314,9 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
     import time
 
     options = {} if args.dt is None else {"dt": args.dt}
+    if args.dt is None:
+        from compare.cli.options import step_notes
+        step_notes(names, [scene, scene.without_pendulum()] if scene.has_pendulum else [scene])
     if args.t_max is not None:  # the model's window, fixed, in every engine run
         options.update(t_max=args.t_max, early_stop=False)
     results, walls = [], {}
@@ -320,7 +324,7 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
         t0 = time.perf_counter()
         results.append(es.engine_spectrum(name, scene, spec, kind=spec.settings.pulse,
                                           workers=workers, convergence=args.convergence,
-                                          **{**threshold_options(name),
+                                          **{**threshold_options(name, scene),
                                              **file_options(loaded, name), **options}))
         walls[name] = time.perf_counter() - t0
     if args.csv:

@@ -5,9 +5,12 @@ causes.
 report``, ``spectrum --engine``, ``campaign``, ``map --engine``): the robust
 threshold search (:func:`compare.measure.thresholds.engine_threshold` with
 :data:`compare.measure.thresholds.SEARCH`), the model's validity at the point,
-the explanation of every isolated overturn, and, where the engine disagrees
-beyond the tolerance, every candidate cause and the primary one
-(:func:`compare.measure.causes.classify`).  Its result, :class:`EnginePoint`,
+the explanation of every isolated overturn, and, where the point fails
+(disagrees beyond the tolerance, no bracket, a collapse below), first the step
+rule (:func:`compare.measure.step_rule.rule_out_step`: finer steps down to the
+engine's reference step; a finer step that passes makes the cause
+'discretisation'), then every candidate cause and the primary one at the finest
+step measured (:func:`compare.measure.causes.classify`).  Its result, :class:`EnginePoint`,
 is the one result type (``to_dict`` is the summary's
 :class:`compare.campaign.summary.ThresholdResult`).
 
@@ -25,6 +28,7 @@ from engines import configure
 
 from compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
                                     sensitivity_detail)
+from compare.measure.step_rule import passes, rule_out_step
 from compare.measure.threshold_point import ThresholdPoint
 from compare.measure.thresholds import SEARCH, engine_threshold
 
@@ -43,7 +47,10 @@ class EnginePoint:
     ``point`` is the robust search's result; ``cause`` the primary cause
     ('agrees' within ``tol``), ``causes`` every applying one, ``valid`` the
     model at the decisive amplitude, ``validity`` every check, ``isolated`` the
-    search's isolated overturns with what made them (``detail``).
+    search's isolated overturns with what made them (``detail``).  ``steps``: the
+    step rule's rows (:mod:`compare.measure.step_rule`: this step, then each finer
+    step tried; empty when the point passed at its step) and ``agreeing_dt`` the
+    coarsest finer step that passes (the cause is then 'discretisation').
     """
 
     case: str
@@ -55,6 +62,8 @@ class EnginePoint:
     validity: tuple = ()
     convergence: tuple = ()
     isolated: tuple = ()
+    steps: tuple = ()
+    agreeing_dt: float | None = None
 
     def __getattr__(self, name):  # omega, a_engine, a_survives, rel_error, ... of the point
         if name == "point":
@@ -63,8 +72,9 @@ class EnginePoint:
 
     @property
     def cpu_s(self) -> float:
-        """CPU seconds of the point's runs when computed, the reruns included."""
-        extra = [r.get("cpu_s", math.nan) for r in self.convergence[1:]]
+        """CPU seconds of the point's runs when computed, the reruns (finer steps of
+        the step rule, cause reruns) included."""
+        extra = [r.get("cpu_s", math.nan) for r in (*self.steps[1:], *self.convergence[1:])]
         return self.point.cpu_s + math.fsum(extra) if extra else self.point.cpu_s
 
     def to_dict(self) -> dict:
@@ -72,6 +82,7 @@ class EnginePoint:
         out.update(case=self.case, cause=self.cause, cause_detail=self.cause_detail,
                    causes=list(self.causes), valid=self.valid, validity=list(self.validity),
                    convergence=list(self.convergence), isolated=list(self.isolated),
+                   steps=list(self.steps), agreeing_dt=self.agreeing_dt,
                    cpu_s=self.cpu_s, search_cpu_s=self.point.cpu_s)
         return out
 
@@ -117,7 +128,8 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
         First bracket's half-width relative to ``a_reference`` (default
         ``0.45 rel_tol``, :class:`~compare.measure.thresholds.Search`).
     convergence : bool
-        Rerun a disagreeing point at dt/2, dt/4 and doubled iterations.
+        Rerun a disagreeing point at dt/2, dt/4 and doubled iterations (of the
+        finest step the step rule measured).  The step rule itself always runs.
     settings : EngineSettings, optional
         Default: :func:`pulse_settings` for pulses up to 2.2 ``a_reference``
         (the widest bracket) with ``options``.
@@ -131,7 +143,7 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
                          mode_reference=mode_reference, search=search)
     isolated = tuple({**i, "detail": explain_isolated(engine, scene, omega, i, settings, kind)}
                      for i in p.isolated)
-    if p.bracketed and abs(p.rel_error) <= tol and not p.collapsed_below:
+    if passes(p, tol):
         validity = model_validity(scene, omega, kind,
                                   {"model threshold": a_reference, "engine survives":
                                    p.a_survives, "engine overturns": p.a_engine},
@@ -140,10 +152,27 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
                   if p.isolated or p.flips else ())
         return EnginePoint(case, p, "agrees", f"within {100 * tol:g} %", causes,
                            validity[0]["valid"], tuple(validity), (), isolated)
-    c = classify(engine, scene, omega, p, settings, kind=kind, tol=tol, search=search,
-                 convergence=convergence)
-    return EnginePoint(case, p, c.cause, c.detail, c.causes, c.valid, c.validity,
-                       c.convergence, isolated)
+    # The step is ruled out before any other cause is named.
+    check = rule_out_step(engine, scene, omega, p, settings, kind=kind, tol=tol, search=search)
+    if check.agreeing_dt is not None:
+        ok = next(r for r in check.rows if r["dt"] == check.agreeing_dt)
+        validity = model_validity(scene, omega, kind,
+                                  {"model threshold": a_reference, "engine survives":
+                                   ok["a_survives"], "engine overturns": ok["a_engine"]},
+                                  settings.friction)
+        detail = check.detail(tol)
+        return EnginePoint(case, p, "discretisation", detail,
+                           ({"name": "discretisation", "detail": detail},),
+                           validity[0]["valid"], tuple(validity), (), isolated,
+                           check.rows, check.agreeing_dt)
+    c = classify(engine, scene, omega, check.point, check.settings, kind=kind, tol=tol,
+                 search=search, convergence=convergence)
+    detail = c.detail
+    if len(check.rows) > 1:
+        detail = (f"at the reference step dt = {check.settings.dt:.3g} s ({check.detail(tol)}): "
+                  f"{detail}")
+    return EnginePoint(case, p, c.cause, detail, c.causes, c.valid, c.validity,
+                       c.convergence, isolated, check.rows if len(check.rows) > 1 else ())
 
 
 def _point_job(args) -> EnginePoint:

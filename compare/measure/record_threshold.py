@@ -35,7 +35,11 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["engine_intensity"]
+__all__ = ["engine_intensity", "STEP_TOL"]
+
+# Agreement with the model's intensity that ends the step rule: the threshold
+# tolerance of the pulse spectra (2 %).
+STEP_TOL = 0.02
 
 
 def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
@@ -63,16 +67,35 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
         overturns]`` even above ``im_hi``), ``collapsed`` (intensities whose
         nominal run ended 'collapsed': the frame broke), ``isolated`` (overturns not
         reproduced by their perturbed neighbours), ``flips``, ``n_runs``,
-        ``cpu_s`` (CPU seconds of the runs when computed), ``im_reference``.
+        ``cpu_s`` (CPU seconds of the runs when computed), ``im_reference``,
+        ``dt`` (the step of the result) and ``step_rule`` (None, or the rows of
+        :func:`compare.measure.step_rule.rule_out_step` when the asked step
+        missed the model's intensity by more than :data:`STEP_TOL`: the result is
+        then the coarsest finer step's that agrees, or the reference step's).
     """
     import engines
     from analytic.ida import scale_to
+    from compare.measure.step_rule import rule_out_step
     from compare.measure.thresholds import engine_threshold
 
     settings = engines.configure(backend, t_max=motion.end_time + st.tail, **(options or {}))
     centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
-    p = engine_threshold(backend, scene, math.nan, centre, settings,
-                         motion=lambda v: scale_to(motion, st.im, v))
+    scaled = lambda v: scale_to(motion, st.im, v)  # noqa: E731
+    p = engine_threshold(backend, scene, math.nan, centre, settings, motion=scaled)
+    step = None
+    if im_model is not None and math.isfinite(im_model):
+        # The step is ruled out first: a coarse step that misses the model's
+        # intensity is remeasured finer; the coarsest step that agrees is used.
+        check = rule_out_step(backend, scene, math.nan, p, settings, tol=STEP_TOL,
+                              motion=scaled)
+        if len(check.rows) > 1:
+            step = {"dt": settings.dt, "rows": list(check.rows),
+                    "agreeing_dt": check.agreeing_dt, "detail": check.detail(STEP_TOL)}
+            if check.agreeing_dt is not None:
+                settings = engines.configure(backend, settings, dt=check.agreeing_dt)
+                p = engine_threshold(backend, scene, math.nan, centre, settings, motion=scaled)
+            else:
+                p, settings = check.point, check.settings
     over = p.bracketed and p.a_engine <= st.im_hi
     censored = p.bracketed and not over or (not p.bracketed and _survives_all(p, st.im_hi))
     long_run = _long_run(backend, scene, motion, st, settings, p, over)
@@ -85,7 +108,7 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
                           if q.status == "collapsed" and not q.perturbation],
             "isolated": list(p.isolated), "flips": [f.to_dict() for f in p.flips],
             "n_runs": p.n_runs, "cpu_s": p.cpu_s, "im_reference": centre,
-            "islands": [], "long_run": long_run}
+            "islands": [], "long_run": long_run, "dt": settings.dt, "step_rule": step}
 
 
 def _long_run(backend, scene, motion, st, settings, p, over: bool) -> dict | None:

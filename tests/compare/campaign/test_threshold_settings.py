@@ -1,41 +1,93 @@
-"""Threshold searches start from each engine's stored calibrated threshold
-settings; restitution and time histories keep the engine's defaults; a settings
-file and ``--dt`` go over them, in that order."""
+"""Threshold searches start from each engine's shipped calibrated threshold
+settings on a scene inside their domain and from the reference settings outside
+it; restitution and time histories keep the engine's defaults; a settings file
+and ``--dt`` go over them, in that order."""
 from __future__ import annotations
+
+import dataclasses
 
 import pytest
 
-from compare.campaign.settings_file import SETTINGS_DIR, stored_settings, threshold_options
+import engines as engines_pkg
+from compare.campaign.settings_file import domain_notes, read_settings_file, threshold_options
 from compare.campaign.study import job_settings
 from compare.campaign.validation import CampaignConfig, backend_settings, engine_options
 from engines import configure
+from engines.calibration import calibrated, scene_coordinates, threshold_choice
 from scenes import load_scene
 
-STORED = sorted(p.stem.removesuffix("-thresholds")
-                for p in SETTINGS_DIR.glob("*-thresholds.toml"))
+ENGINES = engines_pkg.ENGINES
 
 
-def test_stored_threshold_settings_are_valid_engine_settings():
-    assert "pymunk" in STORED  # the cheapest engine is calibrated
-    for engine in STORED:
-        stored = stored_settings(engine, "thresholds")
-        assert set(stored.tables) == {engine}
-        assert stored.path.endswith(f"{engine}-thresholds.toml")
-        # The regenerating command is the file's first line.
-        first = (SETTINGS_DIR / f"{engine}-thresholds.toml").read_text().splitlines()[0]
-        assert first.startswith(f"# trilith calibrate --engine {engine} --metric thresholds")
+@pytest.mark.parametrize("engine", ENGINES)
+def test_every_engine_ships_its_calibration_as_package_data(engine):
+    cal = calibrated(engine)
+    assert cal.source.endswith("thresholds.toml") and f"{engine}_" in cal.source
+    # The regenerating command is the file's first line.
+    assert cal.command.startswith(f"trilith calibrate --engine {engine} --metric thresholds")
+    configure(engine, **cal.options)  # valid settings of the engine
+    if cal.options:  # a calibrated step holds in a stated domain
+        assert cal.domain.ranges
+        assert cal.domain.outside(load_scene("fig5")) is None
 
 
-@pytest.mark.parametrize("engine", STORED)
+def test_a_missing_calibration_is_an_error_not_a_fallback(monkeypatch):
+    import engines.calibration as c
+    calibrated.cache_clear()
+
+    class Missing:
+        def read_text(self, encoding=None):
+            raise FileNotFoundError("thresholds.toml")
+    monkeypatch.setattr(c, "_resource", lambda engine, metric: Missing())
+    try:
+        with pytest.raises(ValueError, match="missing from the engine's package"):
+            threshold_options("pymunk", load_scene("fig5"))
+    finally:
+        monkeypatch.undo()
+        calibrated.cache_clear()
+
+
+@pytest.mark.parametrize("engine", ENGINES)
 def test_only_threshold_searches_use_them(engine):
-    stored = threshold_options(engine)
+    scene = load_scene("fig5")
+    stored = threshold_options(engine, scene)
     config = CampaignConfig(engines=(engine,))
     assert engine_options(engine, config, thresholds=True) == stored
     assert engine_options(engine, config) == {}
     assert backend_settings(engine, config) == configure(engine)  # restitution, histories
-    scene = load_scene("fig5")
     assert job_settings(engine, 0.0, scene, 10.0, 12.0).dt == stored.get("dt",
                                                                           configure(engine).dt)
+
+
+def _outside(cal):
+    """A scene just past the upper end of the domain's first varied range."""
+    name, (lo, hi) = next((n, r) for n, r in cal.domain.ranges if n in ("lam", "mu"))
+    return load_scene("fig5").replace(**{name: hi * 1.05 + 0.01})
+
+
+@pytest.mark.parametrize("engine", [e for e in ENGINES if calibrated(e).options])
+def test_outside_its_domain_the_reference_step_runs_and_says_so(engine):
+    cal = calibrated(engine)
+    scene = _outside(cal)
+    choice = threshold_choice(engine, scene)
+    assert not choice.inside and choice.options == {}
+    assert "outside the domain" in choice.note and f"{configure(engine).dt:g}" in choice.note
+    assert job_settings(engine, 0.0, scene, 10.0, 12.0).dt == configure(engine).dt
+    notes = domain_notes([engine], [scene, load_scene("fig5")])
+    assert len(notes) == 1 and "\n" not in notes[0]
+    # A value the calibration kept fixed (the column's inertia) is outside too.
+    inertia = dataclasses.replace(load_scene("fig5"), J_G=None).replace(
+        J_G=1.5 * scene_coordinates(load_scene("fig5"))["J_G_over_uniform"]
+        * load_scene("fig5").m1 * (0.6 ** 2 + 3.0 ** 2) / 12.0)
+    assert "calibration kept" in threshold_choice(engine, inertia).note
+
+
+def test_a_calibration_file_is_a_settings_file(tmp_path):
+    text = calibrated("pymunk").source
+    from pathlib import Path
+    f = tmp_path / "cal.toml"
+    f.write_text(Path(text).read_text())
+    assert set(read_settings_file(f).tables) == {"pymunk"}
 
 
 def test_a_settings_file_then_dt_go_over_the_calibrated_step():
