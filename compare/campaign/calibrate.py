@@ -71,7 +71,8 @@ class ValidationSet:
         Impacts measured per release (default 3).
     omegas : tuple of float
         Pulse frequencies [rad/s] for ``thresholds`` (default 6, 12, 18: the
-        rising, middle and upper part of the Fig. 5 curves, away from its jumps).
+        rising, middle and upper part of the Fig. 5 curves, away from its jumps);
+        empty: each scene's own band (:func:`compare.campaign.design.scene_omegas`).
     points : tuple of str
         The paper's points for ``histories`` (default A-D).
     """
@@ -319,7 +320,10 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         if metric == "thresholds":
             if id(sc) not in reference:
                 from analytic.spectrum import overturning_spectrum
-                reference[id(sc)] = overturning_spectrum(sc, list(vs.omegas))
+
+                from compare.campaign.design import scene_omegas
+                reference[id(sc)] = overturning_spectrum(
+                    sc, list(vs.omegas) if vs.omegas else scene_omegas(sc))
             return _thresholds(engine, sc, reference[id(sc)], cand, workers)
         return _histories(engine, sc, vs, cand)
 

@@ -47,7 +47,17 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="search the time step only: leave out the engine's declared "
                              "ranges of its other settings (docs/calibrate.md)")
     parser.add_argument("--omega", default=None, metavar="W1,W2,...",
-                        help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18)")
+                        help="pulse frequencies [rad/s] of the thresholds set (default: 6,12,18; "
+                             "with --design each scene's own band)")
+    parser.add_argument("--design", default=None, metavar="N,M",
+                        help="thresholds over a sampled design instead of --scene: N training "
+                             "triliths (the settings are chosen on them) and M held-out ones "
+                             "(the chosen settings' worst error is reported on them), Latin "
+                             "hypercube over lam, b, mu, gamma, l/h, gap/h, lintel height/b "
+                             "(compare/campaign/design.py); the ranges become the settings' "
+                             "domain in --settings-out")
+    parser.add_argument("--seed", type=int, default=None, metavar="S",
+                        help="the design's seed (default 34; the held-out set uses S + 1)")
     add_settings_arg(parser)
     add_workers_arg(parser)
     add_store_args(parser)
@@ -95,7 +105,7 @@ def _space(args, engine: str, base: dict) -> dict:
     return space
 
 
-def _check_budget(engine: str, space: dict, vs, base: dict) -> None:
+def _check_budget(engine: str, space: dict, vs, base: dict, scenes=()) -> None:
     """Refuse before any work a step that is not positive or whose longest run
     (the lowest validation frequency's pulse) is over the run budget."""
     import dataclasses
@@ -108,7 +118,15 @@ def _check_budget(engine: str, space: dict, vs, base: dict) -> None:
         if not 0.0 < dt <= MAX_ENGINE_DT:
             raise ValueError(f"--dt: each step must be in (0, {MAX_ENGINE_DT:g}] s, got {dt!r}")
         check_run_budget(engine, dataclasses.replace(settings, dt=dt),
-                         Pulse(1.0, min(vs.omegas)), option="--dt")
+                         Pulse(1.0, _lowest_omega(vs, scenes)), option="--dt")
+
+
+def _lowest_omega(vs, scenes) -> float:
+    """The lowest validation frequency (the longest pulse) [rad/s]."""
+    from compare.campaign.design import scene_omegas
+    if vs.omegas:
+        return min(vs.omegas)
+    return min(w for sc in scenes for w in scene_omegas(sc))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -120,16 +138,21 @@ def run(args: argparse.Namespace) -> int:
     if len(engine) != 1:
         raise ValueError("--engine: calibrate one engine at a time")
     engine = engine[0]
-    scenes = _common.scenes_from_args(args)
+    design = _design(args)
+    scenes = design[0] if design else _common.scenes_from_args(args)
     loaded = settings_from_args(args, (engine,))
     base = file_options(loaded, engine)
     space = _space(args, engine, base)
     names = tuple(sc.name for sc in scenes)
     name = names[0] if len(names) == 1 else names
-    vs = ValidationSet(scene=name) if args.omega is None else ValidationSet(
-        scene=name, omegas=tuple(float(_number(v.strip(), "--omega"))
-                                 for v in args.omega.split(",") if v.strip()))
-    _check_budget(engine, space, vs, base)
+    if args.omega is not None:
+        omegas = tuple(float(_number(v.strip(), "--omega")) for v in args.omega.split(",")
+                       if v.strip())
+        if not omegas:
+            raise ValueError("--omega: give at least one frequency [rad/s]")
+    vs = (ValidationSet(scene=name, omegas=omegas) if args.omega is not None
+          else ValidationSet(scene=name, omegas=()) if design else ValidationSet(scene=name))
+    _check_budget(engine, space, vs, base, scenes)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
     for option, path in outputs.items():
@@ -155,6 +178,9 @@ def run(args: argparse.Namespace) -> int:
     if bar is not None:
         bar.close()
     _print(cal)
+    held = None
+    if design and cal.recommended is not None:
+        held = _held_out(engine, args, cal, design[1], vs, base, workers)
     body = plain(cal.to_dict())
     if args.json is not None:
         import json
@@ -176,10 +202,13 @@ def run(args: argparse.Namespace) -> int:
         if rec is None:
             info(f"no candidate met the tolerance: {args.settings_out} not written")
         else:
-            atomic.write_text(args.settings_out, settings_toml(engine, {**base, **rec.options}, (
+            text = settings_toml(engine, {**base, **rec.options}, (
                 f"{_command(args, engine)}\nworst error {rec.worst_error:.3g} "
-                f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the validation "
-                f"set")))
+                f"(tolerance {cal.tolerance:g}), {rec.engine_cpu_s:.3g} engine CPU s on the "
+                f"{'training' if design else 'validation'} set"))
+            if design:
+                text += _domain_tables(args, cal, design, held)
+            atomic.write_text(args.settings_out, text)
             info(f"wrote {args.settings_out}")
     return 0 if rec is not None else 1
 
@@ -188,18 +217,83 @@ def _command(args, engine: str) -> str:
     """The calibrate command that regenerates a settings file (what it varied)."""
     import shlex
     words = [f"trilith calibrate --engine {engine} --metric {args.metric}"]
-    words += [f"--scene {shlex.quote(item)}" for item in args.scene or ["fig5"]]
+    if args.design is None:
+        words += [f"--scene {shlex.quote(item)}" for item in args.scene or ["fig5"]]
     words += [f"--set {shlex.quote(item)}" for item in args.overrides]
     if args.no_pendulum:
         words.append("--no-pendulum")
     if args.settings is not None:
         words.append(f"--settings {shlex.quote(args.settings)}")
-    words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance")
+    words += [f"--{k} {getattr(args, k)}" for k in ("dt", "omega", "tolerance", "design",
+                                                    "seed")
               if getattr(args, k) is not None]
     words += [f"--vary {v}" for v in args.vary]
     if args.step_only:
         words.append("--step-only")
     return " ".join(words)
+
+
+def _design(args):
+    """``(training scenes, held-out scenes)`` of ``--design N,M``, or None."""
+    if args.design is None:
+        if args.seed is not None:
+            raise ValueError("--seed: only with --design")
+        return None
+    from compare.campaign.design import SEED, design_scenes
+    if args.metric != "thresholds":
+        raise ValueError("--design: only for --metric thresholds")
+    if args.scene or args.overrides or args.no_pendulum:
+        raise ValueError("--design: the design gives the scenes; leave out --scene, --set "
+                         "and --no-pendulum")
+    parts = [p.strip() for p in args.design.split(",")]
+    if len(parts) != 2 or not all(p.isdigit() for p in parts):
+        raise ValueError(f"--design must be N,M (training and held-out scene counts), got "
+                         f"{args.design!r}")
+    n, m = int(parts[0]), int(parts[1])
+    if not (1 <= n <= 50 and 1 <= m <= 50):
+        raise ValueError(f"--design: N and M must be in [1, 50], got {n},{m}")
+    seed = SEED if args.seed is None else args.seed
+    if not 0 <= seed < 2 ** 32 - 1:
+        raise ValueError(f"--seed must be in [0, 2^32 - 2], got {seed}")
+    return (design_scenes(n, seed, prefix="train"), design_scenes(m, seed + 1, prefix="held"),
+            seed)
+
+
+def _held_out(engine, args, cal, held, vs, base, workers):
+    """The recommended settings' worst error on the held-out scenes (one candidate)."""
+    from compare.campaign.calibrate import ValidationSet, calibrate
+    names = tuple(sc.name for sc in held)
+    ev = calibrate(engine, "thresholds", validation=ValidationSet(scene=names, omegas=vs.omegas),
+                   space={k: [v] for k, v in cal.recommended.options.items()},
+                   tolerance=cal.tolerance, workers=workers, scene=held,
+                   base=base).evaluations[0]
+    worst = max(ev.errors, key=lambda e: e[1]) if ev.errors else ("-", math.nan)
+    print(f"held-out ({len(held)} scenes, {len(ev.errors)} points): worst error "
+          f"{ev.worst_error:.3g} at {worst[0]} (tolerance {cal.tolerance:g}, "
+          f"{'met' if ev.worst_error <= cal.tolerance else 'NOT met'}); "
+          f"{ev.engine_cpu_s:.3g} engine CPU s")
+    return ev
+
+
+def _domain_tables(args, cal, design, held) -> str:
+    """The ``[domain]`` and ``[calibration]`` tables of a design's settings file."""
+    from compare.campaign.design import OMEGA_OVER_P, domain_table
+    rec = cal.recommended
+    lines = ["", "# The ranges the design sampled: a scene uses these settings only inside",
+             "# every one (engines/calibration.py); outside, the reference step runs.",
+             "[domain]"]
+    for key, value in domain_table().items():
+        lines.append(f"{key} = {'true' if value is True else value!r}")
+    train, test, seed = design
+    lines += ["", "[calibration]", f"seed = {seed}", f"training_scenes = {len(train)}",
+              f"training_points = {len(rec.errors)}",
+              f"training_worst_error = {rec.worst_error!r}",
+              f"held_out_scenes = {len(test)}", f"held_out_seed = {seed + 1}",
+              f"held_out_points = {len(held.errors) if held else 0}",
+              f"held_out_worst_error = {(held.worst_error if held else math.nan)!r}",
+              f"tolerance = {cal.tolerance!r}",
+              f"omega_over_p = {list(OMEGA_OVER_P)!r}"]
+    return "\n".join(lines) + "\n"
 
 
 def _label(options: dict) -> str:

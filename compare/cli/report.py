@@ -112,7 +112,6 @@ def run(args: argparse.Namespace) -> int:
     _check_budget(config)
     if args.dt is None:
         from compare.cli.options import step_notes
-        from scenes import load_scene
         sc = load_scene(config.scene)
         step_notes(config.engines, [sc, sc.without_pendulum()] if sc.has_pendulum else [sc])
     use_store(args)

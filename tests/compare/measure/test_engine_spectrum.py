@@ -73,7 +73,9 @@ def test_cli_engine_spectrum_json_csv_plot(tmp_path, capsys):
     assert _without_costs(again["engines"]) == _without_costs(doc["engines"])
     for name, spec in doc["engines"].items():
         # The threshold searches' calibrated step (else the engine's own), carried in the JSON.
-        assert spec["settings"]["dt"] == threshold_options(name).get("dt", engines.configure(name).dt)
+        fig5 = load_scene("fig5")
+        assert spec["settings"]["dt"] == threshold_options(name, fig5).get(
+            "dt", engines.configure(name).dt)
         for key in ("pendulum", "no_pendulum"):
             for p in spec["curves"][key]:
                 for field in ("omega", "a_reference", "a_engine", "a_survives", "rel_error",
