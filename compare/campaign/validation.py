@@ -45,6 +45,16 @@ __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
 
 
 # ----------------------------------------------------------------------- jobs
+def _domain_entry(engine: str, scene) -> dict:
+    """Whether ``scene`` lies in the domain of ``engine``'s calibrated threshold
+    step, the domain and the held-out result it was validated with."""
+    from engines.calibration import calibrated, threshold_choice
+    cal, choice = calibrated(engine), threshold_choice(engine, scene)
+    return {"calibrated": bool(cal.options), "inside": choice.inside, "note": choice.note,
+            "domain": cal.domain.as_dict() if cal.options else None,
+            "calibration": dict(cal.record), "source": cal.command}
+
+
 def _job_history(name, scene, point, config):
     amp, omega = POINTS[point]
     settings = backend_settings(name, config)
@@ -206,6 +216,7 @@ class CampaignResult:
     errors: list = field(default_factory=list)  # jobs that raised, with the message
     long_runs: list = field(default_factory=list)  # compare.measure.long_runs rows
     threshold_settings: dict = field(default_factory=dict)  # engine -> its threshold searches'
+    threshold_domain: dict = field(default_factory=dict)  # engine -> calibration domain, inside
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
@@ -213,7 +224,8 @@ class CampaignResult:
                 "comparisons": self.comparisons, "restitution": self.restitution,
                 "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
                 "errors": self.errors, "long_runs": self.long_runs,
-                "threshold_settings": self.threshold_settings}
+                "threshold_settings": self.threshold_settings,
+                "threshold_domain": self.threshold_domain}
 
 
 def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
@@ -236,7 +248,8 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
         threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True,
                                                                   scene=scene)))
                             for e in config.engines},
-        versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)})
+        versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)},
+        threshold_domain={e: _domain_entry(e, scene) for e in config.engines})
 
     # Reference spectra first (in this process: the compiled kernels are then
     # inherited by the forked workers).

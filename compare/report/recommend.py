@@ -24,7 +24,7 @@ from __future__ import annotations
 import re
 
 from compare.report.cells import cause_phrase
-from compare.report.trust import fmt_pct, fmt_sci, label
+from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
 
 __all__ = ["recommendations"]
 
@@ -41,13 +41,16 @@ def _dt(row: dict, thresholds: bool = False) -> str:
 
 def _thresholds(trust: dict) -> str | None:
     good, finer, bad = [], [], []
-    for e, row in trust.items():
+    for e, row in sorted(trust.items(), key=lambda kv: _point_cost(kv[1])):
         t = row["thresholds"]
         if not t["n_points"]:
             continue
         blamed = [p for p in t["failing"] if p.get("cause") != "model"]
+        cost = row["cost"].get("threshold_point_cpu_s")
+        at = _dt(row, thresholds=True) + (f", {fmt_seconds(cost)} CPU per point"
+                                          if cost is not None else "")
         if not blamed:
-            good.append((label(e), _dt(row, thresholds=True)))
+            good.append((label(e), at))
             continue
         steps = [_DT_MEETS.search(p.get("cause_detail") or "") for p in blamed]
         if all(p.get("cause") == "discretisation" for p in blamed) and all(steps):
@@ -59,7 +62,33 @@ def _thresholds(trust: dict) -> str | None:
                    else f"{100 * worst['rel_error']:+.1f} %")
             bad.append(f"{label(e)} ({err} at Ω = {worst['omega']:g} rad/s, "
                        f"{cause_phrase(worst.get('cause'))})")
-    return _line("Overturning thresholds", good + finer, bad)
+    line = _line("Overturning thresholds, cheapest that passes first", good + finer, bad,
+                 ordered=True)
+    return None if line is None else line[:-1] + _domain_sentence(trust) + "."
+
+
+def _point_cost(row: dict) -> float:
+    cost = row.get("cost", {}).get("threshold_point_cpu_s")
+    return float("inf") if cost is None else cost
+
+
+def _domain_sentence(trust: dict) -> str:
+    """Where the calibrated threshold steps hold, and which engines run their
+    reference step on this scene."""
+    inside, outside = [], []
+    for e, row in trust.items():
+        dom = row.get("threshold_domain") or {}
+        if not dom.get("calibrated"):
+            continue
+        (inside if dom.get("inside") else outside).append(label(e))
+    if not inside and not outside:
+        return ""
+    text = (". Calibrated threshold steps hold inside the domain of their calibration "
+            "(engines/NAME_/thresholds.toml, docs/calibrate.md)")
+    if outside:
+        text += ("; this scene is outside it, so " + ", ".join(outside)
+                 + " ran the reference step")
+    return text
 
 
 def _verdict_use(trust: dict, title: str, key: str, what) -> str | None:
@@ -89,16 +118,21 @@ def _histories(trust: dict) -> str | None:
     return _line("Time histories (verdicts at A-D, θ(t) to the first impact)", good, bad)
 
 
-def _line(title: str, good: list[tuple[str, str]], bad: list[str]) -> str | None:
+def _line(title: str, good: list[tuple[str, str]], bad: list[str],
+          ordered: bool = False) -> str | None:
     """``title: A or B at dt = X; C at dt <= Y; not D (why)``: the engines that
-    pass, grouped by the step they pass at, then the ones that do not."""
+    pass, grouped by the step they pass at (each in its own place when
+    ``ordered``: cheapest first), then the ones that do not."""
     if not good and not bad:
         return None
-    steps: dict[str, list[str]] = {}
-    for name, step in good:
-        steps.setdefault(step, []).append(name)
-    groups = [(", ".join(n[:-1]) + " or " + n[-1] if len(n) > 1 else n[0]) + f" at {step}"
-              for step, n in steps.items()]
+    if ordered:
+        groups = [f"{name} at {step}" for name, step in good]
+    else:
+        steps: dict[str, list[str]] = {}
+        for name, step in good:
+            steps.setdefault(step, []).append(name)
+        groups = [(", ".join(n[:-1]) + " or " + n[-1] if len(n) > 1 else n[0])
+                  + f" at {step}" for step, n in steps.items()]
     text = f"{title}: " + ("; ".join(groups) if groups else "no engine passes")
     if bad:
         text += "; not " + ", not ".join(bad)

@@ -127,9 +127,18 @@ def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
                      f"for {c['spectrum_frequencies']} frequencies")
 
     def settings(row):
-        dt = row["settings"].get("dt")
-        return _cell(("defaults" if dt is None else f"dt = {fmt_sci(dt)} s")
-                     + "; all settings in the table below")
+        # The steps the recommendation names: the threshold searches' (calibrated
+        # inside its domain, else the reference) beside the other checks'.
+        dt, t_dt = row["settings"].get("dt"), row.get("threshold_dt")
+        text = "defaults" if dt is None else f"dt = {fmt_sci(dt)} s"
+        if t_dt is not None:
+            dom = row.get("threshold_domain") or {}
+            why = ("calibrated, this scene inside its domain" if dom.get("calibrated")
+                   and dom.get("inside") else "reference step: scene outside the "
+                   "calibration's domain" if dom.get("calibrated") else "reference step")
+            text = (f"thresholds at dt = {fmt_sci(t_dt)} s ({why}); restitution and θ(t) "
+                    f"at {text}" if t_dt != dt or dom else text)
+        return _cell(text + "; all settings in the table below")
 
     spec = [("restitution vs Eq. 20, worst impact", f"≤ {fmt_pct(tols['restitution'])}",
              lambda r: verdict_cell(r, "restitution_eq20")),

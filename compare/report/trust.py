@@ -277,6 +277,8 @@ def trust_table(doc: dict) -> dict[str, dict]:
         row["settings"] = key_settings(doc, engine)
         if engine in (doc.get("threshold_settings") or {}):  # their own step
             row["threshold_dt"] = doc["threshold_settings"][engine].get("dt")
+        if doc.get("threshold_domain"):  # summaries from before domains had none
+            row["threshold_domain"] = doc["threshold_domain"].get(engine)
         mine = [v for v in doc.get("verdicts", []) if v.get("backend") == engine]
         row["verdicts"] = {"passed": sum(bool(v.get("passed")) for v in mine),
                            "total": len(mine)}

@@ -56,8 +56,14 @@ def test_report_files_and_keys(tiny_report):
     # Threshold searches run at the calibrated threshold step; restitution and
     # histories at the engine's default.
     from compare.campaign.settings_file import threshold_options
-    assert thr["provenance"]["dt"] == pytest.approx(threshold_options("pymunk")["dt"])
-    assert summary["threshold_settings"]["pymunk"]["dt"] == threshold_options("pymunk")["dt"]
+    from scenes import load_scene
+    step = threshold_options("pymunk", load_scene("fig5"))["dt"]
+    assert thr["provenance"]["dt"] == pytest.approx(step)
+    assert summary["threshold_settings"]["pymunk"]["dt"] == step
+    # The recommendation and the trust table name the same threshold step, and
+    # whether the scene lies in its calibration's domain.
+    assert summary["threshold_domain"]["pymunk"]["inside"] is True
+    assert summary["trust"]["pymunk"]["threshold_dt"] == step
     assert summary["settings"]["pymunk"]["dt"] == pytest.approx(1e-4)
     assert thr["provenance"]["version"].startswith("pymunk")
 
