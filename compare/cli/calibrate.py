@@ -283,7 +283,7 @@ def _domain_tables(args, cal, design, held) -> str:
              "# every one (engines/calibration.py); outside, the reference step runs.",
              "[domain]"]
     for key, value in domain_table().items():
-        lines.append(f"{key} = {'true' if value is True else value!r}")
+        lines.append(f"{key} = " + ("true" if value is True else repr(value)))
     train, test, seed = design
     lines += ["", "[calibration]", f"seed = {seed}", f"training_scenes = {len(train)}",
               f"training_points = {len(rec.errors)}",
