@@ -3,4 +3,4 @@
 ``COMMANDS`` lists them in help order.
 """
 COMMANDS = ("simulate", "restitution", "spectrum", "figures", "report", "bench", "view",
-            "record", "map", "scenes", "campaign", "calibrate", "atlas", "fragility", "cache")
+            "record", "map", "scenes", "campaign", "calibrate", "atlas", "fragility", "trust", "cache")

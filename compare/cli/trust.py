@@ -1,0 +1,82 @@
+"""``trilith trust``: how far each engine can be trusted on the user's own trilith
+(:mod:`compare.campaign.trust_check`), as JSON, CSV and one HTML page."""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
+                                 check_output_path, info, parse_engine_list, resolve_workers,
+                                 scene_from_args, use_store)
+
+# The three engines a first answer can afford on 2 cores (DART and Drake cost
+# 10-55 CPU s per threshold point: docs/atlas.md); `--engine all` adds them.
+DEFAULT_ENGINES = "pymunk,mujoco,pybullet"
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "trust",
+        help="how far each engine can be trusted on your own trilith: thresholds, "
+             "restitution, time histories, at which settings and what cost",
+        description="For one scene: where the model is valid across Omega; a small threshold "
+                    "design (6 frequencies across the valid band, both curves with a "
+                    "pendulum) under the step rule; restitution against Eq. 20 (and Eq. 19); "
+                    "theta(t) before the first impact at 0.9x and 1.1x the model's threshold; "
+                    "optionally ground motions. Each engine runs its recommended settings: "
+                    "its calibrated threshold step inside the calibration's domain, else its "
+                    "reference step. Writes trust.json, trust.csv and index.html into --out; "
+                    "one progress line per stage on stderr.")
+    add_scene_args(parser)
+    parser.add_argument("--engine", default=DEFAULT_ENGINES, metavar="NAME[,NAME...]|all",
+                        help=f"engines to judge (default {DEFAULT_ENGINES}; DART and Drake "
+                             "cost 10-55 CPU s per threshold point)")
+    parser.add_argument("--record", default=None, metavar="FILE|DIR",
+                        help="also each ground motion's first overturning intensity (PGA), "
+                             "model against engine: a CSV/AT2 file or a folder of them")
+    parser.add_argument("--out", default=None, metavar="DIR",
+                        help="output folder, replaced whole (default trust-SCENE)")
+    add_workers_arg(parser)
+    add_store_args(parser)
+    return parser
+
+
+def _records(spec: str | None) -> list:
+    if spec is None:
+        return []
+    from scenes.ground_motion import load_record, load_suite
+    if Path(spec).expanduser().is_dir():
+        return load_suite(spec, option="--record")
+    return [load_record(spec, option="--record")]
+
+
+def run(args: argparse.Namespace) -> int:
+    from compare.cli import options as _options
+    from compare.run import atomic
+
+    scene = scene_from_args(args)
+    engines = parse_engine_list(args.engine)
+    workers = resolve_workers(args.workers)
+    records = _records(args.record)
+    out = check_output_path(args.out or f"trust-{scene.name}", "--out", directory=True,
+                            replace=True)
+    use_store(args)
+    _options.step_notes(engines, [scene])
+    from compare.campaign.trust_check import trust_scene
+    from compare.report.trust_page import trust_csv, trust_html
+    from compare.run.jsonable import plain
+    with atomic.output_lock(out):
+        doc = trust_scene(scene, engines, records=records, workers=workers,
+                          quiet=_options.VERBOSITY < 0)
+        with atomic.report_dir(out, lock=False) as tmp:
+            (tmp / "trust.json").write_text(json.dumps(plain(doc), indent=1) + "\n")
+            (tmp / "trust.csv").write_text(trust_csv(doc))
+            (tmp / "index.html").write_text(trust_html(doc))
+    for e, entry in doc["engines"].items():
+        v = entry["threshold_verdict"]
+        word = {True: "trusted", False: "NOT trusted", None: "not judged"}[v["trusted"]]
+        print(f"{entry['label']}: thresholds {word} at dt = {entry['threshold_dt']:g} s "
+              f"({v['why']})")
+    info(f"wrote {out}/index.html, trust.json, trust.csv")
+    return 0
