@@ -9,7 +9,7 @@ import math
 from compare.report.cells import _cell, cause_phrase, csv_text, table
 from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds
 
-__all__ = ["trust_rows", "trust_html", "trust_csv", "point_rows"]
+__all__ = ["trust_rows", "trust_html", "trust_csv", "point_rows", "spectrum_figures"]
 
 
 def _thresholds(entry: dict) -> dict:
@@ -73,8 +73,8 @@ def _cost(entry: dict) -> dict:
     rtf = c["cpu_per_sim_s"]
     return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per threshold point; "
                  + (f"{rtf:.3g} CPU s per simulated s" if rtf is not None else "")
-                 + (f"; step rule reruns {fmt_seconds(c['step_rule_cpu_s'])}"
-                    if c["step_rule_cpu_s"] else ""))
+                 + (f"; failing points remeasured (finer steps, causes): "
+                    f"{fmt_seconds(c['rerun_cpu_s'])} CPU" if c["rerun_cpu_s"] else ""))
 
 
 def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
@@ -96,7 +96,8 @@ def point_rows(doc: dict) -> tuple[list[str], list[list]]:
     for e, entry in doc["engines"].items():
         for p in entry["thresholds"]:
             err = "no bracket" if p["rel_error"] is None else f"{100 * p['rel_error']:+.2f} %"
-            rows.append([entry["label"], p["case"], f"{p['omega']:g}", f"{p['a_model']:.4g}",
+            rows.append([entry["label"], p["case"].replace("_", " "), f"{p['omega']:.3g}",
+                         f"{p['a_model']:.4g}",
                          "-" if p["a_engine"] is None else f"{p['a_engine']:.4g}", err,
                          _cell(cause_phrase(p["cause"]), _ok(p["cause"]), p["cause_detail"]),
                          fmt_sci(p["dt"])])
@@ -106,6 +107,31 @@ def point_rows(doc: dict) -> tuple[list[str], list[list]]:
 def _ok(cause: str) -> bool | None:
     """Green where the engine agrees, plain where the model cannot judge it."""
     return True if cause == "agrees" else None if cause == "model" else False
+
+
+def spectrum_figures(doc: dict) -> list[str]:
+    """Per curve: the model's first-overturning spectrum (invalid frequencies
+    hatched) with each engine's points and their error against the tolerance
+    band, as the validation report draws them (base64 PNGs)."""
+    from compare.report import plots
+    out = []
+    for case, rows in doc["band"]["curves"].items():
+        engines = []
+        for e, entry in doc["engines"].items():
+            pts = [p for p in entry["thresholds"] if p["case"] == case]
+            engines.append({**plots._style_of(e),
+                            "omega": plots._arr([p["omega"] for p in pts]),
+                            "a": plots._arr([p["a_engine"] for p in pts]),
+                            "error": 100.0 * plots._arr([p["rel_error"] for p in pts])})
+        data = {"title": f"{doc['scene'].get('name')}: "
+                         + ("with pendulum" if case == "pendulum" else "without pendulum"),
+                "tol": 100.0 * doc["tolerances"]["threshold"],
+                "omega": plots._arr([r["omega"] for r in rows]),
+                "a": plots._arr([r["a_model"] for r in rows]),
+                "valid": [r["valid"] for r in rows], "breaks": [], "jumps": [],
+                "engines": engines}
+        out.append(plots._figure("trust-spectrum", data, plots._draw_spectrum))
+    return out
 
 
 def trust_csv(doc: dict) -> str:
@@ -132,7 +158,11 @@ def trust_html(doc: dict) -> str:
               f"({band['omegas'][0] / (2 * math.pi):.2g}-"
               f"{band['omegas'][-1] / (2 * math.pi):.2g} Hz).</p>",
             "<h2>Trust table</h2>", table(header, rows),
-            "<h2>Threshold points</h2>", table(*point_rows(doc)),
+            "<h2>Threshold points</h2>",
+            "<div class='figs'>" + "".join(
+                f"<img alt='overturning spectrum and engine points' "
+                f"src='data:image/png;base64,{png}'>" for png in spectrum_figures(doc))
+            + "</div>", table(*point_rows(doc)),
             f"<p class='small'>{esc(doc['project'])}; CPU {doc['cost']['cpu_s']:.1f} s in "
             f"this process, wall {doc['cost']['wall_s']:.1f} s, load average "
             + ", ".join(f"{x:.2f}" for x in doc['cost']['load_average']) + ".</p>"]
