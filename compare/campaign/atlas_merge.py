@@ -11,7 +11,7 @@ CPU, load) is kept in ``parts``, in the order given.
 """
 from __future__ import annotations
 
-__all__ = ["merge_atlases", "runnable_command", "SAME_CONFIG"]
+__all__ = ["merge_atlases", "runnable_command", "select_engines", "SAME_CONFIG"]
 
 # The config fields that must agree for two parts to be one atlas.
 SAME_CONFIG = ("scenes", "omegas", "factors", "cases", "rel_bracket", "rel_tol", "tol")
@@ -125,3 +125,25 @@ def merge_atlases(docs: list[dict], names: list[str] | None = None) -> dict:
             "workers": sorted({part.get("workers") for part in parts
                                if part.get("workers") is not None}),
             "budget_s": None}
+
+
+def select_engines(doc: dict, engines) -> dict:
+    """The atlas ``doc`` with only ``engines`` (e.g. to rejoin it with a remeasured
+    part of the others): their rows, steps, cost and not-run counts; each part
+    keeps its provenance and lists only the kept engines it measured."""
+    keep = [e for e in doc["steps"] if e in set(engines)]
+    missing = sorted(set(engines) - set(doc["steps"]))
+    if missing:
+        raise ValueError(f"engines not in the atlas: {', '.join(missing)}")
+    parts = []
+    for part in _parts_of(doc):
+        mine = [e for e in part.get("engines", []) if e in keep]
+        if mine:
+            parts.append({**part, "engines": mine})
+    return {**doc, "config": {**doc["config"], "engines": keep},
+            "steps": {e: doc["steps"][e] for e in keep},
+            "points": [{**pt, "engines": {e: pt["engines"][e] for e in keep}}
+                       for pt in doc["points"]],
+            "cost": [c for c in doc.get("cost", []) if c.get("engine") in keep],
+            "not_run": {e: n for e, n in (doc.get("not_run") or {}).items() if e in keep},
+            "parts": parts}

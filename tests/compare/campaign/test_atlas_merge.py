@@ -105,3 +105,23 @@ def test_a_legacy_verbosity_in_a_recorded_command_becomes_its_switch():
             args = parser.parse_args(shlex.split(fixed)[1:])  # trilith accepts it
             assert args.verbosity == expect and args.engine == "dart"
     assert runnable_command(None) is None
+
+
+def test_select_engines_keeps_their_rows_and_rejoins_whole():
+    """The stored atlas split into two engine sets and joined again is the same
+    atlas (rows, steps, cost), its parts listing only the engines each measured."""
+    import json
+    from pathlib import Path
+
+    from compare.campaign.atlas_merge import merge_atlases, select_engines
+    stored = json.loads((Path(__file__).parents[3] / "docs/validation/atlas.json").read_text())
+    engines = list(stored["steps"])
+    a, b = select_engines(stored, engines[:2]), select_engines(stored, engines[2:])
+    assert list(a["steps"]) == engines[:2] and all(set(pt["engines"]) == set(engines[:2])
+                                                   for pt in a["points"])
+    assert {c["engine"] for c in b["cost"]} == set(engines[2:])
+    joined = merge_atlases([a, b])
+    assert joined["points"] == stored["points"] and joined["steps"] == stored["steps"]
+    assert sorted(map(str, joined["cost"])) == sorted(map(str, stored["cost"]))
+    with pytest.raises(ValueError, match="not in the atlas: nosuch"):
+        select_engines(stored, ["nosuch"])
