@@ -53,8 +53,13 @@ ENTRY_POINT_GROUP = "trilith_xval.engines"
 def _installed() -> dict[str, str]:
     """Engines registered by other installed packages (entry points)."""
     from importlib.metadata import entry_points
-    return {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)
-            if ep.name not in BACKENDS}
+    found = {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    clash = sorted(set(found) & set(BACKENDS))
+    if clash:  # silently preferring one would measure another engine than asked for
+        raise ValueError(f"installed engine(s) {', '.join(clash)} (entry point group "
+                         f"{ENTRY_POINT_GROUP}) clash with built-in backends of the same "
+                         f"name; rename them in their package")
+    return found
 
 
 def engine_names() -> tuple[str, ...]:

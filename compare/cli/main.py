@@ -163,7 +163,11 @@ def _main(argv: list[str] | None) -> int:
         print("error: standard output is closed; redirect it to a file or /dev/null",
               file=sys.stderr)
         return 2
-    parser, modules = build_parser()
+    try:
+        parser, modules = build_parser()
+    except ValueError as exc:  # the engine registry itself is broken (a name clash)
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     args = parser.parse_args(argv)
     if not args.command:
         parser.print_help()

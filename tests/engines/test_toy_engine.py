@@ -64,3 +64,16 @@ def test_an_installed_package_registers_by_entry_point(monkeypatch):
         assert engines.engine_list("all") == engines.ENGINES + ("toy",)
     finally:
         engines._installed.cache_clear()
+
+
+def test_an_installed_engine_named_as_a_built_in_is_an_error(monkeypatch):
+    from importlib.metadata import EntryPoint
+    ep = EntryPoint("pymunk", "tests.support.toy_engine:ToyEngine", engines.ENTRY_POINT_GROUP)
+    monkeypatch.setattr("importlib.metadata.entry_points",
+                        lambda group=None: [ep] if group == engines.ENTRY_POINT_GROUP else [])
+    engines._installed.cache_clear()
+    try:
+        with pytest.raises(ValueError, match="pymunk .* clash with built-in"):
+            engines.engine_names()
+    finally:
+        engines._installed.cache_clear()
