@@ -188,7 +188,7 @@ def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps:
     by ``deadline`` is counted in ``not_run`` at its step (its coarser steps are
     not run either); a job in ``done`` (an identical trick measured before) runs
     once."""
-    from compare.campaign.study import run_threshold, threshold_description
+    from compare.campaign.study import ThresholdJob, run_threshold
     from compare.run.keys import digest
 
     for e in config.engines:
@@ -198,9 +198,10 @@ def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps:
             keys, fresh = [], {}
             for i in todo:
                 pt = points[i]
-                job = (pt["scene"], pt["case"], pt["pulse"], pt["omega"], pt["a_reference"],
-                       pt["mode"], e, dt, config.rel_bracket, config.rel_tol, opts)
-                key = digest(threshold_description(job))
+                job = ThresholdJob(pt["scene"], pt["case"], pt["pulse"], pt["omega"],
+                                   pt["a_reference"], pt["mode"], e, dt, config.rel_bracket,
+                                   config.rel_tol, opts)
+                key = digest(job.description())
                 keys.append(key)
                 if key not in done:
                     fresh.setdefault(key, job)

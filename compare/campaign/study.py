@@ -28,6 +28,7 @@ The file::
 from __future__ import annotations
 
 import fnmatch
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -39,7 +40,8 @@ from analytic.options import MAX_ENGINE_DT
 from engines import ENGINES
 from scenes import load_scene, read_toml, scene_names
 
-__all__ = ["Study", "load_study", "reference_jobs", "threshold_jobs", "run_reference",
+__all__ = ["Study", "ThresholdJob", "load_study", "reference_jobs", "threshold_jobs",
+           "run_reference",
            "run_threshold", "JOB_RUNS"]
 
 # Runs per threshold job, for estimates: the guard, 2 bracket runs, log2(2 rel_bracket /
@@ -210,11 +212,55 @@ def run_reference(job: tuple) -> tuple[float, str | None]:
     return float(res[0]), res[2]
 
 
-def threshold_jobs(study: Study, references: dict, settings: dict | None = None) -> list[tuple]:
-    """``(scene, case, pulse, omega, a_ref, mode_ref, engine, dt, rel_bracket, rel_tol,
-    options)`` for every reference point that overturns (NaN references have nothing
-    to bracket); ``options`` is the engine's table of ``settings`` (a settings file's
-    ``{engine: {field: value}}``) as sorted pairs."""
+@dataclass(frozen=True)
+class ThresholdJob:
+    """One engine threshold of a study or the atlas: the model's point (scene name,
+    case, pulse, Omega [rad/s], its threshold [m/s^2] and mode), the engine, the
+    step ``dt`` [s] (0: the calibrated threshold step where the scene lies in its
+    domain, else the reference), the search's bracket and resolution, and
+    ``options`` (a settings file's table, sorted pairs).  :attr:`spec` is its run,
+    resolved once (:class:`compare.run.spec.RunSpec`)."""
+
+    scene: str
+    case: str
+    pulse: str
+    omega: float
+    a_ref: float
+    mode_ref: str | None
+    engine: str
+    dt: float
+    rel_bracket: float
+    rel_tol: float
+    options: tuple = ()
+
+    @functools.cached_property
+    def spec(self):
+        """The search's run: calibration (in its domain), the settings file, ``dt``,
+        and friction for the largest pulse of the bisection (2 ``a_ref``)."""
+        from analytic.pulses import pulse_of
+        from compare.run.spec import RunSpec
+        scene = _scene(self.scene, self.case)
+        return RunSpec.resolve(self.engine, scene, pulse_of(self.pulse, 2.0 * self.a_ref,
+                                                            self.omega),
+                               calibrated=True, file_options=dict(self.options),
+                               file_name="file", overrides={"dt": self.dt} if self.dt else None,
+                               overrides_from="the study's steps")
+
+    def description(self) -> dict:
+        """Everything that determines the job's result (its store key)."""
+        from compare.run.keys import backend_version, scene_dict, settings_dict
+        return {"engine": self.engine, "version": backend_version(self.engine),
+                "scene": scene_dict(self.spec.scene), "pulse": self.pulse,
+                "omega": self.omega, "a_ref": self.a_ref, "mode_ref": self.mode_ref,
+                "settings": settings_dict(self.spec.settings),
+                "rel_bracket": self.rel_bracket, "rel_tol": self.rel_tol}
+
+
+def threshold_jobs(study: Study, references: dict,
+                   settings: dict | None = None) -> list[ThresholdJob]:
+    """A :class:`ThresholdJob` for every reference point that overturns (NaN
+    references have nothing to bracket) x engine x step; ``settings`` is a settings
+    file's ``{engine: {field: value}}``."""
     jobs = []
     for (n, c, p, w), (a_ref, mode) in references.items():
         if not math.isfinite(a_ref):
@@ -222,46 +268,38 @@ def threshold_jobs(study: Study, references: dict, settings: dict | None = None)
         for e in study.engines:
             options = tuple(sorted((settings or {}).get(e, {}).items()))
             for dt in study.steps:
-                jobs.append((n, c, p, w, a_ref, mode, e, dt, study.rel_bracket, study.rel_tol,
-                             options))
+                jobs.append(ThresholdJob(n, c, p, w, a_ref, mode, e, dt, study.rel_bracket,
+                                         study.rel_tol, options))
     return jobs
 
 
 def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
-                 options: tuple = ()):
-    """A threshold search's settings as the validation campaign's (friction raised
-    for the largest pulse of the bisection): the engine's calibrated threshold
-    settings, ``options`` (a settings file's table) over them, at time step ``dt``
-    (0: the table's step, else the calibrated threshold step)."""
-    from compare.campaign.config import CampaignConfig, engine_options
-    from compare.measure.engine_spectrum import pulse_settings
-
-    config = CampaignConfig(engines=(engine,), engine_dt=dt or None,
-                            engine_settings={engine: dict(options)} if options else {})
-    return pulse_settings(engine, scene, 2.0 * a_ref, omega,
-                          **engine_options(engine, config, thresholds=True, scene=scene))
+                 options: tuple = (), pulse: str = "sine"):
+    """A threshold search's settings on ``scene``, as a :class:`ThresholdJob`
+    resolves them: the engine's calibrated threshold settings (in their domain),
+    ``options`` (a settings file's table) over them, at time step ``dt`` (0: the
+    table's step, else the calibrated one), friction for pulses up to 2 ``a_ref``."""
+    from analytic.pulses import pulse_of
+    from compare.run.spec import RunSpec
+    return RunSpec.resolve(engine, scene, pulse_of(pulse, 2.0 * a_ref, omega), calibrated=True,
+                           file_options=dict(options), file_name="file",
+                           overrides={"dt": dt} if dt else None).settings
 
 
-def threshold_description(job: tuple) -> dict:
+def threshold_description(job: ThresholdJob) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
-    from compare.run.keys import backend_version, scene_dict, settings_dict
-
-    n, c, p, w, a_ref, mode, e, dt, rb, rt, opts = job
-    scene = _scene(n, c)
-    return {"engine": e, "version": backend_version(e), "scene": scene_dict(scene),
-            "pulse": p, "omega": w, "a_ref": a_ref, "mode_ref": mode,
-            "settings": settings_dict(job_settings(e, dt, scene, a_ref, w, opts)),
-            "rel_bracket": rb, "rel_tol": rt}
+    return job.description()
 
 
-def run_threshold(job: tuple) -> dict:
+def run_threshold(job: ThresholdJob) -> dict:
     """One engine threshold (a row of the combined report), through the store."""
     from compare.run import runs
     from compare.measure.engine_spectrum import measure_point
 
-    n, c, p, w, a_ref, mode, e, dt, rb, rt, opts = job
-    scene = _scene(n, c)
-    settings = job_settings(e, dt, scene, a_ref, w, opts)
+    n, c, p, w, a_ref, mode, e, dt = (job.scene, job.case, job.pulse, job.omega, job.a_ref,
+                                      job.mode_ref, job.engine, job.dt)
+    scene, settings = job.spec.scene, job.spec.settings
+    rb, rt = job.rel_bracket, job.rel_tol
 
     def compute():  # the one threshold measurement; causes without the reruns
         return measure_point(e, scene, w, a_ref, mode, case=c, kind=p, rel_tol=rt,

@@ -97,7 +97,7 @@ def _estimates(jobs, store) -> list[float]:
     from compare.campaign.study import JOB_RUNS
 
     costs = store.mean_costs("run") if store is not None else {}
-    return [JOB_RUNS * _run_cost(job[6], job[7] or dict(job[10]).get("dt", 0.0), costs)
+    return [JOB_RUNS * _run_cost(job.engine, job.dt or dict(job.options).get("dt", 0.0), costs)
             for job in jobs]
 
 
@@ -140,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         done = list(runs.run_many(run_threshold, unique, workers=workers,
                                   on_done=lambda i, r: bar.update(est[i])))
         bar.close()
-        rows = [{**done[i], "scene": job[0], "case": job[1]} for job, i in zip(jobs, index)]
+        rows = [{**done[i], "scene": job.scene, "case": job.case} for job, i in zip(jobs, index)]
         record_refs: list = []
         if study.records is not None:
             from compare.cli.campaign_records import record_rows
@@ -165,12 +165,12 @@ def distinct(jobs: list) -> tuple[list, list[int]]:
     distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
     the scene name is a label)."""
     from compare.run.keys import digest
-    from compare.campaign.study import threshold_description
+
 
     seen: dict[str, int] = {}
     unique, index = [], []
     for job in jobs:
-        key = digest(threshold_description(job))
+        key = digest(job.description())
         if key not in seen:
             seen[key] = len(unique)
             unique.append(job)

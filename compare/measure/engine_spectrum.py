@@ -89,18 +89,14 @@ class EnginePoint:
 
 def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "sine",
                    **options):
-    """The engine's settings (``options`` applied, :func:`engines.configure`) with a
-    fixed friction raised to :data:`engines.base.FRICTION_MARGIN` times the no-sliding
-    bound of the largest pulse a bracket may try (a friction of None is the engine's
-    own default for each run, which follows the same rule)."""
-    from analytic.bounds import required_friction
+    """The engine's settings (``options`` applied) with a fixed friction raised to
+    :data:`engines.base.FRICTION_MARGIN` times the no-sliding bound of the largest
+    pulse a bracket may try (a friction of None is the engine's own default for
+    each run, which follows the same rule): :meth:`compare.run.spec.RunSpec.resolve`."""
     from analytic.pulses import pulse_of
-    from engines.base import FRICTION_MARGIN
-    settings = configure(engine, **options)
-    need = FRICTION_MARGIN * required_friction(scene, pulse_of(kind, a_max, omega))
-    if settings.friction is not None and settings.friction < need:
-        settings = configure(engine, settings, friction=need)
-    return settings
+    from compare.run.spec import RunSpec
+    return RunSpec.resolve(engine, scene, pulse_of(kind, a_max, omega), overrides=options,
+                           overrides_from="the options given").settings
 
 
 def measure_point(engine: str, scene, omega: float, a_reference: float,

@@ -130,7 +130,7 @@ def test_a_budget_leaves_points_measured_at_every_step(monkeypatch):
             return [{"model_valid": True, "model_reason": "valid"} for _ in items]
         clock[0] += 1.0  # each chunk of engine jobs takes one "second"
         calls.append(len(items))
-        return [{"dt": job[7], "dt_used": job[7], "a_engine": job[4], "rel_error": 0.0,
+        return [{"dt": job.dt, "dt_used": job.dt, "a_engine": job.a_ref, "rel_error": 0.0,
                  "cause": "agrees", "cpu_s": 1.0, "sim_s": 1.0} for job in items]
     monkeypatch.setattr(atlas.runs, "run_many", fake_run_many)
     monkeypatch.setattr(atlas.time, "perf_counter", lambda: clock[0])

@@ -108,3 +108,29 @@ def test_the_report_names_the_threshold_step():
     assert rows == [["dt", "1e-4"], ["dt (threshold searches)", "2e-3"]]
     doc["threshold_settings"]["pymunk"]["dt"] = 1e-4  # the same step: no extra row
     assert settings_rows(doc)[1] == [["dt", "1e-4"]]
+
+
+def test_a_threshold_job_is_a_value_resolved_once():
+    """A job's run is resolved once, layer by layer, and names where a bad value
+    came from."""
+    from compare.campaign.study import ThresholdJob
+    from compare.run.spec import RunSpec
+    from analytic.pulses import pulse_of
+
+    job = ThresholdJob("fig5", "pendulum", "sine", 12.0, 10.0, None, "pymunk", 0.0, 0.03,
+                       5e-3, (("iterations", 40),))
+    assert job.spec is job.spec  # resolved once
+    fig5 = load_scene("fig5")
+    assert job.spec.settings.dt == threshold_options("pymunk", fig5)["dt"]
+    assert dict(job.spec.origin) == {"dt": "the calibration of pymunk",
+                                     "iterations": "--settings file"}
+    assert job.description()["settings"]["iterations"] == 40
+    with pytest.raises(ValueError, match=r"dt .*\(from the command line\)"):
+        RunSpec.resolve("pymunk", fig5, pulse_of("sine", 10.0, 12.0), overrides={"dt": -1.0})
+    with pytest.raises(ValueError, match=r"\(from --settings my.toml\)"):
+        RunSpec.resolve("pymunk", fig5, pulse_of("sine", 10.0, 12.0),
+                        file_options={"iterations": -3}, file_name="my.toml")
+    # The friction rule raises a fixed coefficient below the no-sliding bound.
+    spec = RunSpec.resolve("pymunk", fig5, pulse_of("sine", 60.0, 12.0),
+                           overrides={"friction": 0.05})
+    assert spec.settings.friction > 0.05 and dict(spec.origin)["friction"] == "the friction rule"
