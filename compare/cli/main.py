@@ -52,10 +52,13 @@ class HelpFormatter(argparse.HelpFormatter):
         return text
 
     def _format_text(self, text):
-        text = _plain(text)
-        if "\n" in text.strip():  # a docstring: laid out by hand
-            return argparse.RawDescriptionHelpFormatter._format_text(self, text)
-        return super()._format_text(text)
+        return super()._format_text(_plain(text))
+
+    def _fill_text(self, text, width, indent):
+        # The raw formatter differs from the default in _fill_text only.
+        if "\n" in text.strip():  # a docstring or a table: laid out by hand
+            return argparse.RawDescriptionHelpFormatter._fill_text(self, text, width, indent)
+        return super()._fill_text(text, width, indent)
 
     def _expand_help(self, action):
         return _plain(super()._expand_help(action))
