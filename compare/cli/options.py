@@ -50,7 +50,9 @@ def detail(message: str) -> None:
 
 def add_scene_args(parser: argparse.ArgumentParser, several: bool = False) -> None:
     """``--scene`` (with ``several``: repeatable, globs allowed, default fig5),
-    ``--set NAME=VALUE`` and ``--no-pendulum``."""
+    ``--set NAME=VALUE`` and ``--no-pendulum``, in a group whose description
+    says what each scene value means (:data:`analytic.parameters.GLOSSARY`)."""
+    parser = scene_group(parser)
     if several:
         parser.add_argument("--scene", action="append", default=None,
                             metavar="NAME|FILE|GLOB",
@@ -65,6 +67,19 @@ def add_scene_args(parser: argparse.ArgumentParser, several: bool = False) -> No
                         metavar="NAME=VALUE",
                         help=f"override a scene value; NAME in {', '.join(SETTABLE)}")
     parser.add_argument("--no-pendulum", action="store_true", help="remove the pendulum (gamma = 0)")
+
+
+def scene_group(parser: argparse.ArgumentParser):
+    """An argument group for the scene options, described by the glossary."""
+    return parser.add_argument_group("scene (values in 'trilith scenes')",
+                                     description=glossary_text())
+
+
+def glossary_text(indent: str = "") -> str:
+    """The scene values' meanings, one ``name: meaning`` line each."""
+    from analytic.parameters import GLOSSARY
+    width = max(map(len, GLOSSARY))
+    return "\n".join(f"{indent}{k:<{width}}  {v}" for k, v in GLOSSARY.items())
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
