@@ -28,7 +28,9 @@ SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel
             "hinge_x", "depth", "g")
 # Version of the --json documents (simulate, restitution, spectrum); bumped when a
 # key changes meaning or disappears.  1: inputs echoed, 'engine', 'timings' block.
-SCHEMA_VERSION = 1
+# 2: simulate's 'overturn_time' is the verdict's time (as Trajectory.overturn_time);
+# the last rise past alpha it used to mean is 'exceeds_alpha_time'.
+SCHEMA_VERSION = 2
 # Formats matplotlib writes without extra packages (--plot).
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps",
                  ".webp")

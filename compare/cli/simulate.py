@@ -138,13 +138,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
           f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}")
     line = f"verdict: {v.status}"
-    if v.overturned:
-        line += f" ({v.mode}) at t = {v.time:.4f} s"
+    if v.overturned:  # the name of the time in --json and in Python's Trajectory
+        line += f" ({v.mode}), overturn_time = {v.time:.4f} s"
     print(line + (f" -- {v.reason}" if v.reason else ""))
     read = traj.sampled_events()
     rule = read.rule
     up = "none" if read.uplift is None else read.uplift.text()
-    over = "" if read.overturn is None else f", past alpha for good at {read.overturn.text()}"
+    over = ("" if read.exceeds_alpha is None else
+            f", past alpha for good (exceeds_alpha_time) at {read.exceeds_alpha.text()}")
     print(f"uplift (|theta| = {rule.uplift_angle:g} rad): {up}, impacts (theta = 0 crossed "
           f"faster than {rule.impact_speed:g} rad/s): {read.n_impacts}{over}")
     print(f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "
