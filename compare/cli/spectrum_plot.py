@@ -3,8 +3,6 @@ overturning curves above, the pendulum's gain below; a scene without a pendulum
 has its one curve and no gain panel."""
 from __future__ import annotations
 
-import math
-
 __all__ = ["plot_spectrum"]
 
 
@@ -18,6 +16,7 @@ def plot_spectrum(spec, path, validity: dict | None = None) -> None:
     import matplotlib.pyplot as plt
 
     from compare.report.figures import shade_validity
+    from compare.report.units import g_hz_axes
 
     both = len(spec.curves) == 2  # without a pendulum: its one curve, no gain panel
     if both:
@@ -36,10 +35,7 @@ def plot_spectrum(spec, path, validity: dict | None = None) -> None:
         ax1.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0,
                     label="mode jump" if k == 0 else None)
     ax1.set_ylabel(r"overturning amplitude $A_s$ [m/s$^2$]")
-    ax1.secondary_yaxis("right", functions=(lambda a: a / 9.80665,
-                                            lambda a: a * 9.80665)).set_ylabel("[g]")
-    ax1.secondary_xaxis("top", functions=(lambda w: w / (2 * math.pi),
-                                          lambda f: f * 2 * math.pi)).set_xlabel("f [Hz]")
+    g_hz_axes(ax1, hz_label="f [Hz]")
     sc = spec.scene
     ax1.set_title(f"{spec.settings.pulse} pulse, lam={sc.lam:g}, b={sc.b:g} m, "
                   f"gamma={sc.gamma:g}, mu={sc.mu:g}; {spec.criterion.kind}, "
