@@ -19,7 +19,7 @@ import numbers
 from dataclasses import dataclass
 
 __all__ = ["Scene", "DENSITY_STONE", "G_STANDARD", "LENGTH_RANGE", "MASS_RANGE",
-           "INERTIA_RATIO_RANGE", "G_RANGE", "GLOSSARY"]
+           "INERTIA_RATIO_RANGE", "G_RANGE", "GLOSSARY", "glossary_text"]
 
 G_STANDARD = 9.81  # m/s^2, the value the paper's a_up = g/lam plots imply
 DENSITY_STONE = 2500.0  # kg/m^3, used only to give the columns a default mass
@@ -53,6 +53,12 @@ GLOSSARY = {
     "hinge_x": "pendulum hinge position from the lintel's middle [m] (engines only)",
     "g": "gravity [m/s^2]; default 9.81",
 }
+
+
+def glossary_text(indent: str = "") -> str:
+    """:data:`GLOSSARY` as text, one ``name  meaning`` line per value, aligned."""
+    width = max(map(len, GLOSSARY))
+    return "\n".join(f"{indent}{k:<{width}}  {v}" for k, v in GLOSSARY.items())
 
 
 def _check_finite(name: str, value) -> float:

@@ -17,7 +17,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from analytic.parameters import Scene
+from analytic.parameters import Scene, glossary_text
 from scenes import load_scene
 
 from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
@@ -75,13 +75,6 @@ def scene_group(parser: argparse.ArgumentParser):
     """An argument group for the scene options, described by the glossary."""
     return parser.add_argument_group("scene (values in 'trilith scenes')",
                                      description=glossary_text())
-
-
-def glossary_text(indent: str = "") -> str:
-    """The scene values' meanings, one ``name: meaning`` line each."""
-    from analytic.parameters import GLOSSARY
-    width = max(map(len, GLOSSARY))
-    return "\n".join(f"{indent}{k:<{width}}  {v}" for k, v in GLOSSARY.items())
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:
