@@ -206,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         plot_spectrum(spec, args.plot, validity)
     if args.json:
-        body = {**spec.to_dict(), "model_validity": {c: validity[c] for c in spec.curves}}
+        body = {**spec.to_dict(), "model_validity": validity}
         timings = {"wall_time": body.pop("wall_time"), "workers": workers}
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": settings.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,

@@ -103,3 +103,15 @@ def test_engine_spectrum_plot_draws_one_model_curve_without_pendulum(no_pendulum
     labels = _labels(figures[0])
     assert ("model, pendulum" in labels) is (not no_pendulum)
     assert "model, no pendulum" in labels
+
+
+def test_validity_of_a_spectrum_has_its_curves_only(no_pendulum):
+    from analytic import Scene
+    from analytic.spectrum import overturning_spectrum
+    from analytic.threshold_validity import spectrum_validity
+    scene = Scene(gamma=0.0 if no_pendulum else 0.3)
+    spec = overturning_spectrum(scene, [24.0])
+    validity = spectrum_validity(spec)
+    assert tuple(validity) == spec.curves == (("no_pendulum",) if no_pendulum
+                                              else ("no_pendulum", "pendulum"))
+    assert validity["no_pendulum"][0]["model_valid"] is False  # a contact would pull
