@@ -19,7 +19,7 @@ import numbers
 from dataclasses import dataclass
 
 __all__ = ["Scene", "DENSITY_STONE", "G_STANDARD", "LENGTH_RANGE", "MASS_RANGE",
-           "INERTIA_RATIO_RANGE", "G_RANGE"]
+           "INERTIA_RATIO_RANGE", "G_RANGE", "GLOSSARY", "glossary_text"]
 
 G_STANDARD = 9.81  # m/s^2, the value the paper's a_up = g/lam plots imply
 DENSITY_STONE = 2500.0  # kg/m^3, used only to give the columns a default mass
@@ -33,6 +33,32 @@ LENGTH_RANGE = (1e-3, 100.0)  # m: b, h = lam b, l, gap, lintel_height, depth
 MASS_RANGE = (1e-6, 1e10)  # kg: one column; contains the stone default at every size
 INERTIA_RATIO_RANGE = (0.1, 10.0)  # J_G over the uniform rectangle's m1 (b^2 + h^2)/12
 G_RANGE = (0.1, 100.0)  # m/s^2: from small moons to well past Jupiter
+
+# What each scene value means, in the paper's symbols (Eq. 10): the one text the
+# README, every command's --help and `trilith scenes` show, so that a reader from
+# rocking or friction work does not take mu for a friction coefficient.
+GLOSSARY = {
+    "lam": "slenderness of a column, lambda = h/b [-]",
+    "b": "full width of a column, B [m] (not the half-width)",
+    "h": "height of a column, h = lam b [m]",
+    "mu": "lintel mass over one column's mass, mu = m3/m1 [-] (a MASS ratio, not friction)",
+    "gamma": "pendulum bob mass over one column's mass, gamma = m4/m1 [-]; 0 = no pendulum",
+    "l": "pendulum length l, hinge to bob [m]; default 2h/3",
+    "gap": "clear distance d between the two columns [m]; default h",
+    "lintel_height": "thickness of the lintel [m]; default b/2 (engines only)",
+    "alpha": "slenderness angle atan(b/h) [rad]: a block's static overturning angle",
+    "column_mass": "mass m1 of one column [kg]; default stone, 2500 kg/m^3 x b h depth",
+    "J_G": "polar inertia of one column about its centre of mass [kg m^2]; default uniform",
+    "depth": "out-of-plane depth of every body [m] (engines only)",
+    "hinge_x": "pendulum hinge position from the lintel's middle [m] (engines only)",
+    "g": "gravity [m/s^2]; default 9.81",
+}
+
+
+def glossary_text(indent: str = "") -> str:
+    """:data:`GLOSSARY` as text, one ``name  meaning`` line per value, aligned."""
+    width = max(map(len, GLOSSARY))
+    return "\n".join(f"{indent}{k:<{width}}  {v}" for k, v in GLOSSARY.items())
 
 
 def _check_finite(name: str, value) -> float:

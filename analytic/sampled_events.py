@@ -1,4 +1,5 @@
-"""Uplift, impact and overturn read from sampled ``theta(t)`` by one rule, for every backend.
+"""Uplift, impacts and the last rise past alpha read from sampled ``theta(t)`` by one
+rule, for every backend.
 
 The model finds its events exactly (root-found contact conditions, Eqs. 9-10, and
 Zeno chatter resolved down to ``rest_velocity``); an engine knows its state only at
@@ -21,11 +22,12 @@ every engine; the model's exact events stay in ``Trajectory.events``.
   engine samples) and rises ~6e-5 rad (its free deceleration at ``theta = 0+`` is
   0.86 rad/s^2 with the pendulum, 0.76 without): slower chatter, which the model
   resolves and an engine merges within a step or a sample, is counted by neither.
-* **overturn** (an overturned verdict only): the last time before the verdict that
-  ``|theta|`` rises through ``alpha``, linear between samples.  Past it the trilith
-  never came back, so this is where the potential's top was crossed for good (with
-  the energy above the barrier); the verdict's own time (the topple angle, or the
-  moment the fall became certain) depends on each backend's stop rule.
+* **exceeds_alpha** (an overturned verdict only): the last time before the verdict
+  that ``|theta|`` rises through ``alpha``, linear between samples.  Past it the
+  trilith never came back, so this is where the potential's top was crossed for good
+  (with the energy above the barrier).  It is not the overturn time: that is the
+  verdict's own time (``Trajectory.overturn_time``: the topple angle reached, or the
+  moment the fall became certain), which depends on each backend's stop rule.
 
 Every time carries its **resolution**: the crossing lies between the two samples
 that bracket it, so the interpolated time is off by at most its distance to the
@@ -70,7 +72,7 @@ class TimedEvent:
     """One event read by the rule: ``t`` [s] within ``+- resolution`` [s].
 
     ``side``: for an impact the sign of theta after it (+1 left corners); for uplift
-    and overturn the side rocked on.  ``speed``: the |theta_dot| [rad/s] that
+    and exceeds_alpha the side rocked on.  ``speed``: the |theta_dot| [rad/s] that
     qualified an impact (NaN otherwise).
     """
 
@@ -93,12 +95,13 @@ class TimedEvent:
 
 @dataclass(frozen=True)
 class SampledEvents:
-    """What the rule reads from one run: uplift and overturn (or None), the impacts."""
+    """What the rule reads from one run: uplift and the last rise past alpha
+    (``exceeds_alpha``; each None when absent), the impacts."""
 
     rule: EventRule
     uplift: TimedEvent | None
     impacts: tuple[TimedEvent, ...]
-    overturn: TimedEvent | None
+    exceeds_alpha: TimedEvent | None
 
     @property
     def n_impacts(self) -> int:
@@ -113,7 +116,8 @@ class SampledEvents:
                 "uplift": None if self.uplift is None else self.uplift.to_dict(),
                 "n_impacts": self.n_impacts,
                 "impacts": [e.to_dict() for e in self.impacts],
-                "overturn": None if self.overturn is None else self.overturn.to_dict()}
+                "exceeds_alpha": (None if self.exceeds_alpha is None
+                                  else self.exceeds_alpha.to_dict())}
 
 
 def _crossing(t0: float, t1: float, y0: float, y1: float, level: float) -> tuple[float, float]:
@@ -174,7 +178,7 @@ def _impacts(t, theta, theta_dot, rule: EventRule, t_stop: float) -> tuple[Timed
     return tuple(events)
 
 
-def _overturn(t, theta, alpha: float, t_verdict: float) -> TimedEvent | None:
+def _exceeds_alpha(t, theta, alpha: float, t_verdict: float) -> TimedEvent | None:
     mag = np.abs(theta)
     upto = np.flatnonzero(t <= t_verdict)
     if not upto.size:
@@ -185,7 +189,7 @@ def _overturn(t, theta, alpha: float, t_verdict: float) -> TimedEvent | None:
         return None  # never below alpha, or not past it at the verdict
     i = int(below[-1])
     tc, res = _crossing(t[i], t[i + 1], mag[i], mag[i + 1], alpha)
-    return TimedEvent("overturn", tc, res, 1 if theta[i + 1] > 0 else -1)
+    return TimedEvent("exceeds_alpha", tc, res, 1 if theta[i + 1] > 0 else -1)
 
 
 def read_events(t, theta, theta_dot, alpha: float, overturned_at: float | None = None,
@@ -201,7 +205,7 @@ def read_events(t, theta, theta_dot, alpha: float, overturned_at: float | None =
         The scene's slenderness angle [rad], > 0.
     overturned_at : float or None
         The verdict's time when the run overturned (None otherwise): impacts are
-        counted up to it and the overturn is read before it.
+        counted up to it and the last rise past alpha is read before it.
     rule : EventRule or None
         Default :class:`EventRule()`.
     """
@@ -218,9 +222,9 @@ def read_events(t, theta, theta_dot, alpha: float, overturned_at: float | None =
     if not t.size:
         return SampledEvents(rule, None, (), None)
     t_stop = math.inf if overturned_at is None else float(overturned_at)
-    overturn = None if overturned_at is None else _overturn(t, theta, alpha, t_stop)
+    past = None if overturned_at is None else _exceeds_alpha(t, theta, alpha, t_stop)
     return SampledEvents(rule, _uplift(t, theta, rule),
-                         _impacts(t, theta, theta_dot, rule, t_stop), overturn)
+                         _impacts(t, theta, theta_dot, rule, t_stop), past)
 
 
 def events_of(traj, alpha: float | None = None, rule: EventRule | None = None) -> SampledEvents:

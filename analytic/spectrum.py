@@ -67,14 +67,24 @@ class Spectrum:
 
     @property
     def gain_percent(self) -> np.ndarray:
-        """``Delta = 100 (A_yp - A_np) / A_np`` (Section 5.2)."""
+        """``Delta = 100 (A_yp - A_np) / A_np`` (Section 5.2); all zero without a
+        pendulum, where nothing shows it (:attr:`curves`)."""
         return 100.0 * (self.a_pendulum - self.a_no_pendulum) / self.a_no_pendulum
 
+    @property
+    def curves(self) -> tuple[str, ...]:
+        """The curves this spectrum has: ``('no_pendulum', 'pendulum')``, or only
+        ``('no_pendulum',)`` when the scene has no pendulum (``gamma = 0``): its
+        ``a_pendulum`` then repeats ``a_no_pendulum`` and is never shown."""
+        return ("no_pendulum", "pendulum") if self.scene.has_pendulum else ("no_pendulum",)
+
     def mode_jumps(self) -> list[dict]:
-        """Where the overturning mode changes between consecutive frequencies."""
+        """Where the overturning mode changes between consecutive frequencies, on
+        each of :attr:`curves`."""
         out = []
-        for curve, modes in (("no_pendulum", self.mode_no_pendulum),
-                             ("pendulum", self.mode_pendulum)):
+        modes_of = {"no_pendulum": self.mode_no_pendulum, "pendulum": self.mode_pendulum}
+        for curve in self.curves:
+            modes = modes_of[curve]
             for i in range(len(modes) - 1):
                 if modes[i] is not None and modes[i + 1] is not None and modes[i] != modes[i + 1]:
                     out.append({"curve": curve, "omega_before": float(self.omega[i]),
@@ -85,15 +95,18 @@ class Spectrum:
     def to_dict(self) -> dict:
         def arr(a):
             return [float(x) if math.isfinite(x) else None for x in np.asarray(a)]
+        # Without a pendulum the pendulum curve and the gain are left out: they
+        # would repeat the one curve and show a flat 0 % gain.
+        both = len(self.curves) == 2
         return {
             "omega": arr(self.omega),
             "a_no_pendulum": arr(self.a_no_pendulum),
-            "a_pendulum": arr(self.a_pendulum),
+            **({"a_pendulum": arr(self.a_pendulum)} if both else {}),
             "a_no_pendulum_safe": arr(self.a_no_pendulum_safe),
-            "a_pendulum_safe": arr(self.a_pendulum_safe),
-            "gain_percent": arr(self.gain_percent),
+            **({"a_pendulum_safe": arr(self.a_pendulum_safe),
+                "gain_percent": arr(self.gain_percent)} if both else {}),
             "mode_no_pendulum": list(self.mode_no_pendulum),
-            "mode_pendulum": list(self.mode_pendulum),
+            **({"mode_pendulum": list(self.mode_pendulum)} if both else {}),
             "mode_jumps": self.mode_jumps(),
             "pulse": self.settings.pulse,
             "criterion": self.criterion.describe(),
@@ -107,24 +120,29 @@ class Spectrum:
         }
 
     def to_csv(self, path, validity: dict | None = None) -> None:
-        """One row per frequency; with ``validity``
+        """One row per frequency, a column group per curve of :attr:`curves` (the
+        gain only with both); with ``validity``
         (:func:`analytic.threshold_validity.spectrum_validity`) also each curve's
         ``model_valid`` (empty: not checked) and the reason when it is not."""
         import csv
+        curves = self.curves
+        amps = {"no_pendulum": self.a_no_pendulum, "pendulum": self.a_pendulum}
+        modes = {"no_pendulum": self.mode_no_pendulum, "pendulum": self.mode_pendulum}
+        gain = len(curves) == 2
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh, lineterminator="\n")
-            head = ["omega", "a_no_pendulum", "a_pendulum", "gain_percent", "mode_no_pendulum",
-                    "mode_pendulum"]
+            head = (["omega"] + [f"a_{c}" for c in curves] + ["gain_percent"] * gain
+                    + [f"mode_{c}" for c in curves])
             if validity:
-                head += ["model_valid_no_pendulum", "model_valid_pendulum",
-                         "model_reason_no_pendulum", "model_reason_pendulum"]
+                head += ([f"model_valid_{c}" for c in curves]
+                         + [f"model_reason_{c}" for c in curves])
             w.writerow(head)
             for i, om in enumerate(self.omega):
-                row = [f"{om:.12g}", f"{self.a_no_pendulum[i]:.12g}",
-                       f"{self.a_pendulum[i]:.12g}", f"{self.gain_percent[i]:.12g}",
-                       self.mode_no_pendulum[i] or "", self.mode_pendulum[i] or ""]
+                row = ([f"{om:.12g}"] + [f"{amps[c][i]:.12g}" for c in curves]
+                       + [f"{self.gain_percent[i]:.12g}"] * gain
+                       + [modes[c][i] or "" for c in curves])
                 if validity:
-                    vs = [validity[c][i] for c in ("no_pendulum", "pendulum")]
+                    vs = [validity[c][i] for c in curves]
                     row += ["" if v["model_valid"] is None else v["model_valid"] for v in vs]
                     row += [v["model_reason"] for v in vs]
                 w.writerow(row)

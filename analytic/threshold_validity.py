@@ -128,9 +128,10 @@ def curve_validity(scene: Scene, omegas, amplitudes, kind: str = "sine",
 
 
 def spectrum_validity(spectrum, workers: int = 1) -> dict[str, list[dict]]:
-    """Both curves of an :class:`analytic.spectrum.Spectrum`:
-    ``{"no_pendulum": [...], "pendulum": [...]}``, one :func:`point_validity`
-    per frequency, each checked on its own scene (the no-pendulum curve on
+    """Every curve of an :class:`analytic.spectrum.Spectrum` (``spectrum.curves``):
+    ``{"no_pendulum": [...], "pendulum": [...]}``, or only ``"no_pendulum"`` for a
+    scene without a pendulum; one :func:`point_validity` per frequency, each
+    checked on its own scene (the no-pendulum curve on
     ``scene.without_pendulum()``); both curves share one set of workers."""
     _check_workers(workers)
     sc, kind = spectrum.scene, spectrum.settings.pulse
@@ -139,8 +140,10 @@ def spectrum_validity(spectrum, workers: int = 1) -> dict[str, list[dict]]:
         jobs += _jobs(sc, spectrum.omega, spectrum.a_pendulum, kind)
     checked = _many_validity(jobs, workers)
     n = len(spectrum.omega)
-    return {"no_pendulum": checked[:n], "pendulum": checked[n:] if n < len(checked)
-            else checked[:n]}
+    out = {"no_pendulum": checked[:n]}
+    if sc.gamma != 0.0:
+        out["pendulum"] = checked[n:]
+    return out
 
 
 def invalid_spans(omegas, valid, step: float | None = None) -> list[tuple[float, float]]:

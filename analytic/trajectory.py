@@ -177,6 +177,10 @@ class Trajectory:
 
     @property
     def overturn_time(self) -> float | None:
+        """When the run overturned [s]: the verdict's time (the criterion met,
+        |theta| at the topple angle or alpha, or the fall certain), None when it did
+        not overturn.  The last rise of |theta| past alpha, earlier, is
+        ``sampled_events().exceeds_alpha`` (``exceeds_alpha_time`` in the JSON)."""
         return self.verdict.time if self.verdict.overturned else None
 
     @property
@@ -193,11 +197,13 @@ class Trajectory:
     def summary(self) -> dict:
         """The result part of ``trilith simulate --json``.
 
-        ``uplift_time``, ``n_impacts`` and ``overturn_time`` (the last rise of
-        ``|theta|`` through alpha) are read by the shared rule of
-        :mod:`analytic.sampled_events`, each time with its resolution [s], so that
-        every backend's are comparable; ``verdict_time`` is when the backend's
-        criterion was met, ``events`` the backend's own events.
+        ``uplift_time``, ``n_impacts`` and ``exceeds_alpha_time`` (the last rise
+        of ``|theta|`` through alpha, past which the trilith never came back) are
+        read by the shared rule of :mod:`analytic.sampled_events`, each time with
+        its resolution [s], so that every backend's are comparable;
+        ``verdict_time`` is when the backend's criterion was met, and
+        ``overturn_time`` is it for an overturned run (None otherwise), as
+        :attr:`overturn_time`; ``events`` are the backend's own events.
 
         ``engine`` names the backend (the key every JSON document uses); wall
         and CPU times (``wall_time``, and the engines' ``diagnostics['wall_time']``
@@ -221,9 +227,11 @@ class Trajectory:
             "uplift_time": None if read is None or read.uplift is None else read.uplift.t,
             "uplift_resolution": (None if read is None or read.uplift is None
                                   else read.uplift.resolution),
-            "overturn_time": None if read is None or read.overturn is None else read.overturn.t,
-            "overturn_resolution": (None if read is None or read.overturn is None
-                                    else read.overturn.resolution),
+            "overturn_time": self.overturn_time,
+            "exceeds_alpha_time": (None if read is None or read.exceeds_alpha is None
+                                   else read.exceeds_alpha.t),
+            "exceeds_alpha_resolution": (None if read is None or read.exceeds_alpha is None
+                                         else read.exceeds_alpha.resolution),
             "sampled_events": None if read is None else read.to_dict(),
             "max_abs_theta": self.max_abs_theta,
             "criterion": self.criterion.kind,

@@ -1,7 +1,8 @@
 """Named scene files (TOML) and the one loader every command uses.
 
 A scene file has one ``[scene]`` table whose keys are :class:`analytic.Scene`
-fields (``b``, ``lam``, ``mu``, ``gamma``, ``l``, ...).  ``load_scene`` accepts a
+fields (``b``, ``lam``, ``mu``, ``gamma``, ``l``, ...); the column height ``h``
+may be given instead of ``lam`` (``lam = h/b``), not beside it.  ``load_scene`` accepts a
 name (a file in ``scenes/data``) or a path.  Shipped scenes: ``fig5``, the
 paper's Fig. 8, 9 and 11 grids (``fig8_lam5_gamma0.1``, ``fig9_lam3_b0.4``,
 ``fig11_mu2``, ...), ``single_block`` (Housner checks) and ``no_pendulum``;
@@ -142,10 +143,12 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
         raise ValueError(f"{path}: expected exactly one [scene] table, found "
                          f"{_short(', '.join(data)) or 'none'}")
     fields = set(Scene.field_names())
-    allowed = ", ".join(sorted(fields))
+    allowed = ", ".join(sorted(fields | {"h"}))
     for key in table:
-        if key not in fields:
+        if key not in fields | {"h"}:
             raise ValueError(f"{path}: unknown key {_short(key)}; allowed: {allowed}")
+    if "h" in table and "lam" in table:
+        raise ValueError(f"{path}: give either lam or h (h = lam b), not both")
     for key in overrides:
         if key not in fields:
             raise ValueError(f"override: unknown key {key!r}; allowed: {allowed}")
@@ -155,11 +158,19 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
         _check_value(f"override {key}={value!r}", key, value)
     values = {"name": path.stem}
     values.update(table)
+    given_h = ""
+    if "h" in values:
+        # A file may state the height, as drawings do; the model's parameter is lam.
+        h = values.pop("h")
+        b = values.get("b", Scene.b)
+        if b > 0:  # otherwise Scene refuses b before it reads lam
+            values["lam"] = h / b
+            given_h = f"h = {h:g} m and b = {b:g} m give lam = h/b = {h / b:g}; "
     try:
         scene = Scene(**values)
     except (TypeError, ValueError) as exc:
         # Scene's messages start with the field name ("b must be in ...").
-        raise ValueError(f"{path}: {exc}") from None
+        raise ValueError(f"{path}: {given_h}{exc}") from None
     if not overrides:
         return scene
     try:

@@ -133,7 +133,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
               f"points, {len(jobs)} engine threshold jobs ({len(unique)} distinct); at most {_duration(sum(est))} of "
               f"CPU, ~{_duration(sum(est) / workers)} on {workers} workers (jobs already in "
-              "the store cost nothing)", file=sys.stderr, flush=True)
+              "the store cost nothing)",
+              # Asked for with --estimate it is the result (stdout); before a run, a
+              # progress line (stderr).
+              file=sys.stdout if args.estimate else sys.stderr, flush=True)
         if args.estimate:
             return 0
         bar = _bar(sum(est))

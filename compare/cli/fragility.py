@@ -319,29 +319,42 @@ def ida_settings(args) -> IDASettings:
 
 def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:
     """``trilith spectrum --record FILE``: the record's first overturning intensity
-    (and islands) for each backend; ``--json`` prints them as one object."""
+    (and islands) for each backend, as the scale factor of the file's record and
+    the PGA it means; ``--json`` prints them as one object."""
+    from analytic.ida import intensity_of
     from compare.cli.excitation_args import scaled_record
     from compare.cli.options import print_json
     from scenes.ground_motion import load_record
     st = ida_settings(args)
     loaded = settings_from_args(args, backends[1:])
-    record = scaled_record(load_record(args.record, option="--record"), args)
+    given = load_record(args.record, option="--record")
+    record = scaled_record(given, args)
     use_store(args)
     results = _run_all([(b, scene, record, st, file_options(loaded, b)) for b in backends],
                        workers, args.scheduler)
+    # The factor on the record as the file gives it (--scale included), whatever the
+    # intensity measure searched: one number a user multiplies the file by.
+    per_im = (record.pga / given.pga if given.pga > 0 else 1.0) / intensity_of(record, st.im)
+    for r in results:
+        factor = None if r["censored"] else r["im_overturn"] * per_im
+        r["scale_overturn"] = factor
+        r["pga_overturn"] = None if factor is None else factor * given.pga
     if args.json:
         print_json({"command": "spectrum", "record": record.describe(), "ida": st.describe(),
                     "backends": dict(zip(backends, results))})
         return 0
     unit = IM_UNITS[st.im]
     print(f"record {record.label}: PGA {record.pga:.4g} m/s^2 ({record.pga / G_STANDARD:.3g} g), "
-          f"PGV {record.pgv:.4g} m/s; first overturning {IM_TEXT[st.im]} "
-          f"(grid step {100 * st.rel_step:g} %, bracket {100 * st.rtol:g} %):")
+          f"PGV {record.pgv:.4g} m/s; first overturning scale factor of the file's record "
+          f"and the PGA it means (searched on {IM_TEXT[st.im]}, grid step "
+          f"{100 * st.rel_step:g} %, bracket {100 * st.rtol:g} %):")
     for b, r in zip(backends, results):
         if r["censored"]:
-            print(f"  {b}: none up to {st.im_hi:g} {unit}")
+            print(f"  {b}: none up to {st.im_hi:g} {unit}".rstrip())
             continue
-        g = f" ({r['im_overturn'] / G_STANDARD:.3g} g)" if st.im == "pga" else ""
-        isl = "".join(f", survives again {a:.4g}-{c:.4g}" for a, c in r["islands"])
-        print(f"  {b}: {r['im_overturn']:.4g} {unit}{g}{isl}")
+        pga = r["pga_overturn"]
+        isl = "".join(f", survives again {a:.4g}-{c:.4g} {unit}".rstrip()
+                      for a, c in r["islands"])
+        print(f"  {b}: scale factor {r['scale_overturn']:.4g} (PGA {pga:.4g} m/s^2, "
+              f"{pga / G_STANDARD:.3g} g){isl}")
     return 0

@@ -31,11 +31,38 @@ _WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF
 
 
 def _version() -> str:
+    """The package version and, run from a git checkout, its commit (``+dirty``
+    when tracked files differ from it): a bug report then names the code.  Never
+    fails: without git, or outside a checkout, the version alone."""
+    from pathlib import Path
+
+    from compare.run.provenance import git_commit
     try:
         from importlib.metadata import PackageNotFoundError, version
-        return version("trilith-xval")
+        text = version("trilith-xval")
     except PackageNotFoundError:  # a source checkout that was never installed
-        return "unknown (not installed)"
+        text = "unknown (not installed)"
+    root = Path(__file__).resolve().parents[2]
+    # Only this package's own checkout: an installed copy inside another
+    # repository (a .venv in a clone) must not report that repository's commit.
+    if (root / ".git").exists():
+        commit = git_commit(root)
+        if commit != "unknown":
+            head, _, dirty = commit.partition("+")
+            text += f" (commit {head[:12]}{', with uncommitted changes' if dirty else ''})"
+    return text
+
+
+class _VersionAction(argparse.Action):
+    """``--version``, computed when asked for (git is not run for other commands)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="show the version (and the git commit of a checkout) and exit"):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"{parser.prog} {_version()}")  # on stdout, as argparse's own action
+        parser.exit()
 
 
 class HelpFormatter(argparse.HelpFormatter):
@@ -52,10 +79,13 @@ class HelpFormatter(argparse.HelpFormatter):
         return text
 
     def _format_text(self, text):
-        text = _plain(text)
-        if "\n" in text.strip():  # a docstring: laid out by hand
-            return argparse.RawDescriptionHelpFormatter._format_text(self, text)
-        return super()._format_text(text)
+        return super()._format_text(_plain(text))
+
+    def _fill_text(self, text, width, indent):
+        # The raw formatter differs from the default in _fill_text only.
+        if "\n" in text.strip():  # a docstring or a table: laid out by hand
+            return argparse.RawDescriptionHelpFormatter._fill_text(self, text, width, indent)
+        return super()._fill_text(text, width, indent)
 
     def _expand_help(self, action):
         return _plain(super()._expand_help(action))
@@ -99,7 +129,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
         description=f"Cross-validate physics engines ({', '.join(engine_names())}) "
                     "against the analytic rocking model of a trilith with a pendulum mass "
                     "absorber.")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     modules = {}
     for name in COMMANDS:

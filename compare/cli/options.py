@@ -17,7 +17,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from analytic.parameters import Scene
+from analytic.parameters import Scene, glossary_text
 from scenes import load_scene
 
 from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
@@ -28,7 +28,9 @@ SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel
             "hinge_x", "depth", "g")
 # Version of the --json documents (simulate, restitution, spectrum); bumped when a
 # key changes meaning or disappears.  1: inputs echoed, 'engine', 'timings' block.
-SCHEMA_VERSION = 1
+# 2: simulate's 'overturn_time' is the verdict's time (as Trajectory.overturn_time);
+# the last rise past alpha it used to mean is 'exceeds_alpha_time'.
+SCHEMA_VERSION = 2
 # Formats matplotlib writes without extra packages (--plot).
 PLOT_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".tif", ".tiff", ".eps", ".ps",
                  ".webp")
@@ -62,7 +64,9 @@ def detail(message: str) -> None:
 
 def add_scene_args(parser: argparse.ArgumentParser, several: bool = False) -> None:
     """``--scene`` (with ``several``: repeatable, globs allowed, default fig5),
-    ``--set NAME=VALUE`` and ``--no-pendulum``."""
+    ``--set NAME=VALUE`` and ``--no-pendulum``, in a group whose description
+    says what each scene value means (:data:`analytic.parameters.GLOSSARY`)."""
+    parser = scene_group(parser)
     if several:
         parser.add_argument("--scene", action="append", default=None,
                             metavar="NAME|FILE|GLOB",
@@ -77,6 +81,12 @@ def add_scene_args(parser: argparse.ArgumentParser, several: bool = False) -> No
                         metavar="NAME=VALUE",
                         help=f"override a scene value; NAME in {', '.join(SETTABLE)}")
     parser.add_argument("--no-pendulum", action="store_true", help="remove the pendulum (gamma = 0)")
+
+
+def scene_group(parser: argparse.ArgumentParser):
+    """An argument group for the scene options, described by the glossary."""
+    return parser.add_argument_group("scene (values in 'trilith scenes')",
+                                     description=glossary_text())
 
 
 def parse_overrides(items: list[str]) -> dict[str, float]:

@@ -76,7 +76,8 @@ def run(args: argparse.Namespace) -> int:
     check_output(args.out)  # the encoder (ffmpeg for .mp4)
     result = record(scene, excitation, args.engine, args.out, settings)
     verdicts = ", ".join(f"{name}: {traj.verdict.status}"
-                         + (f" at {traj.verdict.time:.3f} s" if traj.overturned else "")
+                         + (f", overturn_time = {traj.overturn_time:.3f} s"
+                            if traj.overturned else "")
                          for name, traj in result.trajectories.items())
     print(f"wrote {result.path}: {result.n_frames} frames at {result.fps:g} fps "
           f"({result.duration:.3f} s); {verdicts}")

@@ -22,7 +22,7 @@ from scenes import load_scene
 
 from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_workers_arg,
                                  check_output_path, detail, format_quantity, parse_engine_list,
-                                 resolve_workers, settings_from_args)
+                                 resolve_workers, scene_group, settings_from_args)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
 # contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
@@ -33,7 +33,7 @@ from compare.cli.options import add_store_args, use_store
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser("report", help="run the validation campaign, write an HTML/JSON report",
                               description=__doc__)
-    p.add_argument("--scene", default="fig5", help="scene name or TOML path")
+    scene_group(p).add_argument("--scene", default="fig5", help="scene name or TOML path")
     add_engine_list_arg(p, engine_names())
     p.add_argument("--quick", action="store_true",
                    help="smaller grids (< 2 min on 2 cores) instead of the full campaign")

@@ -40,7 +40,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--csv", metavar="FILE", default=None,
                         help="write t, theta, theta_dot, psi, psi_dot samples")
     parser.add_argument("--plot", metavar="FILE.png", default=None,
-                        help="write theta(t)/alpha and psi(t) (PNG, PDF or SVG)")
+                        help="write theta(t)/alpha and psi(t) with the events marked (PNG, "
+                             "PDF or SVG); an engine's run is drawn over the model's")
     return parser
 
 
@@ -61,27 +62,29 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
     return configure(name, **options)
 
 
-def _plot(traj, scene, path: str) -> None:
+def _plot(runs: list, scene, path: str) -> None:
+    """theta(t)/alpha of ``runs`` (the model's first, when the run is an engine's)
+    with each run's events, and psi(t) below when the scene has a pendulum."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from compare.show.history import plot_psi, plot_theta
+
     rows = 2 if scene.has_pendulum else 1
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.6 * rows), squeeze=False)
-    ax = axes[0, 0]
-    ax.plot(traj.t, traj.theta / scene.alpha, lw=1.0)
-    ax.axhline(1.0, color="0.6", lw=0.6, ls="--")
-    ax.axhline(-1.0, color="0.6", lw=0.6, ls="--")
-    ax.set_ylabel(r"$\theta/\alpha$")
-    for e in traj.sampled_events().impacts:  # the rule every backend's are read by
-        ax.axvline(e.t, color="0.85", lw=0.5, zorder=0)
-    v = traj.verdict
-    ax.set_title(f"{traj.backend}: {v.status}" + (f" ({v.mode}, t = {v.time:.3f} s)"
-                                                    if v.overturned else ""), fontsize=9)
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.8 * rows + 0.4),
+                             squeeze=False)
+    plot_theta(runs, scene.alpha, ax=axes[0, 0])
+    titles = []
+    for traj in runs:
+        v = traj.verdict
+        titles.append(f"{traj.backend}: {v.status}" + (
+            f" ({v.mode}, overturn_time = {traj.overturn_time:.3f} s)" if v.overturned else ""))
+    axes[0, 0].set_title("\n".join(titles), fontsize=9)
     if scene.has_pendulum:
-        axes[1, 0].plot(traj.t, traj.psi, lw=1.0, color="C1")
-        axes[1, 0].set_ylabel(r"$\psi$ [rad]")
-    axes[-1, 0].set_xlabel("t [s]")
+        plot_psi(runs, ax=axes[1, 0], legend=False)  # named once, above
+    for ax in axes[:-1, 0]:
+        ax.set_xlabel("")
     fig.tight_layout()
     from compare.run.atomic import savefig
     savefig(fig, path, dpi=120)
@@ -114,6 +117,12 @@ def run(args: argparse.Namespace) -> int:
     settings = _settings(args.engine, args.criterion, args.t_max,
                          file_options(loaded, args.engine))
     check_run_budget(args.engine, settings, excitation)
+    # An engine's plot shows the model's run beside it (same scene, excitation,
+    # criterion and window): what a cross-validation is read from.
+    overlay = args.plot is not None and not args.engine.startswith("analytic")
+    if overlay:
+        model_settings = _settings("analytic", args.criterion, args.t_max)
+        check_run_budget("analytic", model_settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
     if args.plot is not None:
@@ -124,7 +133,9 @@ def run(args: argparse.Namespace) -> int:
         with atomic_path(args.csv) as tmp:
             traj.to_csv(tmp)
     if args.plot is not None:
-        _plot(traj, scene, args.plot)
+        model = [get_backend("analytic").simulate(scene, excitation, model_settings)
+                 ] if overlay else []
+        _plot(model + [traj], scene, args.plot)
     if args.json:
         summary = traj.summary()
         timings = summary.pop("timings")
@@ -138,13 +149,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
           f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}")
     line = f"verdict: {v.status}"
-    if v.overturned:
-        line += f" ({v.mode}) at t = {v.time:.4f} s"
+    if v.overturned:  # the name of the time in --json and in Python's Trajectory
+        line += f" ({v.mode}), overturn_time = {v.time:.4f} s"
     print(line + (f" -- {v.reason}" if v.reason else ""))
     read = traj.sampled_events()
     rule = read.rule
     up = "none" if read.uplift is None else read.uplift.text()
-    over = "" if read.overturn is None else f", past alpha for good at {read.overturn.text()}"
+    over = ("" if read.exceeds_alpha is None else
+            f", past alpha for good (exceeds_alpha_time) at {read.exceeds_alpha.text()}")
     print(f"uplift (|theta| = {rule.uplift_angle:g} rad): {up}, impacts (theta = 0 crossed "
           f"faster than {rule.impact_speed:g} rad/s): {read.n_impacts}{over}")
     print(f"max |theta| = {sig(traj.max_abs_theta)} rad (alpha = {sig(scene.alpha)} rad), "

@@ -159,13 +159,14 @@ def _settings(args: argparse.Namespace):
     return SpectrumSettings(**kw)
 
 
-def _valid_text(validity: dict, i: int) -> str:
-    """'yes', 'no' (both curves), 'no (np)' / 'no (yp)' (one), '-' (unchecked)."""
-    v = {c: validity[c][i]["model_valid"] for c in ("no_pendulum", "pendulum")}
+def _valid_text(validity: dict, i: int, curves=("no_pendulum", "pendulum")) -> str:
+    """'yes', 'no' (every curve), 'no (np)' / 'no (yp)' (one of two), '-' (unchecked)."""
+    v = {c: validity[c][i]["model_valid"] for c in curves}
     if None in v.values():
         return "-"
-    bad = [short for c, short in (("no_pendulum", "np"), ("pendulum", "yp")) if not v[c]]
-    return "yes" if not bad else ("no" if len(bad) == 2 else f"no ({bad[0]})")
+    bad = [short for c, short in (("no_pendulum", "np"), ("pendulum", "yp"))
+           if c in curves and not v[c]]
+    return "yes" if not bad else ("no" if len(bad) == len(curves) else f"no ({bad[0]})")
 
 
 def _number(value: float, width: int) -> str:
@@ -217,26 +218,32 @@ def run(args: argparse.Namespace) -> int:
           f"gamma = {scene.gamma:.4g}; {settings.pulse} pulse; criterion "
           f"{settings.criterion.kind}, t_max = {settings.t_max}, tol = {settings.tol:g} m/s^2, "
           f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)")
-    print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13} {'A_yp [m/s^2]':>12} "
-          f"{'mode_yp':>13} {'Delta [%]':>9}  model valid")
+    both = len(spec.curves) == 2  # without a pendulum: one curve, no gain
+    print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13}"
+          + (f" {'A_yp [m/s^2]':>12} {'mode_yp':>13} {'Delta [%]':>9}" if both else "")
+          + "  model valid")
     gain = spec.gain_percent
     for i, w in enumerate(spec.omega):
         print(f"{w:13.4g} {_number(spec.a_no_pendulum[i], 12)} "
-              f"{spec.mode_no_pendulum[i] or '-':>13} {_number(spec.a_pendulum[i], 12)} "
-              f"{spec.mode_pendulum[i] or '-':>13} {_number(gain[i], 9)}  "
-              f"{_valid_text(validity, i)}")
+              f"{spec.mode_no_pendulum[i] or '-':>13}"
+              + (f" {_number(spec.a_pendulum[i], 12)} {spec.mode_pendulum[i] or '-':>13} "
+                 f"{_number(gain[i], 9)}" if both else "")
+              + f"  {_valid_text(validity, i, spec.curves)}")
     for jump in spec.mode_jumps():
-        print(f"mode jump ({jump['curve']}): {jump['mode_before']} at Omega = "
+        where = f" ({jump['curve'].replace('_', ' ')})" if both else ""
+        print(f"mode jump{where}: {jump['mode_before']} at Omega = "
               f"{jump['omega_before']:g} rad/s -> {jump['mode_after']} at "
               f"{jump['omega_after']:g} rad/s")
-    invalid = [float(w) for i, w in enumerate(spec.omega) if _valid_text(validity, i) != "yes"
-               and _valid_text(validity, i) != "-"]
+    invalid = [float(w) for i, w in enumerate(spec.omega)
+               if _valid_text(validity, i, spec.curves) not in ("yes", "-")]
     if invalid:
+        why = "a contact would pull or the bob meets a column" if both else \
+            "a contact would pull"
         info(f"warning: the model is invalid on the threshold run at {len(invalid)} "
-             f"frequencies (Omega {min(invalid):g} to {max(invalid):g} rad/s): a contact would "
-             f"pull or the bob meets a column; those thresholds are the model's, not a "
-             f"trilith's (model_reason in --json/--csv)")
-    missing = int(sum(1 for a in list(spec.a_no_pendulum) + list(spec.a_pendulum)
+             f"frequencies (Omega {min(invalid):g} to {max(invalid):g} rad/s): {why}; "
+             f"those thresholds are the model's, not a trilith's (model_reason in "
+             f"--json/--csv)")
+    missing = int(sum(1 for a in list(spec.a_no_pendulum) + list(spec.a_pendulum) * both
                       if not math.isfinite(a)))
     if missing:
         info(f"warning: {missing} point(s) did not overturn up to a_max = "

@@ -46,13 +46,18 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from compare.report.units import g_hz_axes
+
     fig, (top, low) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.4),
                                    gridspec_kw={"height_ratios": [2, 1]})
-    top.plot(reference.omega, reference.a_pendulum, "k-", lw=1.2, label="model, pendulum")
-    top.plot(reference.omega, reference.a_no_pendulum, "k--", lw=1.2, label="model, no pendulum")
-    for jump in reference.mode_jumps():
+    if reference.scene.gamma > 0.0:  # without a pendulum its curve repeats the other
+        top.plot(reference.omega, reference.a_pendulum, "k-", lw=1.2, label="model, pendulum")
+    top.plot(reference.omega, reference.a_no_pendulum,
+             "k--" if reference.scene.gamma > 0.0 else "k-", lw=1.2, label="model, no pendulum")
+    for k, jump in enumerate(reference.mode_jumps()):
         for ax in (top, low):
-            ax.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0)
+            ax.axvspan(jump["omega_before"], jump["omega_after"], color="0.9", zorder=0,
+                       label="model's mode jump" if (k == 0 and ax is top) else None)
     markers = {"pendulum": "o", "no_pendulum": "s"}
     for k, es in enumerate(spectra):
         color = f"C{k}"
@@ -77,6 +82,7 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     low.axhspan(-100 * tol, 100 * tol, color="C2", alpha=0.12, lw=0)
     low.axhline(0.0, color="0.5", lw=0.6)
     top.set_ylabel(r"first overturning $A_s$ [m/s$^2$]")
+    g_hz_axes(top)  # g and Hz beside the SI axes, as on the model's spectrum plots
     low.set_ylabel("engine error [%]")
     low.set_xlabel(r"$\Omega$ [rad/s]")
     top.legend(fontsize=7, ncol=2)
@@ -101,7 +107,9 @@ def plot_document(doc: dict, path) -> None:
     def values(key):
         return [math.nan if v is None else v for v in ref[key]]
 
-    reference = NS(omega=ref["omega"], a_pendulum=values("a_pendulum"),
+    reference = NS(omega=ref["omega"],
+                   # Absent from the document of a scene without a pendulum.
+                   a_pendulum=values("a_pendulum") if "a_pendulum" in ref else None,
                    a_no_pendulum=values("a_no_pendulum"),
                    mode_jumps=lambda: ref["mode_jumps"], settings=NS(pulse=ref["pulse"]),
                    scene=NS(**{k: doc["inputs"]["scene"][k] for k in ("lam", "b", "gamma", "mu")}))

@@ -48,7 +48,8 @@ def rows(backends) -> list[dict]:
             out.append({"case": case, "backend": name, "status": traj.verdict.status,
                         "uplift": read.uplift.text() if read.uplift else "none",
                         "impacts": read.n_impacts,
-                        "overturn": read.overturn.text() if read.overturn else "-",
+                        "exceeds_alpha": (read.exceeds_alpha.text() if read.exceeds_alpha
+                                          else "-"),
                         "verdict_time": ("-" if traj.verdict.time is None
                                          else f"{traj.verdict.time:.4f} s"),
                         "cpu_s": float(cpu), "exact": exact})
@@ -65,7 +66,7 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|---|---|")
     for r in table:
         print(f"| {r['case']} | {r['backend']} | {r['status']} | {r['uplift']} | {r['impacts']} "
-              f"| {r['overturn']} | {r['verdict_time']} | {r['cpu_s']:.2f} | {r['exact']} |")
+              f"| {r['exceeds_alpha']} | {r['verdict_time']} | {r['cpu_s']:.2f} | {r['exact']} |")
     print(f"\nload average {load0[0]:.1f} -> {os.getloadavg()[0]:.1f}")
     return 0
 

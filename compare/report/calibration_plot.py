@@ -21,18 +21,36 @@ def _label(e, varied) -> str:
     return ", ".join(f"{k} {e.options[k]:g}" for k in varied if k in e.options)
 
 
-def pareto_plot(cal, path) -> None:
-    """Write the plot of :class:`compare.campaign.calibrate.Calibration` ``cal`` to
-    ``path`` (PNG, PDF or SVG by suffix), atomically."""
+def pareto_plot(cal, path=None, ax=None):
+    """The Pareto front of a calibration on one axes.
+
+    Parameters
+    ----------
+    cal : compare.campaign.calibrate.Calibration
+    path : str or Path, optional
+        Where to write the figure (PNG, PDF or SVG by suffix), atomically; the
+        figure is then closed.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (matplotlib's convention); default a new figure's axes.
+
+    Returns
+    -------
+    matplotlib.axes.Axes or None
+        The axes drawn on; None once written to ``path`` on a figure of its own.
+    """
     import matplotlib
-    matplotlib.use("Agg")
+    if ax is None and path is not None:
+        matplotlib.use("Agg")  # a file only: no display needed
     import matplotlib.pyplot as plt
 
     from compare.run import atomic
 
     pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.engine_cpu_s > 0]
     front = [e for e in cal.front if e in pts]
-    fig, ax = plt.subplots(figsize=(7.0, 5.4), dpi=150, layout="constrained")
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(7.0, 5.4), dpi=150, layout="constrained")
+    fig = ax.figure
     ax.scatter([e.engine_cpu_s for e in pts], [max(e.worst_error, 1e-6) for e in pts], s=28,
                color="0.55", label="candidate (settings: table, CSV)", zorder=2)
     if front:
@@ -92,9 +110,19 @@ def pareto_plot(cal, path) -> None:
     ax.legend(fontsize=8, loc="best")
     if keyed:
         from matplotlib.lines import Line2D
+        # Below the axes: outside the figure's layout on a figure of our own; under
+        # the given axes (in its coordinates) on a caller's.
+        where = ({"loc": "outside lower center"} if own else
+                 {"loc": "upper center", "bbox_to_anchor": (0.5, -0.12),
+                  "bbox_transform": ax.transAxes})
         fig.legend([Line2D([], [], ls="none")] * len(keyed),
                    [f"{k}: {_label(e, varied)}" for k, e in enumerate(keyed, 1)],
-                   loc="outside lower center", ncols=1 if len(keyed) < 4 else 2,
-                   fontsize=8, frameon=False, handlelength=0, handletextpad=0)
+                   ncols=1 if len(keyed) < 4 else 2, fontsize=8, frameon=False,
+                   handlelength=0, handletextpad=0, **where)
+    if path is None:
+        return ax
     atomic.savefig(fig, path)
-    plt.close(fig)
+    if own:
+        plt.close(fig)
+        return None
+    return ax

@@ -213,11 +213,16 @@ QUICK_MARK = "QUICK (coarse grid, not the paper's figure)"
 
 def shade_validity(ax, sp: Spectrum, validity: dict | None, label: bool = True) -> None:
     """Hatch the frequencies where either curve's model is invalid on its
-    threshold run (``/``: with the pendulum, ``\\``: without)."""
+    threshold run (``/``: with the pendulum, ``\\``: without; a scene without a
+    pendulum has its one curve, labelled "model invalid")."""
     if not validity:
         return
     for curve, hatch, text in (("pendulum", "///", "model invalid (with pendulum)"),
                                ("no_pendulum", "\\\\", "model invalid (without)")):
+        if curve not in sp.curves:
+            continue
+        if len(sp.curves) == 1:
+            text = "model invalid"
         spans = invalid_spans(sp.omega, [v["model_valid"] for v in validity[curve]])
         for k, (lo, hi) in enumerate(spans):
             ax.axvspan(lo, hi, facecolor="none", edgecolor="0.55", hatch=hatch, lw=0,
@@ -226,8 +231,11 @@ def shade_validity(ax, sp: Spectrum, validity: dict | None, label: bool = True) 
 
 def _draw_spectrum(ax, sp: Spectrum, legend: bool, validity: dict | None = None) -> None:
     shade_validity(ax, sp, validity)
-    ax.plot(sp.omega, sp.a_no_pendulum, "k--", lw=1.0, label="without pendulum")
-    ax.plot(sp.omega, sp.a_pendulum, "k-", lw=1.2, label="with pendulum")
+    if "pendulum" in sp.curves:
+        ax.plot(sp.omega, sp.a_no_pendulum, "k--", lw=1.0, label="without pendulum")
+        ax.plot(sp.omega, sp.a_pendulum, "k-", lw=1.2, label="with pendulum")
+    else:  # one curve: no "with pendulum" copy of it
+        ax.plot(sp.omega, sp.a_no_pendulum, "k-", lw=1.2, label="no pendulum")
     curves = {"no_pendulum": sp.a_no_pendulum, "pendulum": sp.a_pendulum}
     first = True
     for jump in sp.mode_jumps():

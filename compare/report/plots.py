@@ -34,6 +34,7 @@ import numpy as np
 from analytic.threshold_validity import invalid_spans
 from compare.report import figure_cache
 from compare.report.trust import label
+from compare.report.units import g_hz_axes
 
 __all__ = ["spectra_figures", "convergence_figure", "convergence_axes", "history_figures",
            "restitution_figures", "shade_invalid", "color", "marker", "DPI", "WIDTH"]
@@ -159,14 +160,9 @@ def _draw_spectrum(d: dict):
                        label="mode jump" if (k == 0 and ax is top) else None)
     top.set_title(d["title"], loc="left")
     top.set_ylabel("first overturning A [m/s²]")
-    g_axis = top.secondary_yaxis("right", functions=(lambda x: x / 9.80665,
-                                                     lambda x: x * 9.80665))
-    g_axis.set_ylabel("[g]")
     bot.set_ylabel("engine / model − 1 [%]")
     bot.set_xlabel("Ω [rad/s]")
-    hz = top.secondary_xaxis("top", functions=(lambda x: x / (2 * math.pi),
-                                               lambda x: x * 2 * math.pi))
-    hz.set_xlabel("f = Ω/2π [Hz]")
+    g_hz_axes(top)
     lim = max([2.0 * tol] + [abs(v) * 1.2 for eng in d["engines"] for v in eng["error"]
                              if math.isfinite(v)])
     bot.set_ylim(-lim, lim)

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["G", "TWO_PI", "accel", "freq", "rel_error", "resolution_pct", "period"]
+__all__ = ["G", "TWO_PI", "accel", "freq", "rel_error", "resolution_pct", "period",
+           "g_hz_axes"]
 
 G = 9.80665  # m/s^2: standard gravity, the unit of "g" beside an acceleration
 TWO_PI = 2.0 * math.pi  # rad per cycle: Hz beside an angular frequency
@@ -57,3 +58,32 @@ def rel_error(err, rel_tol=None) -> str:
     if _finite(rel_tol) and abs(err) <= rel_tol * (1 + 1e-9):
         return f"|e| ≤ {resolution_pct(rel_tol)}"
     return f"{100 * err:+.1f} %"
+
+
+def g_hz_axes(ax, g: bool = True, hz: bool = True, hz_label: str = "f = Ω/2π [Hz]"):
+    """The twin axes of a plot of an acceleration [m/s^2] against an angular
+    frequency [rad/s]: g on the right, Hz on top (the same data, other units).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Its y axis in m/s^2 (with ``g``), its x axis in rad/s (with ``hz``).
+    g, hz : bool
+        Which twin axes to add.
+    hz_label : str
+        The top axis's label.
+
+    Returns
+    -------
+    tuple
+        ``(g_axis, hz_axis)``, each None when not asked for.
+    """
+    g_axis = hz_axis = None
+    if g:
+        g_axis = ax.secondary_yaxis("right", functions=(lambda a: a / G, lambda a: a * G))
+        g_axis.set_ylabel("[g]")
+    if hz:
+        hz_axis = ax.secondary_xaxis("top", functions=(lambda w: w / TWO_PI,
+                                                       lambda f: f * TWO_PI))
+        hz_axis.set_xlabel(hz_label)
+    return g_axis, hz_axis

@@ -72,17 +72,18 @@ def test_zero_samples_and_a_run_ending_on_an_impact():
     assert read.n_impacts == 1
 
 
-def test_overturn_is_the_last_rise_through_alpha_before_the_verdict():
+def test_exceeds_alpha_is_the_last_rise_through_alpha_before_the_verdict():
     t = np.linspace(0.0, 3.0, 301)
     # Up past alpha at 0.5 s, back below, then up for good: |theta| = alpha at 2.0 s.
     theta = (np.where(t < 1.0, 0.25 * np.sin(math.pi * t), 0.0)
              + np.where(t > 1.5, 0.4 * (t - 1.5), 0.0))
     read = read_events(t, theta, np.gradient(theta, t), ALPHA, overturned_at=2.9)
-    assert read.overturn.t == pytest.approx(2.0, abs=1e-9)
-    assert read.overturn.resolution == pytest.approx(0.0, abs=1e-9)  # a sample sits on it
-    assert read_events(t, theta, np.gradient(theta, t), ALPHA).overturn is None  # not overturned
+    assert read.exceeds_alpha.t == pytest.approx(2.0, abs=1e-9)
+    assert read.exceeds_alpha.resolution == pytest.approx(0.0, abs=1e-9)  # a sample sits on it
+    not_overturned = read_events(t, theta, np.gradient(theta, t), ALPHA)
+    assert not_overturned.exceeds_alpha is None
     read = read_events(t, theta, np.gradient(theta, t), ALPHA, overturned_at=2.052)
-    assert read.overturn.t == pytest.approx(2.0, abs=1e-9)
+    assert read.exceeds_alpha.t == pytest.approx(2.0, abs=1e-9)
 
 
 @pytest.mark.parametrize("kwargs, name", [({"uplift_angle": 0.0}, "uplift_angle"),
@@ -119,5 +120,5 @@ def test_model_and_pymunk_read_by_the_same_rule_agree(point):
     for a, b in zip(model.impacts, engine.impacts):
         assert abs(a.t - b.t) <= a.resolution + b.resolution
     if point == "D":  # overturns without impact
-        assert abs(engine.overturn.t - model.overturn.t) <= (engine.overturn.resolution
-                                                             + model.overturn.resolution)
+        past_e, past_m = engine.exceeds_alpha, model.exceeds_alpha
+        assert abs(past_e.t - past_m.t) <= past_e.resolution + past_m.resolution

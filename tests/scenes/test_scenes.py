@@ -133,3 +133,38 @@ def test_cli_reports_bad_scene_file_with_exit_code_2(tmp_path, capsys):
     assert err.startswith("error: ") and str(path) in err and "'widht'" in err
     assert len(err.strip().splitlines()) == 1  # one line, no traceback
     assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_file_may_give_h_instead_of_lam(tmp_path):
+    path = tmp_path / "tall.toml"
+    path.write_text("[scene]\nb = 0.5\nh = 3.5\n")
+    s = load_scene(path)
+    assert s.h == pytest.approx(3.5, rel=1e-15)  # h / b * b: float rounding only
+    assert s.lam == pytest.approx(7.0, rel=1e-15)
+    # Without b the default width is used, as for every other missing key.
+    path.write_text("[scene]\nh = 1.2\n")
+    assert load_scene(path).h == pytest.approx(1.2, rel=1e-15)
+
+
+def test_h_and_lam_together_are_refused_in_one_line(tmp_path, capsys):
+    path = tmp_path / "both.toml"
+    path.write_text("[scene]\nb = 0.6\nlam = 5\nh = 3\n")
+    with pytest.raises(ValueError, match=r"either lam or h.*not both"):
+        load_scene(path)
+    rc = main(["scenes", "--scene", str(path)])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: ") and len(err.strip().splitlines()) == 1
+    assert str(path) in err and "lam" in err and "h" in err
+
+
+@pytest.mark.parametrize("body, words", [
+    ("[scene]\nb = 0.6\nh = 0.3\n", ["h = 0.3 m", "lam must be in"]),  # lam = 0.5 < 1
+    ("[scene]\nb = 0\nh = 3\n", ["b must be in"]),
+    ("[scene]\nh = true\n", ["'h'", "number"]),
+])
+def test_bad_h_is_named(tmp_path, body, words):
+    path = tmp_path / "bad.toml"
+    path.write_text(body)
+    with pytest.raises(ValueError) as info:
+        load_scene(path)
+    assert all(w in str(info.value) for w in words), str(info.value)

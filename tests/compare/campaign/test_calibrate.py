@@ -198,3 +198,23 @@ def test_the_pareto_plot_keys_its_points_by_the_settings_that_vary(tmp_path):
     out = tmp_path / "front.png"
     pareto_plot(cal, out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_pareto_plot_draws_on_the_given_axes(tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from compare.campaign.calibrate import Calibration
+    from compare.report.calibration_plot import pareto_plot
+    evs = [Evaluation({"dt": dt}, err, (), cpu, 2.0 * cpu, 1.0, 1)
+           for dt, err, cpu in ((1e-4, 0.004, 8.0), (5e-4, 0.009, 2.0))]
+    cal = Calibration("pymunk", "test", "thresholds", 0.01, ValidationSet(omegas=(12.0,)), evs)
+    fig, (left, right) = plt.subplots(1, 2)
+    assert pareto_plot(cal, ax=right) is right
+    assert not left.has_data() and right.has_data()
+    assert right.get_xscale() == "log" and "worst error" in right.get_ylabel()
+    out = tmp_path / "two.png"
+    assert pareto_plot(cal, out, ax=left) is left  # the caller's figure, written
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    plt.close(fig)
