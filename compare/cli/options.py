@@ -326,7 +326,7 @@ def use_store(args: argparse.Namespace):
     (None with ``--no-cache``).  Call before any work: a bad ``--cache`` or
     ``--scheduler`` is a usage error."""
     from compare.run import runs
-    from compare.run.store import RunStore, default_cache_dir
+    from compare.run.store import RunStore
 
     address = getattr(args, "scheduler", None)
     if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
@@ -336,10 +336,25 @@ def use_store(args: argparse.Namespace):
         runs.check_scheduler(address)  # an address with no scheduler: refused now
     runs.set_scheduler(address)
     runs.STATS.clear()
-    store = None if getattr(args, "no_cache", False) else RunStore(
-        args.cache if getattr(args, "cache", None) else default_cache_dir())
+    store = None
+    if not getattr(args, "no_cache", False):
+        directory, source = store_location(args)
+        store = RunStore(directory, source=source)
     runs.activate(store)
     return store
+
+
+def store_location(args: argparse.Namespace) -> tuple[str, str]:
+    """The run store's directory and what named it (``'--cache'``,
+    ``'TRILITH_CACHE'`` or ``'the default store'``), for messages; an empty
+    ``--cache`` is refused (it would silently mean the default store)."""
+    from compare.run.store import default_cache_dir, default_cache_source
+    cache = getattr(args, "cache", None)
+    if cache is not None:
+        if not cache.strip():
+            raise ValueError("--cache must name a directory, got an empty string")
+        return cache, "--cache"
+    return str(default_cache_dir()), default_cache_source()
 
 
 # --- engine settings files ---
