@@ -39,12 +39,19 @@ def _mib(n: int) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.run.keys import CODE_SETS, code_version
     from compare.cli.options import store_location
     from compare.run.store import RunStore
 
     directory, source = store_location(args)
     store = RunStore(directory, check_database=args.action != "clear", source=source)
+    try:
+        return _act(store, args)
+    finally:
+        store.close()  # no connection left open (a read-only mount must unmount)
+
+
+def _act(store, args) -> int:
+    from compare.run.keys import CODE_SETS, code_version
     current = {code_version(packages) for packages in CODE_SETS}
     if args.action == "clear":
         n = store.clear()

@@ -24,30 +24,9 @@ from compare.cli.main import main
 from compare.run import atomic, runs
 from compare.run.store import DB_NAME, RunStore
 
+from tests.support.hostile import refused, snapshot
 from tests.support.paths import ROOT
 TRILITH = [sys.executable, "-m", "compare.cli.main"]
-
-
-def snapshot(directory: Path) -> dict:
-    """Every file and directory under ``directory`` with its bytes (files) and mode."""
-    out = {}
-    for p in sorted(directory.rglob("*")):
-        st = p.lstat()
-        out[str(p.relative_to(directory))] = (st.st_mode, p.read_bytes() if p.is_file() else None)
-    return out
-
-
-def refused(argv, capsys, needle: str) -> None:
-    """``trilith ARGV`` exits 2 with one ``error:`` line containing ``needle``."""
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse's own errors
-        code = exc.code
-    err = capsys.readouterr().err
-    lines = err.splitlines()
-    assert code == 2, err
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and needle in lines[0], lines[0]
 
 
 @pytest.fixture
