@@ -39,7 +39,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help=f"engines beside the model: {', '.join(ENGINES)}, or none")
     add_settings_arg(parser)
     parser.add_argument("--out", default="fragility", metavar="DIR",
-                        help="writes fragility.json, fragility.csv and fragility.png")
+                        help="a new or empty folder, or one an earlier fragility run wrote "
+                             "(replaced whole): fragility.json, fragility.csv, fragility.png")
     add_workers_arg(parser)
     add_store_args(parser, scheduler=True)
     return parser
@@ -133,7 +134,9 @@ def run(args: argparse.Namespace) -> int:
     st = ida_settings(args)
     loaded = settings_from_args(args, engines_)
     workers = resolve_workers(args.workers)
-    out = check_output_path(args.out, "--out", directory=True)
+    # Built beside --out and swapped in whole, so that nothing exists until the
+    # results do, and only a folder this tool wrote (or an empty one) is replaced.
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
     suite = load_suite(args.records)
     store = use_store(args)
     backends = ("analytic",) + engines_
@@ -184,6 +187,14 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
 
 
 def _write(out, doc: dict, st: IDASettings) -> None:
+    import json
+
+    from compare.run.atomic import report_dir
+    with report_dir(out) as tmp:
+        _write_files(tmp, doc, st)
+
+
+def _write_files(out, doc: dict, st: IDASettings) -> None:
     import json
 
     from compare.run.atomic import write_text
