@@ -173,14 +173,16 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
     # A record with no robust bracket has no intensity: listed, left out of the fit.
     usable = {b: [math.inf if r["censored"] else r["im_overturn"] for r in per[b]
                   if r.get("bracketed", True)] for b in backends}
-    fits = {b: fragility(v, censored_at=st.im_hi) if v else None for b, v in usable.items()}
+    # A curve needs two motions: with fewer there is no fit, only the records.
+    fits = {b: fragility(v, censored_at=st.im_hi) if len(v) >= 2 else None
+            for b, v in usable.items()}
     ref = fits["analytic"]
     return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
             "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
                          "duration": r.end_time, "n_samples": len(r.times)} for r in suite],
             "backends": {b: {"fit": None if fits[b] is None else fits[b].describe(),
                              "records": per[b],
-                             **({} if b == "analytic" or fits[b] is None else
+                             **({} if b == "analytic" or fits[b] is None or ref is None else
                                 {"agreement": agreement(ref, fits[b])})}
                          for b in backends},
             "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
