@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import time
 
 from analytic.excitation import G_STANDARD
@@ -326,8 +327,21 @@ def add_ida_args(parser: argparse.ArgumentParser) -> None:
 
 def ida_settings(args) -> IDASettings:
     lo, hi = _im_range(args)
-    return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step, rtol=args.rtol,
-                       tail=args.tail)
+    try:
+        return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step,
+                           rtol=args.rtol, tail=args.tail)
+    except ValueError as exc:  # the API names its fields; a user typed options
+        text = str(exc)
+        for field, option in _IDA_OPTIONS:
+            text = re.sub(rf"\b{field}\b", option, text)
+        raise ValueError(text) from None
+
+
+# IDASettings' fields and the options that set them (messages name the options).
+# 'im' first: once replaced, the other names' '--im-range' must not match it.
+_IDA_OPTIONS = (("im", "--im"), ("im_lo", "--im-range low end"),
+                ("im_hi", "--im-range high end"), ("rel_step", "--rel-step"),
+                ("rtol", "--rtol"), ("tail", "--tail"))
 
 
 def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:

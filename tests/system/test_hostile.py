@@ -118,10 +118,26 @@ def test_record_with_bom_keeps_its_first_sample(here, capsys):
     (["report", "--quick", "--dt", "1e-5", "--out", "r"], "--dt: a pybullet run"),
     (["calibrate", "--engine", "pymunk", "--dt", "1e-9"], "--dt: a pymunk run"),
     (["calibrate", "--engine", "pymunk", "--dt", "-1"], "each step must be in (0, 0.1] s"),
+    (["calibrate", "--engine", "pymunk", "--omega", ""], "--omega must be a comma-separated"),
+    (["calibrate", "--engine", "pymunk", "--tolerance", "5"], "--tolerance must be in (0, 1]"),
+    (["fragility", "--records", "sample", "--rel-step", "50"], "--rel-step must be in (0, 10]"),
+    (["fragility", "--records", "sample", "--tail", "1000"], "--tail must be in (0, 600]"),
+    (["fragility", "--records", "sample", "--rtol", "0.5", "--rel-step", "0.2"],
+     "--rtol (0.5) must be below --rel-step"),
+    (["spectrum", "--omega", "10", "--cache", ""], "--cache must name a directory"),
 ])
 def test_option_refused_in_one_line(argv, needle, here, capsys):
     before = snapshot(here)
     refused(argv, capsys, needle)
+    assert snapshot(here) == before
+
+
+def test_a_step_from_a_settings_file_is_blamed_on_the_file(here, capsys):
+    (here / "s.toml").write_text("[pymunk]\ndt = 0.09\n")
+    before = snapshot(here)
+    line = refused(["calibrate", "--engine", "pymunk", "--settings", "s.toml"], capsys,
+                   "--settings 's.toml'")
+    assert "--dt" not in line
     assert snapshot(here) == before
 
 
