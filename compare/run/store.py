@@ -47,6 +47,7 @@ from pathlib import Path
 from compare.run import store_db
 from compare.run.store_db import default_cache_dir, default_cache_source
 from compare.run.codec import MAGIC, ForeignValue, decode, encode
+from compare.run.store_figures import StoreFigures
 
 __all__ = ["RunStore", "default_cache_dir", "default_cache_source", "DB_NAME"]
 
@@ -65,7 +66,7 @@ def _is_full(exc: sqlite3.DatabaseError) -> bool:
     return getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL
 
 
-class RunStore:
+class RunStore(StoreFigures):
     """A directory holding ``runs.sqlite``; safe to share between processes.
 
     Parameters
@@ -320,36 +321,6 @@ class RunStore:
             else:  # cannot grow (a file size limit), I/O error, damage
                 self._warn("write", f"cannot store a result ({exc})")
 
-    # ------------------------------------------------------------- figures
-    def count(self, kind: str | None = None, since: float | None = None) -> int:
-        """Entries (of ``kind``; created at or after ``since``, a ``time.time()``)."""
-        sql, args = "SELECT COUNT(*) FROM runs WHERE 1", []
-        if kind is not None:
-            sql, args = sql + " AND kind = ?", [*args, kind]
-        if since is not None:
-            sql, args = sql + " AND created >= ?", [*args, since]
-        rows = self._query(sql, args)
-        return int(rows[0][0]) if rows else 0
-
-    def created(self) -> dict[str, float]:
-        """Key -> creation time of every entry (tests: nothing was rewritten)."""
-        return dict(self._query("SELECT key, created FROM runs"))
-
-    def mean_costs(self, kind: str = "run") -> dict[str, tuple[float, int]]:
-        """Label -> (mean cost [s], count) over the stored entries of ``kind``."""
-        rows = self._query("SELECT label, AVG(cost), COUNT(*) FROM runs WHERE kind = ? "
-                           "GROUP BY label", (kind,))
-        return {label: (float(mean), int(n)) for label, mean, n in rows}
-
-    def by_code(self) -> list[tuple[str, int, int]]:
-        """``(code version, entries, value bytes)`` per code version; entries this
-        format did not write (old pickles) are grouped under ``'foreign'``."""
-        rows = self._query(
-            "SELECT CASE WHEN substr(value, 1, ?) = ? THEN code ELSE 'foreign' END AS c, "
-            "COUNT(*), SUM(length(value)) FROM runs GROUP BY c ORDER BY c",
-            (len(MAGIC), MAGIC))
-        return [(code or "unknown", int(n), int(size or 0)) for code, n, size in rows]
-
     def files(self) -> list[Path]:
         """The store's files that exist (the database, its WAL and shared memory)."""
         return [p for p in (self.path, self.path.with_name(DB_NAME + "-wal"),
@@ -371,29 +342,6 @@ class RunStore:
                     (*sorted(keep), len(MAGIC), MAGIC))
         self._query("VACUUM")
         return before - self.count()
-
-    def verify(self):
-        """Every entry whose digest or value does not check, without serving any.
-
-        Returns
-        -------
-        checked : int
-            Entries read.
-        bad : list of tuple
-            ``(key, kind, label, why)`` per entry that would not be served.
-        """
-        if self._connect() is None:
-            return 0, []
-        bad = []
-        problems = [r[0] for r in self._query("PRAGMA quick_check") if r[0] != "ok"]
-        if problems:
-            bad.append(("-", "database", "-", "; ".join(problems[:3])))
-        if self._legacy:
-            rows = self._query("SELECT key, kind, label, value, '' FROM runs")
-        else:
-            rows = self._query("SELECT key, kind, label, value, digest FROM runs")
-        entries = store_db.bad_entries(rows, decode)
-        return len(rows), bad + entries
 
     def clear(self) -> int:
         """Delete the store's files (nothing else in the directory); returns the
