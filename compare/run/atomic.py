@@ -200,6 +200,9 @@ def output_lock(path, option: str = "--out"):
 
     path = Path(path)
     lock = path.with_name(path.name + ".lock")
+    # Folders made for the lock are removed at the end when still empty: a
+    # refused or failed run leaves no new folder behind.
+    made = [p for p in (lock.parent, *lock.parent.parents) if not p.exists()]
     lock.parent.mkdir(parents=True, exist_ok=True)
     while True:
         fh = _open_lock(lock)
@@ -224,6 +227,9 @@ def output_lock(path, option: str = "--out"):
             with contextlib.suppress(OSError):
                 os.unlink(lock)
         fh.close()
+        for folder in made:  # innermost first; only the empty ones go
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 @contextlib.contextmanager
@@ -239,8 +245,8 @@ def report_dir(out, lock: bool = True):
     out = Path(out)
     check_replaceable(out)
     parent = out.parent if str(out.parent) else Path(".")
-    parent.mkdir(parents=True, exist_ok=True)
     with output_lock(out) if lock else contextlib.nullcontext():
+        parent.mkdir(parents=True, exist_ok=True)  # the lock made it (and removes it)
         _remove_stale(Path(parent) / out.name)
         tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=parent))
         try:

@@ -85,3 +85,18 @@ def test_rewriting_an_output_keeps_its_mode(here, capsys):
     assert main(argv) == 0
     assert os.stat("t.csv").st_mode & 0o777 == 0o640
     capsys.readouterr()
+
+
+def test_a_failed_locked_build_leaves_no_folder(here):
+    with pytest.raises(RuntimeError):
+        with atomic.output_lock(here / "a" / "b" / "out"):
+            assert (here / "a" / "b").is_dir()
+            raise RuntimeError("the campaign failed")
+    assert list(here.iterdir()) == []
+    with pytest.raises(RuntimeError):
+        with atomic.report_dir(here / "y" / "r"):
+            raise RuntimeError("the report failed")
+    assert list(here.iterdir()) == []
+    with atomic.report_dir(here / "x" / "r") as tmp:  # success: the folders stay
+        (tmp / "f.txt").write_text("1")
+    assert (here / "x" / "r" / "f.txt").is_file() and not (here / "x" / "r.lock").exists()
