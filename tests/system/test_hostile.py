@@ -132,11 +132,15 @@ def test_option_refused_in_one_line(argv, needle, here, capsys):
     assert snapshot(here) == before
 
 
-def test_a_step_from_a_settings_file_is_blamed_on_the_file(here, capsys):
-    (here / "s.toml").write_text("[pymunk]\ndt = 0.09\n")
+@pytest.mark.parametrize("argv, step", [
+    (["calibrate", "--engine", "pymunk"], "0.09"),
+    (["report", "--quick", "--engine", "pymunk", "--out", "r"], "1e-7"),
+    (["spectrum", "--engine", "pymunk", "--omega", "10"], "1e-7"),
+])
+def test_a_step_from_a_settings_file_is_blamed_on_the_file(argv, step, here, capsys):
+    (here / "s.toml").write_text(f"[pymunk]\ndt = {step}\n")
     before = snapshot(here)
-    line = refused(["calibrate", "--engine", "pymunk", "--settings", "s.toml"], capsys,
-                   "--settings 's.toml'")
+    line = refused([*argv, "--settings", "s.toml"], capsys, "--settings 's.toml'")
     assert "--dt" not in line
     assert snapshot(here) == before
 
