@@ -17,7 +17,6 @@ import json
 import os
 import re
 import stat
-from pathlib import Path
 
 __all__ = ["read_bytes", "read_text", "read_json", "check_schema", "MAX_JSON_DEPTH",
            "MAX_JSON_BYTES"]
@@ -130,7 +129,3 @@ def read_json(path, where: str, *, max_bytes: int = MAX_JSON_BYTES,
         check_schema(doc, where, schema_versions)
     return doc
 
-
-def path_text(path) -> str:
-    """``path`` quoted for a message."""
-    return repr(str(Path(path)))

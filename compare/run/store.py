@@ -29,8 +29,9 @@ served and nothing is stored; a full disk, or a store that cannot grow, is
 reported once on stderr and the results are still returned, just not kept.
 
 Concurrency: WAL journal (readers never block the writer), every write one
-autocommitted insert that keeps a readable existing value (a SIGKILL loses at most the transaction in
-flight; SQLite rolls it back on the next open), and ``busy_timeout`` so
+autocommitted insert that keeps a proven existing value (a SIGKILL loses at most
+the transaction in flight; SQLite rolls it back on the next open), and
+``busy_timeout`` so
 processes sharing a store wait for each other's lock instead of failing.
 """
 from __future__ import annotations
@@ -38,7 +39,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
-import stat
 import sqlite3
 import sys
 import time
