@@ -39,10 +39,14 @@ import tempfile
 from pathlib import Path
 
 __all__ = ["write_text", "write_bytes", "savefig", "savetxt", "atomic_path",
-           "output_lock", "report_dir", "check_replaceable", "check_name_length", "MARKER"]
+           "output_lock", "report_dir", "check_replaceable", "check_name_length", "MARKER",
+           "MANIFEST", "check_into", "record_into"]
 
 # The file that marks a directory as written (and replaceable) by this tool.
 MARKER = ".trilith-output"
+# The list of files this tool wrote into a folder it shares with other files
+# (figures --out, bench --out): only those are ever rewritten there.
+MANIFEST = ".trilith-written"
 # The content of an output's lock file: what proves this tool wrote it.
 LOCK_TEXT = "trilith-xval output lock: removed when the output is written\n"
 # Bytes a temporary name adds to an output's name: '.' + '.tmp-' + 8 random ones
@@ -98,6 +102,43 @@ def check_replaceable(out, option: str = "--out") -> None:
             raise ValueError(f"{option} {str(out)!r} holds files this tool did not write "
                              f"(no {MARKER} inside) and is not replaced; choose a new or "
                              "empty directory")
+
+
+def _recorded(out: Path) -> set[str]:
+    try:
+        lines = (out / MANIFEST).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {line for line in lines if line and not line.startswith("#")}
+
+
+def check_into(out, names, option: str = "--out") -> None:
+    """``ValueError`` naming ``option`` unless every file of ``names`` is missing
+    from the folder ``out`` or recorded in its :data:`MANIFEST` (written there
+    by this tool before): a user's file of the same name is never overwritten."""
+    out = Path(out)
+    if out.is_symlink():
+        raise ValueError(f"{option} {str(out)!r} is a symbolic link (to "
+                         f"{os.readlink(out)!r}); name the directory itself")
+    if not out.is_dir():
+        return
+    ours = _recorded(out)
+    for name in names:
+        target = out / name
+        if (target.exists() or target.is_symlink()) and name not in ours:
+            raise ValueError(f"{option} {str(out)!r}: {name} exists and this tool did not "
+                             f"write it (not in {MANIFEST}); move it or choose another "
+                             f"{option}")
+
+
+def record_into(out, names) -> None:
+    """Add ``names`` to the :data:`MANIFEST` of the folder ``out`` (created with its
+    parents), before the files are written: a killed run leaves them claimable."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = sorted(_recorded(out) | set(names))
+    write_text(out / MANIFEST, "# files written here by trilith-xval (rewritten by its next "
+               "run; nothing else here is touched)\n" + "\n".join(names) + "\n")
 
 
 def _remove_stale(out: Path) -> None:

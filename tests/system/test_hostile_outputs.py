@@ -14,7 +14,7 @@ import pytest
 from compare.cli.main import main
 from compare.run import atomic
 
-from tests.support.hostile import decoy, refused, snapshot  # noqa: F401
+from tests.support.hostile import decoy, make_decoy, refused, snapshot, tree_digest  # noqa: F401
 from tests.system.test_fragility_cli import ARGS, write_suite
 
 
@@ -100,3 +100,27 @@ def test_a_failed_locked_build_leaves_no_folder(here):
     with atomic.report_dir(here / "x" / "r") as tmp:  # success: the folders stay
         (tmp / "f.txt").write_text("1")
     assert (here / "x" / "r" / "f.txt").is_file() and not (here / "x" / "r.lock").exists()
+
+
+@pytest.mark.parametrize("argv", [["figures", "--quick"], ["bench", "--quick"]])
+def test_shared_folders_never_overwrite_a_users_file(argv, tmp_path, capsys):
+    folder = make_decoy(tmp_path / "mine")
+    (folder / "fig5.png").write_bytes(b"mine")
+    (folder / "workprecision.json").write_text("{}")
+    before = tree_digest(folder)
+    refused([*argv, "--out", str(folder)], capsys, f"--out {str(folder)!r}:")
+    assert tree_digest(folder) == before
+
+
+def test_a_refused_figures_run_creates_no_folder(here, capsys):
+    refused(["figures", "--out", "new", "--dpi", "10"], capsys, "--dpi")
+    assert list(here.iterdir()) == []
+
+
+def test_files_recorded_as_ours_are_rewritten(here):
+    atomic.record_into(here / "f", ["a.png"])
+    (here / "f" / "a.png").write_text("old")
+    atomic.check_into(here / "f", ["a.png", "b.png"])  # ours, and a missing one
+    (here / "f" / "c.png").write_text("mine")
+    with pytest.raises(ValueError, match="--out .*c.png exists and this tool did not"):
+        atomic.check_into(here / "f", ["c.png"])
