@@ -129,14 +129,21 @@ class RunStore(StoreFigures):
     def _check_directory(self) -> None:
         store_db.check_directory(self.directory, self._where)
 
+    @property
+    def _other(self) -> str:
+        """The advice on where else to keep results, naming what chose this store."""
+        if self.source == "TRILITH_CACHE":
+            return "another --cache, or set TRILITH_CACHE to another directory"
+        return "another --cache"
+
     def _damaged(self, exc: Exception) -> ValueError:
         return ValueError(f"run store {str(self.path)!r} is not usable ({exc}); remove it "
                           f"with 'trilith cache clear --cache {self.directory}' or choose "
-                          "another --cache")
+                          f"{self._other}")
 
     def _foreign(self, exc: Exception) -> ValueError:
         return ValueError(f"{self._where}: its {DB_NAME} is not a trilith-xval run store "
-                          f"({exc}); it is left untouched: choose another --cache")
+                          f"({exc}); it is left untouched: choose {self._other}")
 
     def _identify(self) -> str:
         try:
