@@ -137,9 +137,11 @@ class RunStore(StoreFigures):
         return "another --cache"
 
     def _damaged(self, exc: Exception) -> ValueError:
-        return ValueError(f"run store {str(self.path)!r} is not usable ({exc}); remove it "
-                          f"with 'trilith cache clear --cache {self.directory}' or choose "
-                          f"{self._other}")
+        # Only a file proven ours (its header's marker) is one 'cache clear' removes.
+        cure = (f"remove it with 'trilith cache clear --cache {self.directory}'"
+                if store_db.header_is_ours(self.path) else "move it away")
+        return ValueError(f"run store {str(self.path)!r} is not usable ({exc}); {cure} or "
+                          f"choose {self._other}")
 
     def _foreign(self, exc: Exception) -> ValueError:
         return ValueError(f"{self._where}: its {DB_NAME} is not a trilith-xval run store "
