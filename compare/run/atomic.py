@@ -56,7 +56,8 @@ _TMP_EXTRA = len(".") + len(".tmp-") + 8
 # The exact file sets of report and campaign directories written before the
 # marker existed: replaced like marked ones (a folder of a user's holds other files).
 _UNMARKED_OUTPUTS = ({"index.html", "summary.json", "summary.md"},
-                     {"index.html", "campaign.json"})
+                     {"index.html", "campaign.json"},
+                     {"fragility.json", "fragility.csv", "fragility.png"})
 
 
 def check_name_length(path, option: str, suffix: str = "") -> None:
@@ -123,6 +124,13 @@ def check_into(out, names, option: str = "--out") -> None:
     if not out.is_dir():
         return
     ours = _recorded(out)
+    if not (out / MANIFEST).exists():
+        try:
+            present = {p.name for p in out.iterdir()}
+        except OSError as exc:
+            raise ValueError(f"{option} {str(out)!r}: {exc.strerror or exc}") from None
+        if present == set(names):  # exactly a whole output of a version before the manifest
+            return
     for name in names:
         target = out / name
         if (target.exists() or target.is_symlink()) and name not in ours:

@@ -124,3 +124,15 @@ def test_files_recorded_as_ours_are_rewritten(here):
     (here / "f" / "c.png").write_text("mine")
     with pytest.raises(ValueError, match="--out .*c.png exists and this tool did not"):
         atomic.check_into(here / "f", ["c.png"])
+
+
+def test_a_whole_output_of_an_older_version_is_rewritten_a_part_is_not(here):
+    names = ["a.json", "b.png"]
+    (here / "old").mkdir()
+    for name in names:
+        (here / "old" / name).write_text("from before the manifest")
+    atomic.check_into(here / "old", names)  # exactly an earlier output: ours
+    (here / "part").mkdir()
+    (here / "part" / "b.png").write_text("mine")
+    with pytest.raises(ValueError, match="b.png exists"):
+        atomic.check_into(here / "part", names)
