@@ -147,9 +147,13 @@ def _uri(path: Path, **params) -> str:
     return f"file:{urllib.parse.quote(str(Path(path).absolute()))}?{query}"
 
 
-def open_ro(path: Path, timeout: float) -> sqlite3.Connection:
-    """A read-only connection (``mode=ro``; ``immutable=1`` when SQLite cannot create
-    the WAL index beside a file on a read-only filesystem or directory)."""
+def open_ro(path: Path, timeout: float, immutable: bool = False) -> sqlite3.Connection:
+    """A read-only connection (``mode=ro``; ``immutable=1`` when asked, or when
+    SQLite cannot create the WAL index beside a file on a read-only filesystem or
+    directory: then it creates no file at all)."""
+    if immutable:
+        return sqlite3.connect(_uri(path, mode="ro", immutable=1), uri=True, timeout=timeout,
+                               isolation_level=None, check_same_thread=False)
     try:
         conn = sqlite3.connect(_uri(path, mode="ro"), uri=True, timeout=timeout,
                                isolation_level=None, check_same_thread=False)
@@ -190,9 +194,14 @@ def identify(path: Path, timeout: float) -> str:
         what = "an empty file" if not head else "not an SQLite database"
         raise NotAStore(f"it is {what}")
     ours = header_is_ours(path)
+    app_header = int.from_bytes(head[68:72], "big") if len(head) >= 72 else 0
+    if app_header not in (0, APPLICATION_ID):  # another program's marker: not opened
+        raise NotAStore(f"application id {app_header:#x}: another program's database")
     conn = None
     try:
-        conn = open_ro(path, timeout)
+        # Not proven ours yet: opened immutable, so that SQLite creates no -wal or
+        # -shm file beside another application's database.
+        conn = open_ro(path, timeout, immutable=not ours)
         app = conn.execute("PRAGMA application_id").fetchone()[0]
         version = conn.execute("PRAGMA user_version").fetchone()[0]
         tables = {r[0] for r in conn.execute(
@@ -237,6 +246,7 @@ def migrate(conn: sqlite3.Connection) -> None:
     except BaseException:
         conn.execute("ROLLBACK")
         raise
+    conn.execute("PRAGMA wal_checkpoint(PASSIVE)")  # the marker into the file's header
 
 
 def create(path: Path) -> None:

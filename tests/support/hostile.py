@@ -92,6 +92,8 @@ def make_decoy(directory: Path) -> Path:
     (directory / "fragility.png").write_bytes(b"\x89PNG\r\n\x1a\n my own figure")
     (directory / "fragility.json").write_text('{"mine": true}\n')
     con = sqlite3.connect(directory / "runs.sqlite")
+    # WAL, as the store's own: a careless reader would leave -wal/-shm files beside it.
+    con.execute("PRAGMA journal_mode=WAL")
     con.execute("CREATE TABLE runs (id INTEGER PRIMARY KEY, payload TEXT)")
     con.execute("CREATE TABLE notes (x TEXT)")
     con.execute("INSERT INTO runs (payload) VALUES ('my data')")

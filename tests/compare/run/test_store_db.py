@@ -43,7 +43,7 @@ def test_a_proven_entry_is_kept_and_a_failing_one_replaced(tmp_path):
 
 @pytest.mark.parametrize("sql, needle", [
     ("CREATE TABLE other (x)", r"application id 0x0, tables \['other', 't'\]"),
-    ("PRAGMA application_id = 7", "application id 0x7"),
+    ("PRAGMA application_id = 7", "application id 0x7: another program"),
 ])
 def test_foreign_databases_are_named(tmp_path, sql, needle):
     con = sqlite3.connect(tmp_path / DB_NAME)
