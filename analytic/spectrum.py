@@ -164,6 +164,29 @@ def _frequency(scene: Scene, ss: SpectrumSettings, omega: float) -> tuple:
     return np_res, first_overturn_amplitude(scene, omega, ss)
 
 
+# More frequencies than any figure plots (the paper's have ~100): a bisection per
+# frequency and curve makes 1e5 about an hour of compiled runs.
+MAX_FREQUENCIES = 100_000
+
+
+def _frequencies(omegas) -> np.ndarray:
+    """``omegas`` as a 1-D array of 1 to :data:`MAX_FREQUENCIES` values in (0, 1e4]."""
+    if isinstance(omegas, (str, bytes)):
+        raise TypeError(f"omegas must be numbers, got a {type(omegas).__name__}")
+    if hasattr(omegas, "__len__") and len(omegas) > MAX_FREQUENCIES:
+        raise ValueError(f"omegas has {len(omegas)} frequencies, more than "
+                         f"{MAX_FREQUENCIES}")
+    try:
+        w = np.atleast_1d(np.asarray(omegas, dtype=float))
+    except (TypeError, ValueError):
+        raise TypeError("omegas must be a sequence of numbers") from None
+    if w.ndim != 1 or w.size == 0 or w.size > MAX_FREQUENCIES or not np.all(np.isfinite(w)) \
+            or np.any(w <= 0) or np.any(w > 1e4):
+        raise ValueError(f"omegas must be a list of 1 to {MAX_FREQUENCIES} frequencies in "
+                         "(0, 1e4] rad/s")
+    return w
+
+
 def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None = None,
                          workers: int = 1, progress: bool = False, map_fn=None) -> Spectrum:
     """Both curves of the overturning spectrum of ``scene`` over ``omegas``.
@@ -193,10 +216,7 @@ def overturning_spectrum(scene: Scene, omegas, settings: SpectrumSettings | None
         raise ValueError("settings must be analytic.spectrum.SpectrumSettings")
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
-    w = np.atleast_1d(np.asarray(omegas, dtype=float))
-    if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0) \
-            or np.any(w > 1e4):
-        raise ValueError("omegas must be a non-empty list of frequencies in (0, 1e4] rad/s")
+    w = _frequencies(omegas)
     if not (isinstance(workers, int) and 1 <= workers <= 256):
         raise ValueError(f"workers must be an integer in [1, 256], got {workers!r}")
     t0 = time.perf_counter()

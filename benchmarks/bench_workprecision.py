@@ -86,8 +86,19 @@ def apply_resolution_floor(points: list[Point]) -> list[Point]:
     return points
 
 
+def output_names() -> list[str]:
+    """The files :func:`write_outputs` writes into its folder."""
+    return ["workprecision.json", "workprecision.md",
+            *(f"workprecision_{metric}.png" for metric in METRICS)]
+
+
 def write_outputs(points: list[Point], machine: dict, meta: dict, out: Path, log=print) -> None:
-    """Fronts, JSON, plots and markdown tables from measured points."""
+    """Fronts, JSON, plots and markdown tables from measured points; in a folder
+    other than the default one, a file of the same name that this tool did not
+    write (:data:`compare.run.atomic.MANIFEST`) is never overwritten."""
+    if Path(out) != OUT_DIR:
+        atomic.check_into(out, output_names())
+    atomic.record_into(out, output_names())
     apply_resolution_floor(points)
     mark_front(points)
     write_json(out / "workprecision.json", machine, points, meta)

@@ -12,8 +12,6 @@ they are.
 from __future__ import annotations
 
 import math
-import os
-import stat
 import tomllib
 from pathlib import Path
 
@@ -36,24 +34,9 @@ def read_toml(path: Path, what: str) -> dict:
     (``what``: 'scene file', 'campaign file') when it is not a regular file, cannot
     be read, is over :data:`MAX_FILE_BYTES`, is not UTF-8 or not TOML (nesting too
     deep included)."""
+    from compare.run.safe_read import read_bytes
     where = f"{what} {str(path)!r}"
-    try:
-        if not stat.S_ISREG(os.stat(path).st_mode):  # before open: a FIFO would block
-            raise ValueError(f"{where} is not a regular file (a directory, FIFO or "
-                             "device)")
-        with open(path, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-                raise ValueError(f"{where} is not a regular file (a directory, FIFO or "
-                                 "device)")
-            data = fh.read(MAX_FILE_BYTES + 1)
-    except FileNotFoundError:
-        raise ValueError(f"{where} does not exist") from None
-    except IsADirectoryError:
-        raise ValueError(f"{where} is a directory, not a TOML file") from None
-    except OSError as exc:
-        raise ValueError(f"{where} cannot be read ({exc.strerror or exc})") from None
-    if len(data) > MAX_FILE_BYTES:
-        raise ValueError(f"{where} is larger than {MAX_FILE_BYTES} bytes")
+    data = read_bytes(path, where, MAX_FILE_BYTES)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:

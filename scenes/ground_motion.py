@@ -42,20 +42,11 @@ _OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
 
 
 def _open_text(path: Path, where: str) -> list[str]:
+    from compare.run.safe_read import read_text
     if path.is_dir():
         raise ValueError(f"{where}: {str(path)!r} is a directory, not a record file")
-    if not path.exists():
-        raise ValueError(f"{where}: file {str(path)!r} does not exist")
-    if not path.is_file():
-        raise ValueError(f"{where}: {str(path)!r} is not a regular file (a FIFO or device)")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise ValueError(f"{where}: {str(path)!r} is larger than {MAX_FILE_BYTES >> 20} MB")
-    try:
-        return path.read_text(encoding="utf-8-sig").splitlines()  # a BOM is not data
-    except UnicodeDecodeError:
-        raise ValueError(f"{where}: {str(path)!r} is not a UTF-8 text file") from None
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot read {str(path)!r} ({exc.strerror})") from None
+    # A BOM is not data (read_text drops it); devices and FIFOs are refused unread.
+    return read_text(path, f"{where}: file {str(path)!r}", MAX_FILE_BYTES).splitlines()
 
 
 def _number(text: str, where: str, lineno: int, what: str) -> float:

@@ -73,17 +73,10 @@ def read_settings_file(path) -> SettingsFile:
         per run (:data:`RUN_FIELDS`) or a value the engine refuses; the message
         starts with the file's name.
     """
+    from compare.run.safe_read import read_bytes
     p = Path(path)
     where = f"settings file {str(p)!r}"
-    if not p.is_file():
-        raise ValueError(f"{where}: not a readable file")
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot be read ({exc.strerror})") from None
-    if len(data) > MAX_BYTES:
-        raise ValueError(f"{where}: {len(data)} bytes, more than a settings file's "
-                         f"{MAX_BYTES} bytes")
+    data = read_bytes(p, where, MAX_BYTES)
     try:
         doc = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:

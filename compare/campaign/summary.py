@@ -26,7 +26,6 @@ The dicts stay available as ``raw`` on every view, for fields not typed here.
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -367,6 +366,14 @@ class Summary:
 
 
 def load(path: str | Path) -> Summary:
-    """Read ``summary.json`` at ``path`` into a :class:`Summary`."""
-    return Summary.from_dict(json.loads(Path(path).read_text()))
+    """Read ``summary.json`` at ``path`` into a :class:`Summary`; ``ValueError``
+    naming the file when it is not a regular file, too large, nested too deep,
+    of a schema this version does not read, or not shaped like a summary."""
+    from compare.run.safe_read import read_json
+    where = f"summary file {str(path)!r}"
+    doc = read_json(path, where, schema_versions=range(1, SCHEMA_VERSION + 1))
+    try:
+        return Summary.from_dict(doc)
+    except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
+        raise ValueError(f"{where}: not a summary ({type(exc).__name__}: {exc})") from None
 

@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
     if sources is not None:
         if args.html is None and args.json is None:
             raise ValueError("--from reads stored atlases: give --html FILE and/or --json FILE")
-        docs = [_read_atlas(path) for path in sources]
+        from compare.campaign.atlas_check import read_atlas
+        docs = [read_atlas(path) for path in sources]
         if len(docs) > 1:
             from compare.campaign.atlas_merge import merge_atlases
             from compare.run.provenance import collect
@@ -92,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
             doc["command"] = doc["provenance"]["command"] = _join_command(args, sources)
         else:
             doc = docs[0]
+        page = _render(doc, args, " ".join(f"--from {p!r}" for p in sources))
         if args.json is not None:
             _write_json(args.json, doc)
     else:
@@ -123,24 +125,28 @@ def run(args: argparse.Namespace) -> int:
         from compare.run.provenance import collect
         doc["provenance"] = collect(args)
         doc["command"] = doc["provenance"]["command"]
+        page = _render(doc, args, "the atlas")
         if args.json is not None:
             _write_json(args.json, doc)
-    if args.html is not None:
-        from compare.report.atlas_page import write_page
-        write_page(doc, args.html)
+    if page is not None:
+        from compare.run import atomic
+        atomic.write_text(args.html, page)
         info(f"wrote {args.html}")
     _print(doc)
     return 0
 
 
-def _read_atlas(path: str) -> dict:
+def _render(doc: dict, args: argparse.Namespace, where: str) -> str | None:
+    """The HTML page (when ``--html``) and the printed rows, built in memory before
+    any file is written: a document the checks let through but the renderer
+    cannot read is still refused with nothing written."""
+    from compare.report.atlas_page import page_html, trusted_rows
     try:
-        doc = json.loads(open(path, encoding="utf-8").read())
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"--from {path!r}: not a readable atlas JSON ({exc})") from None
-    if not isinstance(doc, dict) or not {"points", "steps", "config"} <= set(doc):
-        raise ValueError(f"--from {path!r}: not an atlas (needs 'points', 'steps', 'config')")
-    return doc
+        trusted_rows(doc)
+        return page_html(doc) if args.html is not None else None
+    except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
+        raise ValueError(f"{where}: not an atlas this version can render "
+                         f"({type(exc).__name__}: {exc})") from None
 
 
 def _write_json(path: str, doc: dict) -> None:

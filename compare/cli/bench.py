@@ -63,9 +63,14 @@ def run(args: argparse.Namespace) -> int:
     engines = parse_engine_list(args.engine, none_ok=True)  # before any heavy work
     if not engines and args.no_analytic:
         raise ValueError("--engine none with --no-analytic leaves nothing to measure")
-    out = check_output_path(args.out, "--out", directory=True) if args.out is not None else None
-    use_store(args)
+    # Only this tool's own earlier files are rewritten; nothing is created yet.
+    out = None if args.out is None else check_output_path(args.out, "--out", directory=True,
+                                                          files=())
     bench = _load_bench()
+    if out is not None:
+        from compare.run.atomic import check_into
+        check_into(out, bench.output_names(), "--out")
+    use_store(args)
     payload = bench.run(quick=args.quick, out=out, engines=engines,
                         analytic=not args.no_analytic, log=info)
     failures = failed_defaults(bench, payload["points"])

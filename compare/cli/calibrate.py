@@ -82,6 +82,15 @@ def _number(text: str, option: str) -> float | int:
     return value
 
 
+def _omegas(text: str) -> tuple[float, ...]:
+    """``--omega W1,W2,...``: at least one frequency."""
+    omegas = tuple(float(_number(v.strip(), "--omega")) for v in text.split(",") if v.strip())
+    if not omegas:
+        raise ValueError(f"--omega must be a comma-separated list of frequencies [rad/s], "
+                         f"got {text!r}")
+    return omegas
+
+
 def _space(args, engine: str, base: dict) -> dict:
     from compare.campaign.calibrate import MAX_CANDIDATES, default_space
     space = default_space(engine, step_only=args.step_only, base=base)
@@ -105,9 +114,12 @@ def _space(args, engine: str, base: dict) -> dict:
     return space
 
 
-def _check_budget(engine: str, space: dict, vs, base: dict, scenes=()) -> None:
+def _check_budget(engine: str, space: dict, vs, base: dict, source: str = "--dt",
+                  scenes=()) -> None:
     """Refuse before any work a step that is not positive or whose longest run
-    (the lowest validation frequency's pulse) is over the run budget."""
+    (the lowest validation frequency's pulse) is over the run budget; ``source``
+    names where the steps came from (``--dt``, or the ``--settings`` file whose
+    step the default search multiplies)."""
     import dataclasses
 
     from analytic.excitation import Pulse
@@ -116,9 +128,10 @@ def _check_budget(engine: str, space: dict, vs, base: dict, scenes=()) -> None:
     settings = configure(engine, **base)
     for dt in space.get("dt", [settings.dt]):
         if not 0.0 < dt <= MAX_ENGINE_DT:
-            raise ValueError(f"--dt: each step must be in (0, {MAX_ENGINE_DT:g}] s, got {dt!r}")
+            raise ValueError(f"{source}: each step must be in (0, {MAX_ENGINE_DT:g}] s, "
+                             f"got {dt!r}")
         check_run_budget(engine, dataclasses.replace(settings, dt=dt),
-                         Pulse(1.0, _lowest_omega(vs, scenes)), option="--dt")
+                         Pulse(1.0, _lowest_omega(vs, scenes)), option=source)
 
 
 def _lowest_omega(vs, scenes) -> float:
@@ -145,14 +158,18 @@ def run(args: argparse.Namespace) -> int:
     space = _space(args, engine, base)
     names = tuple(sc.name for sc in scenes)
     name = names[0] if len(names) == 1 else names
-    if args.omega is not None:
-        omegas = tuple(float(_number(v.strip(), "--omega")) for v in args.omega.split(",")
-                       if v.strip())
-        if not omegas:
-            raise ValueError("--omega: give at least one frequency [rad/s]")
-    vs = (ValidationSet(scene=name, omegas=omegas) if args.omega is not None
+    vs = (ValidationSet(scene=name, omegas=_omegas(args.omega)) if args.omega is not None
           else ValidationSet(scene=name, omegas=()) if design else ValidationSet(scene=name))
-    _check_budget(engine, space, vs, base, scenes)
+    if args.tolerance is not None and not (math.isfinite(args.tolerance)
+                                           and 0.0 < args.tolerance <= 1.0):
+        raise ValueError(f"--tolerance must be in (0, 1], got {args.tolerance!r}")
+    if args.dt is not None:
+        source = "--dt"
+    elif "dt" in base:  # the default search multiplies the file's step
+        source = f"--settings {loaded.path!r} (dt = {base['dt']!r}, times the search factors)"
+    else:
+        source = f"{engine}'s calibrated step (times the search factors)"
+    _check_budget(engine, space, vs, base, source, scenes)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
     for option, path in outputs.items():

@@ -18,7 +18,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "rad/s and write fig5 ... fig11 (PNG, PDF or SVG; Fig. 5 one journal "
                     "column wide, 3.5 in, the others two, 7 in) and figures.json into --out.")
     parser.add_argument("--out", default="figures", metavar="DIR",
-                        help="output directory, created if missing")
+                        help="output directory, created if missing; a file there of the "
+                             "same name that this tool did not write is never overwritten")
     add_workers_arg(parser)
     parser.add_argument("--dpi", type=int, default=DEFAULT_DPI,
                         help="resolution, in [50, 1200]")
@@ -31,9 +32,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    from compare.report.figures import (FigureSettings, check_output_options, make_figures,
+                                        output_names, quick_settings)
     workers = resolve_workers(args.workers)
-    check_output_path(args.out, "--out", directory=True)
-    from compare.report.figures import FigureSettings, check_output_options, make_figures, quick_settings
+    # Only this tool's own earlier files are rewritten; nothing is created yet.
+    check_output_path(args.out, "--out", directory=True, files=output_names(args.format))
 
     check_output_options(args.dpi, args.format)  # before minutes of spectra
     fs = quick_settings() if args.quick else FigureSettings()

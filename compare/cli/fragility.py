@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import time
 
 from analytic.excitation import G_STANDARD
@@ -39,7 +40,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help=f"engines beside the model: {', '.join(ENGINES)}, or none")
     add_settings_arg(parser)
     parser.add_argument("--out", default="fragility", metavar="DIR",
-                        help="writes fragility.json, fragility.csv and fragility.png")
+                        help="a new or empty folder, or one an earlier fragility run wrote "
+                             "(replaced whole): fragility.json, fragility.csv, fragility.png")
     add_workers_arg(parser)
     add_store_args(parser, scheduler=True)
     return parser
@@ -133,7 +135,9 @@ def run(args: argparse.Namespace) -> int:
     st = ida_settings(args)
     loaded = settings_from_args(args, engines_)
     workers = resolve_workers(args.workers)
-    out = check_output_path(args.out, "--out", directory=True)
+    # Built beside --out and swapped in whole, so that nothing exists until the
+    # results do, and only a folder this tool wrote (or an empty one) is replaced.
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
     suite = load_suite(args.records)
     store = use_store(args)
     backends = ("analytic",) + engines_
@@ -170,20 +174,30 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
     # A record with no robust bracket has no intensity: listed, left out of the fit.
     usable = {b: [math.inf if r["censored"] else r["im_overturn"] for r in per[b]
                   if r.get("bracketed", True)] for b in backends}
-    fits = {b: fragility(v, censored_at=st.im_hi) if v else None for b, v in usable.items()}
+    # A curve needs two motions: with fewer there is no fit, only the records.
+    fits = {b: fragility(v, censored_at=st.im_hi) if len(v) >= 2 else None
+            for b, v in usable.items()}
     ref = fits["analytic"]
     return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
             "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
                          "duration": r.end_time, "n_samples": len(r.times)} for r in suite],
             "backends": {b: {"fit": None if fits[b] is None else fits[b].describe(),
                              "records": per[b],
-                             **({} if b == "analytic" or fits[b] is None else
+                             **({} if b == "analytic" or fits[b] is None or ref is None else
                                 {"agreement": agreement(ref, fits[b])})}
                          for b in backends},
             "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 
 
 def _write(out, doc: dict, st: IDASettings) -> None:
+    import json
+
+    from compare.run.atomic import report_dir
+    with report_dir(out) as tmp:
+        _write_files(tmp, doc, st)
+
+
+def _write_files(out, doc: dict, st: IDASettings) -> None:
     import json
 
     from compare.run.atomic import write_text
@@ -313,8 +327,21 @@ def add_ida_args(parser: argparse.ArgumentParser) -> None:
 
 def ida_settings(args) -> IDASettings:
     lo, hi = _im_range(args)
-    return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step, rtol=args.rtol,
-                       tail=args.tail)
+    try:
+        return IDASettings(im=args.im, im_lo=lo, im_hi=hi, rel_step=args.rel_step,
+                           rtol=args.rtol, tail=args.tail)
+    except ValueError as exc:  # the API names its fields; a user typed options
+        text = str(exc)
+        for field, option in _IDA_OPTIONS:
+            text = re.sub(rf"\b{field}\b", option, text)
+        raise ValueError(text) from None
+
+
+# IDASettings' fields and the options that set them (messages name the options).
+# 'im' first: once replaced, the other names' '--im-range' must not match it.
+_IDA_OPTIONS = (("im", "--im"), ("im_lo", "--im-range low end"),
+                ("im_hi", "--im-range high end"), ("rel_step", "--rel-step"),
+                ("rtol", "--rtol"), ("tail", "--tail"))
 
 
 def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int:

@@ -208,7 +208,8 @@ def resolve_workers(n: int, option: str = "--workers") -> int:
 
 
 def check_output_path(path: str | os.PathLike, option: str, *, directory: bool = False,
-                      replace: bool = False, suffixes: tuple[str, ...] | None = None) -> Path:
+                      replace: bool = False, suffixes: tuple[str, ...] | None = None,
+                      files: tuple[str, ...] | None = None) -> Path:
     """Check an output path before any work; returns it as a Path.
 
     A file (``directory=False``): not an existing directory nor a special file,
@@ -219,8 +220,10 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
     nothing else there is touched, unless ``replace``: then the directory is
     replaced whole at the end, and refused now unless it is new, empty or one
     this tool wrote (:func:`compare.run.atomic.check_replaceable`); nothing is
-    created now, its nearest existing ancestor is checked writable.
-    Writability is probed by creating a temporary file, which also holds for
+    created now, its nearest existing ancestor is checked writable.  With
+    ``files`` (the names to be written into the directory), likewise nothing is
+    created now, and each must be missing or one this tool wrote there
+    (:func:`compare.run.atomic.check_into`).  Writability is probed by creating a temporary file, which also holds for
     root on read-only mounts; names too long for the temporary name beside
     them are refused.
     """
@@ -231,18 +234,22 @@ def check_output_path(path: str | os.PathLike, option: str, *, directory: bool =
         raise ValueError(f"{option}: the path contains a NUL character")
     p = Path(text)
     try:
-        return _check_output_path(p, text, option, directory, replace, suffixes)
+        return _check_output_path(p, text, option, directory, replace, suffixes, files)
     except OSError as exc:  # a name too long, a loop of links, a permission
         raise ValueError(f"{option} {text[:60]!r}: {exc.strerror or exc}") from None
 
 
 def _check_output_path(p: Path, text: str, option: str, directory: bool, replace: bool,
-                       suffixes: tuple[str, ...] | None) -> Path:
+                       suffixes: tuple[str, ...] | None, files=None) -> Path:
     if directory:
         if p.exists() and not p.is_dir():
             raise ValueError(f"{option} must be a directory, but {text!r} is a file")
-        if replace:  # built beside it and swapped in: create nothing now
-            check_replaceable(p, option)
+        if replace or files is not None:  # created by the writer: nothing now
+            if replace:
+                check_replaceable(p, option)
+            else:
+                from compare.run.atomic import check_into
+                check_into(p, files, option)
             ancestor = next(a for a in (p.absolute(), *p.absolute().parents) if a.exists())
             try:
                 if not ancestor.is_dir():
@@ -348,7 +355,7 @@ def use_store(args: argparse.Namespace):
     (None with ``--no-cache``).  Call before any work: a bad ``--cache`` or
     ``--scheduler`` is a usage error."""
     from compare.run import runs
-    from compare.run.store import RunStore, default_cache_dir
+    from compare.run.store import RunStore
 
     address = getattr(args, "scheduler", None)
     if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
@@ -358,10 +365,25 @@ def use_store(args: argparse.Namespace):
         runs.check_scheduler(address)  # an address with no scheduler: refused now
     runs.set_scheduler(address)
     runs.STATS.clear()
-    store = None if getattr(args, "no_cache", False) else RunStore(
-        args.cache if getattr(args, "cache", None) else default_cache_dir())
+    store = None
+    if not getattr(args, "no_cache", False):
+        directory, source = store_location(args)
+        store = RunStore(directory, source=source)
     runs.activate(store)
     return store
+
+
+def store_location(args: argparse.Namespace) -> tuple[str, str]:
+    """The run store's directory and what named it (``'--cache'``,
+    ``'TRILITH_CACHE'`` or ``'the default store'``), for messages; an empty
+    ``--cache`` is refused (it would silently mean the default store)."""
+    from compare.run.store import default_cache_dir, default_cache_source
+    cache = getattr(args, "cache", None)
+    if cache is not None:
+        if not cache.strip():
+            raise ValueError("--cache must name a directory, got an empty string")
+        return cache, "--cache"
+    return str(default_cache_dir()), default_cache_source()
 
 
 # --- engine settings files ---

@@ -58,9 +58,11 @@ def parse_engines(text: str) -> tuple[str, ...]:
     return parse_engine_list(text)
 
 
-def _check_budget(config) -> None:
+def _check_budget(config, loaded=None) -> None:
     """Refuse before any work an engine run over the run budget: the longest pulse
-    of the campaign (its lowest threshold frequency, or a labelled point's)."""
+    of the campaign (its lowest threshold frequency, or a labelled point's).  The
+    message names where the step came from: ``--dt``, the ``--settings`` file
+    (``loaded``) or the engine's calibrated step."""
     from analytic.excitation import Pulse
     from scenes import POINTS
 
@@ -70,7 +72,13 @@ def _check_budget(config) -> None:
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
     for name in config.engines:
         settings = backend_settings(name, config)
-        check_run_budget(name, settings, Pulse(1.0, omega), option="--dt")
+        if config.engine_dt is not None:
+            option = "--dt"
+        elif loaded is not None and "dt" in loaded.options(name):
+            option = f"--settings {loaded.path!r}"
+        else:
+            option = f"{name}'s calibrated step"
+        check_run_budget(name, settings, Pulse(1.0, omega), option=option)
 
 
 def _record_suite(spec: str | None) -> list:
@@ -109,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
                    engine_settings={} if loaded is None else
                    {k: v for k, v in loaded.tables.items() if k in engines})
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
-    _check_budget(config)
+    _check_budget(config, loaded)
     if args.dt is None:
         from compare.cli.options import step_notes
         sc = load_scene(config.scene)

@@ -300,7 +300,13 @@ def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
         settings = configure(name, **file_options(loaded, name))
         dt = args.dt if args.dt is not None else settings.dt
         finest = dt / 4 if args.convergence else dt
-        option = "--dt" + (" (with --convergence: dt/4)" if args.convergence else "")
+        if args.dt is not None:
+            option = "--dt"
+        elif "dt" in file_options(loaded, name):
+            option = f"--settings {loaded.path!r}"
+        else:
+            option = f"{name}'s calibrated step"
+        option += " (with --convergence: dt/4)" if args.convergence else ""
         check_run_budget(name, dataclasses.replace(settings, dt=finest),
                          pulse_of(shape, 1.0, float(min(omegas))), option=option)
 

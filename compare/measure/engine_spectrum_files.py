@@ -161,13 +161,12 @@ def summary_table(paths) -> str:
     points within the tolerance, the agreement region (every point up to the first
     frequency with a disagreeing point), what lies beyond, isolated overturns, runs
     and CPU seconds when computed (the searches / with the convergence reruns)."""
-    import json
-    from pathlib import Path
+    from compare.run.safe_read import read_json
     lines = ["| engine | agree within 2 % | region | beyond (error, primary causes) "
              "| isolated overturns | runs | CPU s (search / all) | CPU per simulated s |",
              "|---|---|---|---|---|---|---|---|"]
     for path in paths:
-        doc = json.loads(Path(path).read_text())
+        doc = read_json(path, f"spectrum file {str(path)!r}", schema_versions=(1,))
         lines += [_row(doc, engine) for engine in doc["engines"]]
     return "\n".join(lines)
 
@@ -175,15 +174,17 @@ def summary_table(paths) -> str:
 def main(argv=None) -> int:
     """``FILE.json ...``: print the summary table; ``--plot OUT.png FILE.json``:
     redraw a stored spectrum's figure."""
-    import json
     import sys
     from pathlib import Path
+
+    from compare.run.safe_read import read_json
     args = list(sys.argv[1:] if argv is None else argv)
     if args[:1] == ["--plot"]:
         out, source = args[1], args[2]
         from compare.run.atomic import atomic_path
+        doc = read_json(source, f"spectrum file {source!r}", schema_versions=(1,))
         with atomic_path(out, Path(out).suffix) as tmp:
-            plot_document(json.loads(Path(source).read_text()), tmp)
+            plot_document(doc, tmp)
         return 0
     print(summary_table(args))
     return 0

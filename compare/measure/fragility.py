@@ -26,7 +26,49 @@ import numpy as np
 from scipy import stats
 
 __all__ = ["FragilityFit", "fit_lognormal", "empirical_curve", "fragility",
-           "agreement"]
+           "agreement", "MAX_MOTIONS", "MAX_BOOT", "MAX_GRID"]
+
+# Sizes beyond which an argument is a mistake, not a suite: a record suite has
+# tens to hundreds of motions; 1e5 uncensored ones fit in about a second, and
+# 400 resamples of them in minutes.
+MAX_MOTIONS = 100_000
+MAX_BOOT = 100_000
+MAX_GRID = 100_000
+
+
+def _positive(value, name: str, infinite: bool = False) -> float:
+    """``value`` as a float > 0 (finite unless ``infinite``), else
+    TypeError/ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name} must be a number, got {value!r} ({type(value).__name__})")
+    value = float(value)
+    if not ((math.isfinite(value) or infinite and value == math.inf) and value > 0.0):
+        raise ValueError(f"{name} must be a {'' if infinite else 'finite '}number > 0, "
+                         f"got {value!r}")
+    return value
+
+
+def _intensities(im, name: str = "im", least: int = 1) -> np.ndarray:
+    """``im`` as a 1-D float array of intensities > 0 (``inf``: censored), with
+    ``least`` to :data:`MAX_MOTIONS` entries; TypeError/ValueError naming ``name``."""
+    if isinstance(im, (str, bytes)) or not hasattr(im, "__len__"):
+        raise TypeError(f"{name} must be a sequence of numbers, got {type(im).__name__}")
+    if len(im) > MAX_MOTIONS:
+        raise ValueError(f"{name} has {len(im)} values, more than {MAX_MOTIONS}")
+    try:
+        arr = np.asarray(im, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a sequence of numbers") from None
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be one-dimensional, got shape {arr.shape}")
+    if arr.size < least:
+        raise ValueError(f"{name} must hold at least {least} intensities (a fragility "
+                         f"curve needs two motions), got {arr.size}")
+    bad = np.flatnonzero(np.isnan(arr) | (arr <= 0.0) | (arr == -math.inf))
+    if bad.size:
+        raise ValueError(f"{name} must hold intensities > 0 (inf for a motion that never "
+                         f"overturned), got {float(arr[bad[0]])!r} at index {int(bad[0])}")
+    return arr
 
 
 @dataclass(frozen=True)
@@ -65,8 +107,13 @@ class FragilityFit:
 
 def fit_lognormal(im: np.ndarray, censored_at: float) -> tuple[float, float]:
     """``(median, beta)`` by maximum likelihood; ``inf`` entries of ``im`` are
-    right-censored at ``censored_at``.  NaNs when fewer than two are uncensored."""
-    im = np.asarray(im, dtype=float)
+    right-censored at ``censored_at``.  NaNs when fewer than two are uncensored.
+    ``ValueError``/``TypeError`` naming the argument for intensities that are
+    not > 0 (NaN included) or a ``censored_at`` that is not a finite number > 0."""
+    im = _intensities(im)
+    # inf: nothing was censored (a fit of complete data)
+    censored_at = _positive(censored_at, "censored_at",
+                            infinite=bool(np.all(np.isfinite(im))))
     seen = im[np.isfinite(im)]
     if seen.size < 2 or np.ptp(seen) == 0.0 and seen.size == im.size:
         return math.nan, math.nan
@@ -83,7 +130,7 @@ def fit_lognormal(im: np.ndarray, censored_at: float) -> tuple[float, float]:
 
 def empirical_curve(im: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(x, F)``: the steps of the empirical curve at the uncensored ``IM_i``."""
-    im = np.asarray(im, dtype=float)
+    im = _intensities(im)
     x = np.sort(im[np.isfinite(im)])
     return x, np.arange(1, x.size + 1) / im.size
 
@@ -101,11 +148,34 @@ def fragility(im, censored_at: float, grid=None, n_boot: int = 400, level: float
     grid : array, optional
         Intensities of the band (default: 60 points, geometric, over the data).
     n_boot, level, seed
-        Bootstrap resamples, band level, random seed (results are reproducible).
+        Bootstrap resamples (1 to :data:`MAX_BOOT`), band level in (0, 1),
+        random seed (an integer; results are reproducible).
+
+    Raises
+    ------
+    ValueError, TypeError
+        Naming the parameter and its allowed range: ``im`` with fewer than 2 or
+        more than :data:`MAX_MOTIONS` values or a value that is not > 0 (NaN
+        included; ``inf`` is a censored motion), ``censored_at`` not a finite
+        number > 0, ``grid`` not finite and > 0 or over :data:`MAX_GRID` points,
+        ``n_boot``, ``level`` or ``seed`` out of range.
     """
-    im = np.asarray(im, dtype=float)
-    if im.size < 1:
-        raise ValueError("fragility needs at least one ground motion")
+    im = _intensities(im, least=2)
+    censored_at = _positive(censored_at, "censored_at")
+    if isinstance(n_boot, bool) or not isinstance(n_boot, (int, np.integer)):
+        raise TypeError(f"n_boot must be an integer, got {n_boot!r}")
+    if not 1 <= n_boot <= MAX_BOOT:
+        raise ValueError(f"n_boot must be in [1, {MAX_BOOT}], got {n_boot}")
+    if isinstance(level, bool) or not isinstance(level, (int, float, np.floating)):
+        raise TypeError(f"level must be a number, got {level!r}")
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level must be in (0, 1), got {level!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"seed must be an integer, got {seed!r}")
+    if grid is not None:
+        grid = _intensities(grid, "grid")
+        if grid.size > MAX_GRID or not np.all(np.isfinite(grid)):
+            raise ValueError(f"grid must hold 1 to {MAX_GRID} finite intensities > 0")
     median, beta = fit_lognormal(im, censored_at)
     seen = im[np.isfinite(im)]
     if grid is None:

@@ -10,7 +10,6 @@ exactly that.  Update after a new atlas::
 """
 from __future__ import annotations
 
-import json
 import math
 import sys
 from collections import Counter
@@ -103,7 +102,12 @@ def main(argv: list[str] | None = None) -> int:
         print("usage: python -m compare.report.atlas_findings ATLAS.json FILE.md [FILE.md ...]",
               file=sys.stderr)
         return 2
-    doc = json.loads(Path(args[0]).read_text(encoding="utf-8"))
+    from compare.campaign.atlas_check import read_atlas
+    try:
+        doc = read_atlas(args[0], "atlas file")
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     for name in args[1:]:
         changed = update(Path(name), doc, ATLAS_BEGIN, ATLAS_END, render_atlas)
         print(f"{name}: atlas block {'updated' if changed else 'unchanged'}")

@@ -312,13 +312,17 @@ STYLE = ("body{font-family:sans-serif;margin:1em;max-width:1300px}img{max-width:
          "td,th{padding:2px 3px}}.nb{white-space:nowrap}")
 
 
-def write_page(doc: dict, path) -> Path:
-    """A standalone page of :func:`atlas_html`, written atomically."""
-    from compare.run import atomic
-    page = ("<!DOCTYPE html><html><head><meta charset='utf-8'><meta name='viewport' "
+def page_html(doc: dict) -> str:
+    """A standalone page of :func:`atlas_html`."""
+    return ("<!DOCTYPE html><html><head><meta charset='utf-8'><meta name='viewport' "
             "content='width=device-width, initial-scale=1'><title>trust atlas</title>"
             f"<style>{STYLE}</style></head><body>{atlas_html(doc, 1)}</body></html>\n")
-    atomic.write_text(path, page)
+
+
+def write_page(doc: dict, path) -> Path:
+    """:func:`page_html`, written atomically."""
+    from compare.run import atomic
+    atomic.write_text(path, page_html(doc))
     return Path(path)
 
 
@@ -329,12 +333,12 @@ def stored_atlas_section(path=None) -> str:
     """The report's atlas section from the stored atlas (``docs/validation/atlas.json``,
     measured by ``trilith atlas``, not by the report's own campaign); a line saying
     it is missing when there is none."""
-    import json
+    from compare.campaign.atlas_check import read_atlas
     p = Path(path) if path is not None else STORED
     if not p.is_file():
         return ("<h2 id='atlas'>Trust atlas</h2><p>No stored atlas "
                 f"(<code>{html.escape(str(p.name))}</code>); <code>trilith atlas --json "
                 "docs/validation/atlas.json</code> measures it (docs/atlas.md).</p>")
-    doc = json.loads(p.read_text(encoding="utf-8"))
+    doc = read_atlas(p, "stored atlas")
     return ("<p class='small'>From the stored atlas <code>docs/validation/atlas.json</code> "
             "(measured separately from this report's campaign).</p>" + atlas_html(doc, 2))

@@ -41,7 +41,7 @@ from compare.run import atomic
 from compare.run.jsonable import plain
 from scenes import load_scene
 
-__all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra",
+__all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra", "output_names",
            "plot_figure", "make_figures", "omega_grid", "quick_settings", "figure_size",
            "check_output_options", "plain_text", "QUICK_MARK", "shade_validity",
            "FORMATS", "DEFAULT_DPI"]
@@ -318,6 +318,11 @@ def _draw_figure(plt, spec: FigureSpec, spectra: dict, path: Path, dpi: int,
 
 
 # --- the whole run --------------------------------------------------------------------
+def output_names(fmt: str) -> list[str]:
+    """The files :func:`make_figures` writes into its folder (in ``fmt``)."""
+    return ["figures.json", *(f"{spec.name}.{fmt}" for spec in FIGURES)]
+
+
 def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
                  progress: bool = False, dpi: int = DEFAULT_DPI, fmt: str = "png") -> dict:
     """Compute every spectrum, write ``<fig>.<fmt>`` per figure and ``figures.json``.
@@ -355,7 +360,9 @@ def make_figures(out_dir, fs: FigureSettings | None = None, workers: int = 1,
     t0 = time.perf_counter()
     spectra = compute_spectra(fs, workers=workers, progress=progress)
     validity = {key: spectrum_validity(sp, workers=workers) for key, sp in spectra.items()}
-    out.mkdir(parents=True, exist_ok=True)
+    names = output_names(fmt)
+    atomic.check_into(out, names, "out_dir (--out)")  # a user's file is never overwritten
+    atomic.record_into(out, names)
     doc = {"quick": fs.quick, "settings": fs.describe(), "omega": omega_grid(fs).tolist(),
            "figures": {}, "dpi": dpi, "format": fmt}
     for spec in FIGURES:

@@ -16,7 +16,6 @@ Update after a new full campaign::
 """
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -139,7 +138,14 @@ def main(argv: list[str] | None = None) -> int:
         print("usage: python -m compare.report.findings SUMMARY.json README.md "
               "[docs/engine-trust.md]", file=sys.stderr)
         return 2
-    doc = json.loads(Path(args[0]).read_text(encoding="utf-8"))
+    from compare.campaign.summary import SCHEMA_VERSION
+    from compare.run.safe_read import read_json
+    try:
+        doc = read_json(args[0], f"summary file {args[0]!r}",
+                        schema_versions=range(1, SCHEMA_VERSION + 1))
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     changed = update(Path(args[1]), doc)
     print(f"{args[1]}: findings {'updated' if changed else 'unchanged'}")
     if len(args) == 3:

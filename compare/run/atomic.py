@@ -21,21 +21,34 @@ killed builds left (marked, or empty; never anything else).
 
 :func:`output_lock` takes ``fcntl.flock`` on ``<out>.lock``: a second process
 writing the same output fails at once with a one-line ``ValueError`` instead of
-racing.  The kernel drops the lock when its holder dies, even by SIGKILL.
+racing.  The kernel drops the lock when its holder dies, even by SIGKILL.  The
+lock file holds :data:`LOCK_TEXT` and is removed by its holder when it is done
+(a waiter that locked the removed file sees it is gone and takes the new one);
+a file of that name the tool did not write is locked but never removed.
+
+A rewritten file keeps the mode of the file it replaces (a 0640 output stays
+0640); a new one gets the ordinary 0666 less the umask.
 """
 from __future__ import annotations
 
 import contextlib
 import os
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 
 __all__ = ["write_text", "write_bytes", "savefig", "savetxt", "atomic_path",
-           "output_lock", "report_dir", "check_replaceable", "check_name_length", "MARKER"]
+           "output_lock", "report_dir", "check_replaceable", "check_name_length", "MARKER",
+           "MANIFEST", "check_into", "record_into"]
 
 # The file that marks a directory as written (and replaceable) by this tool.
 MARKER = ".trilith-output"
+# The list of files this tool wrote into a folder it shares with other files
+# (figures --out, bench --out): only those are ever rewritten there.
+MANIFEST = ".trilith-written"
+# The content of an output's lock file: what proves this tool wrote it.
+LOCK_TEXT = "trilith-xval output lock: removed when the output is written\n"
 # Bytes a temporary name adds to an output's name: '.' + '.tmp-' + 8 random ones
 # (tempfile), and a file's suffix on top; the lock file's '.lock' adds fewer.
 _TMP_EXTRA = len(".") + len(".tmp-") + 8
@@ -43,7 +56,8 @@ _TMP_EXTRA = len(".") + len(".tmp-") + 8
 # The exact file sets of report and campaign directories written before the
 # marker existed: replaced like marked ones (a folder of a user's holds other files).
 _UNMARKED_OUTPUTS = ({"index.html", "summary.json", "summary.md"},
-                     {"index.html", "campaign.json"})
+                     {"index.html", "campaign.json"},
+                     {"fragility.json", "fragility.csv", "fragility.png"})
 
 
 def check_name_length(path, option: str, suffix: str = "") -> None:
@@ -69,6 +83,9 @@ def check_replaceable(out, option: str = "--out") -> None:
     files an earlier report or campaign wrote before the marker existed; never
     the working directory or one of its ancestors, never a file."""
     out = Path(out)
+    if out.is_symlink():  # the swap would replace the link, not the folder it names
+        raise ValueError(f"{option} {str(out)!r} is a symbolic link (to "
+                         f"{os.readlink(out)!r}); name the directory itself")
     if out.exists() and not out.is_dir():
         raise ValueError(f"{option} must be a directory, got the file {str(out)!r}")
     here, target = Path.cwd().resolve(), out.resolve()
@@ -86,6 +103,50 @@ def check_replaceable(out, option: str = "--out") -> None:
             raise ValueError(f"{option} {str(out)!r} holds files this tool did not write "
                              f"(no {MARKER} inside) and is not replaced; choose a new or "
                              "empty directory")
+
+
+def _recorded(out: Path) -> set[str]:
+    try:
+        lines = (out / MANIFEST).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {line for line in lines if line and not line.startswith("#")}
+
+
+def check_into(out, names, option: str = "--out") -> None:
+    """``ValueError`` naming ``option`` unless every file of ``names`` is missing
+    from the folder ``out`` or recorded in its :data:`MANIFEST` (written there
+    by this tool before): a user's file of the same name is never overwritten."""
+    out = Path(out)
+    if out.is_symlink():
+        raise ValueError(f"{option} {str(out)!r} is a symbolic link (to "
+                         f"{os.readlink(out)!r}); name the directory itself")
+    if not out.is_dir():
+        return
+    ours = _recorded(out)
+    if not (out / MANIFEST).exists():
+        try:
+            present = {p.name for p in out.iterdir()}
+        except OSError as exc:
+            raise ValueError(f"{option} {str(out)!r}: {exc.strerror or exc}") from None
+        if present == set(names):  # exactly a whole output of a version before the manifest
+            return
+    for name in names:
+        target = out / name
+        if (target.exists() or target.is_symlink()) and name not in ours:
+            raise ValueError(f"{option} {str(out)!r}: {name} exists and this tool did not "
+                             f"write it (not in {MANIFEST}); move it or choose another "
+                             f"{option}")
+
+
+def record_into(out, names) -> None:
+    """Add ``names`` to the :data:`MANIFEST` of the folder ``out`` (created with its
+    parents), before the files are written: a killed run leaves them claimable."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = sorted(_recorded(out) | set(names))
+    write_text(out / MANIFEST, "# files written here by trilith-xval (rewritten by its next "
+               "run; nothing else here is touched)\n" + "\n".join(names) + "\n")
 
 
 def _remove_stale(out: Path) -> None:
@@ -116,7 +177,11 @@ def atomic_path(path, suffix: str = ""):
     os.close(fd)
     try:
         yield Path(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; outputs are ordinary files
+        try:  # a rewritten output keeps its mode; mkstemp made the new one 0600
+            mode = stat.S_IMODE(os.stat(path).st_mode)
+        except OSError:
+            mode = 0o666 & ~_umask()
+        os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException as exc:
         with contextlib.suppress(OSError):
@@ -157,26 +222,63 @@ def savetxt(path, data, **kwargs) -> None:
         np.savetxt(tmp, data, **kwargs)
 
 
+def _open_lock(lock: Path):
+    """The lock file, open; created with :data:`LOCK_TEXT` when missing."""
+    try:
+        fd = os.open(lock, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        os.write(fd, LOCK_TEXT.encode())
+        os.close(fd)
+    except FileExistsError:
+        pass
+    return open(lock, "a")
+
+
+def _ours(lock: Path) -> bool:
+    try:
+        return lock.is_file() and not lock.is_symlink() and lock.read_text() == LOCK_TEXT
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
 @contextlib.contextmanager
-def output_lock(path):
-    """Hold ``<path>.lock`` (flock) for the block; ``ValueError`` if another
-    process holds it.  The lock file stays (deleting it would race a waiter)."""
+def output_lock(path, option: str = "--out"):
+    """Hold ``<path>.lock`` (flock) for the block; ``ValueError`` naming ``option``
+    if another process holds it.  The lock file is removed at the end when this
+    tool wrote it (:data:`LOCK_TEXT`)."""
     import fcntl
 
     path = Path(path)
     lock = path.with_name(path.name + ".lock")
+    # Folders made for the lock are removed at the end when still empty: a
+    # refused or failed run leaves no new folder behind.
+    made = [p for p in (lock.parent, *lock.parent.parents) if not p.exists()]
     lock.parent.mkdir(parents=True, exist_ok=True)
-    fh = open(lock, "a")
-    try:
+    while True:
+        fh = _open_lock(lock)
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise ValueError(f"--out {str(path)!r} is being written by another process "
+            fh.close()
+            raise ValueError(f"{option} {str(path)!r} is being written by another process "
                              f"(lock {str(lock)!r} held); wait for it or choose another "
-                             "--out") from None
+                             f"{option}") from None
+        try:  # the holder before us may have removed the file we locked: retry
+            same = os.path.samestat(os.fstat(fh.fileno()), os.stat(lock))
+        except OSError:
+            same = False
+        if same:
+            break
+        fh.close()
+    try:
         yield lock
     finally:
+        if _ours(lock):  # removed while still locked: a waiter notices and retries
+            with contextlib.suppress(OSError):
+                os.unlink(lock)
         fh.close()
+        for folder in made:  # innermost first; only the empty ones go
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 @contextlib.contextmanager
@@ -192,8 +294,8 @@ def report_dir(out, lock: bool = True):
     out = Path(out)
     check_replaceable(out)
     parent = out.parent if str(out.parent) else Path(".")
-    parent.mkdir(parents=True, exist_ok=True)
     with output_lock(out) if lock else contextlib.nullcontext():
+        parent.mkdir(parents=True, exist_ok=True)  # the lock made it (and removes it)
         _remove_stale(Path(parent) / out.name)
         tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.tmp-", dir=parent))
         try:

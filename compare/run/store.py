@@ -17,74 +17,44 @@ else ``~/.cache/trilith-xval``; when none of those can be created (a CI job with
 an unusual ``HOME``) ``<tmp>/trilith-xval-<uid>``.  One file, ``runs.sqlite``.
 The directory is created (mode 0700) only when a first result is stored, and
 refused when another user owns it or others may write in it (a planted store).
-A store that SQLite cannot read is refused with one line naming the file; a
-full disk under the store is reported once on stderr and the results are still
-returned, just not kept.
+The file must be this tool's (:mod:`compare.run.store_db`: a marker in the SQLite
+header, checked through a read-only connection first): any other file called
+``runs.sqlite`` is refused in one line and never written, pruned or deleted.
+Every entry carries a digest of its key and value, checked on every read: an
+entry that fails it is named in one line on stderr and recomputed, never served
+(``trilith cache verify`` checks a whole store).  A store SQLite cannot read is
+refused with one line naming the file.  A store that cannot be written (a
+read-only filesystem or directory) is used read-only: its proven entries are
+served and nothing is stored; a full disk, or a store that cannot grow, is
+reported once on stderr and the results are still returned, just not kept.
 
 Concurrency: WAL journal (readers never block the writer), every write one
-autocommitted insert that keeps a readable existing value (a SIGKILL loses at most the transaction in
-flight; SQLite rolls it back on the next open), and ``busy_timeout`` so
+autocommitted insert that keeps a proven existing value (a SIGKILL loses at most
+the transaction in flight; SQLite rolls it back on the next open), and
+``busy_timeout`` so
 processes sharing a store wait for each other's lock instead of failing.
 """
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
-import stat
 import sqlite3
 import sys
-import tempfile
 import time
 from pathlib import Path
 
+from compare.run import store_db
+from compare.run.store_db import default_cache_dir, default_cache_source
 from compare.run.codec import MAGIC, ForeignValue, decode, encode
+from compare.run.store_figures import StoreFigures
 
-__all__ = ["RunStore", "default_cache_dir", "DB_NAME"]
+__all__ = ["RunStore", "default_cache_dir", "default_cache_source", "DB_NAME"]
 
 DB_NAME = "runs.sqlite"
 # Waiting for another process's write lock: writes take ~1 ms, so 60 s means a
 # stuck peer, not contention.
 BUSY_TIMEOUT_MS = 60_000
-_SCHEMA = ("CREATE TABLE IF NOT EXISTS runs (key TEXT PRIMARY KEY, kind TEXT NOT NULL, "
-           "label TEXT NOT NULL, cost REAL NOT NULL, created REAL NOT NULL, "
-           "value BLOB NOT NULL, code TEXT NOT NULL DEFAULT '')")
-_COLUMNS = {"key", "kind", "label", "cost", "created", "value", "code"}
-
-
-def default_cache_dir(environ=None) -> Path:
-    """The store's directory when ``--cache`` is not given (see the module doc)."""
-    env = os.environ if environ is None else environ
-    if env.get("TRILITH_CACHE"):
-        return Path(env["TRILITH_CACHE"]).expanduser()
-    candidates = []
-    xdg = env.get("XDG_CACHE_HOME", "")
-    if xdg and os.path.isabs(xdg):
-        candidates.append(Path(xdg) / "trilith-xval")
-    home = env.get("HOME") or os.path.expanduser("~")
-    if home and home != "~" and os.path.isabs(home):
-        candidates.append(Path(home) / ".cache" / "trilith-xval")
-    for path in candidates:  # not created here: only a stored result creates it
-        if _creatable(path):
-            return path
-    uid = os.getuid() if hasattr(os, "getuid") else "user"
-    return Path(tempfile.gettempdir()) / f"trilith-xval-{uid}"
-
-
-def _creatable(path: Path) -> bool:
-    """``path`` is a writable directory, or its nearest existing ancestor is one."""
-    return _not_creatable(path) is None
-
-
-def _not_creatable(path: Path) -> str | None:
-    """Why ``path`` cannot be created (or written in), or None."""
-    for p in (path, *path.parents):
-        if p.exists():
-            if not p.is_dir():
-                return f"{str(p)!r} is not a directory"
-            if not os.access(p, os.W_OK | os.X_OK):
-                return f"{str(p)!r} is not writable"
-            return None
-    return "no existing parent directory"
 
 
 # -------------------------------------------------------------------------- store
@@ -96,7 +66,7 @@ def _is_full(exc: sqlite3.DatabaseError) -> bool:
     return getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL
 
 
-class RunStore:
+class RunStore(StoreFigures):
     """A directory holding ``runs.sqlite``; safe to share between processes.
 
     Parameters
@@ -105,10 +75,13 @@ class RunStore:
         Checked now, created (mode 0700) when the first result is stored.
         ``ValueError`` (one line) if it is not a directory, cannot be created,
         is owned by another user or writable by others, or if its
-        ``runs.sqlite`` is not a readable run store.
+        ``runs.sqlite`` is not this tool's store or not readable.
     check_database : bool
         Open and check ``runs.sqlite`` now (default); False leaves that to the
         first use (:meth:`clear` of a damaged store).
+    source : str
+        Where ``directory`` came from, for messages: ``'--cache'`` (default),
+        ``'TRILITH_CACHE'`` or ``'the default store'``.
 
     Examples
     --------
@@ -119,12 +92,17 @@ class RunStore:
     {'x': 1.5}
     """
 
-    def __init__(self, directory, *, check_database: bool = True) -> None:
+    def __init__(self, directory, *, check_database: bool = True,
+                 source: str = "--cache") -> None:
         self.directory = Path(directory).expanduser()
         self.path = self.directory / DB_NAME
+        self.source = source
+        self.readonly = False
+        self._legacy = False
+        self._readonly_why = "it is read-only"
         self._conn = None
         self._pid = None
-        self._full_reported = False
+        self._warned: set[str] = set()
         self._check_directory()
         if check_database and self.path.exists():
             try:
@@ -133,74 +111,91 @@ class RunStore:
                 self._report_full()
 
     def __getstate__(self):  # a connection does not cross processes: reopen there
-        return {"directory": self.directory}
+        return {"directory": self.directory, "source": self.source}
 
     def __setstate__(self, state):
-        self.__init__(state["directory"])
+        self.__init__(state["directory"], source=state.get("source", "--cache"))
 
     def __repr__(self) -> str:
         return f"RunStore({str(self.directory)!r})"
 
     # ------------------------------------------------------------- opening
+    @property
+    def _where(self) -> str:
+        if self.source.startswith("-"):
+            return f"{self.source} {str(self.directory)!r}"
+        return f"{self.source} ({str(self.directory)!r})"
+
     def _check_directory(self) -> None:
-        where = f"--cache {str(self.directory)!r}"
-        if not self.directory.exists():
-            why = _not_creatable(self.directory)
-            if why is not None:
-                raise ValueError(f"{where}: cannot create the store directory ({why})")
-            return
-        try:
-            st = self.directory.stat()
-        except OSError as exc:
-            raise ValueError(f"{where}: {exc.strerror or exc}") from None
-        if not stat.S_ISDIR(st.st_mode):
-            raise ValueError(f"{where} is not a directory")
-        if hasattr(os, "getuid") and st.st_uid != os.getuid():
-            raise ValueError(f"{where} belongs to another user (uid {st.st_uid}); a run "
-                             "store must be your own: choose another --cache")
-        if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-            raise ValueError(f"{where} is writable by other users (mode "
-                             f"{stat.S_IMODE(st.st_mode):o}); 'chmod go-w' it or choose "
-                             "another --cache")
+        store_db.check_directory(self.directory, self._where)
+
+    @property
+    def _other(self) -> str:
+        """The advice on where else to keep results, naming what chose this store."""
+        if self.source == "TRILITH_CACHE":
+            return "another --cache, or set TRILITH_CACHE to another directory"
+        return "another --cache"
 
     def _damaged(self, exc: Exception) -> ValueError:
-        return ValueError(f"run store {str(self.path)!r} is not usable ({exc}); remove it "
-                          f"with 'trilith cache clear --cache {self.directory}' or choose "
-                          "another --cache")
+        # Only a file proven ours (its header's marker) is one 'cache clear' removes.
+        cure = (f"remove it with 'trilith cache clear --cache {self.directory}'"
+                if store_db.header_is_ours(self.path) else "move it away")
+        return ValueError(f"run store {str(self.path)!r} is not usable ({exc}); {cure} or "
+                          f"choose {self._other}")
+
+    def _foreign(self, exc: Exception) -> ValueError:
+        return ValueError(f"{self._where}: its {DB_NAME} is not a trilith-xval run store "
+                          f"({exc}); it is left untouched: choose {self._other}")
+
+    def _identify(self) -> str:
+        try:
+            return store_db.identify(self.path, BUSY_TIMEOUT_MS / 1000)
+        except store_db.NotAStore as exc:
+            raise self._foreign(exc) from None
+        except store_db.Damaged as exc:
+            raise self._damaged(exc) from None
+
+    def _writable(self) -> bool:
+        return (os.access(self.directory, os.W_OK | os.X_OK)
+                and os.access(self.path, os.W_OK))
 
     def _connect(self, create: bool = False) -> sqlite3.Connection | None:
         """The connection (reopened in a forked child); None when the store does
-        not exist yet and ``create`` is false."""
+        not exist yet and ``create`` is false or it cannot be created."""
         if self._conn is not None and self._pid == os.getpid():
             return self._conn
-        if not self.path.exists():
+        if not self.path.exists() and not self.path.is_symlink():
             if not create:
                 return None
-            try:
-                self.directory.mkdir(mode=0o700, parents=True, exist_ok=True)
-            except OSError as exc:
-                raise ValueError(f"--cache: cannot create the store directory "
-                                 f"{str(self.directory)!r} ({exc.strerror})") from None
-            self._check_directory()
+            if not self._create():
+                return None
         elif not self.path.is_file():
-            raise self._damaged("not a regular file")
+            raise self._foreign("not a regular file")
+        kind = self._identify()
+        timeout = BUSY_TIMEOUT_MS / 1000
         # A forked child must not touch its parent's connection: open its own.
         conn = None
         try:
-            conn = sqlite3.connect(self.path, timeout=BUSY_TIMEOUT_MS / 1000,
-                                   isolation_level=None, check_same_thread=False)
-            conn.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
-            if conn.execute("PRAGMA journal_mode").fetchone()[0] != "wal":
-                conn.execute("PRAGMA journal_mode=WAL")
-            # WAL + NORMAL: a commit survives a killed process (not a power cut).
-            conn.execute("PRAGMA synchronous=NORMAL")
-            conn.execute(_SCHEMA)
-            columns = {row[1] for row in conn.execute("PRAGMA table_info(runs)")}
-            if columns == _COLUMNS - {"code"}:  # a store from before code versions
-                conn.execute("ALTER TABLE runs ADD COLUMN code TEXT NOT NULL DEFAULT ''")
-            elif columns != _COLUMNS:
-                raise sqlite3.DatabaseError(f"its 'runs' table has the columns "
-                                            f"{sorted(columns)}, not a run store's")
+            if self._writable():
+                try:
+                    conn = store_db.open_rw(self.path, timeout)
+                    conn.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
+                    # WAL + NORMAL: a commit survives a killed process (not a power cut).
+                    conn.execute("PRAGMA synchronous=NORMAL")
+                    if kind == "legacy":
+                        store_db.migrate(conn)
+                        kind = "current"
+                except sqlite3.OperationalError as exc:
+                    if _is_full(exc):
+                        raise
+                    if conn is not None:  # e.g. a file size limit: read what is there
+                        conn.close()
+                    conn, self._readonly_why = None, f"it cannot be written ({exc})"
+            if conn is None:
+                conn = store_db.open_ro(self.path, timeout)
+                conn.execute(f"PRAGMA busy_timeout={BUSY_TIMEOUT_MS}")
+                self.readonly = True
+            self._legacy = kind == "legacy"  # read-only and never migrated: serve nothing
         except sqlite3.DatabaseError as exc:
             if conn is not None:
                 conn.close()
@@ -210,11 +205,38 @@ class RunStore:
         self._conn, self._pid = conn, os.getpid()
         return conn
 
+    def _create(self) -> bool:
+        """Create the directory and a marked database; False (reported once) when
+        the filesystem does not let us."""
+        try:
+            self.directory.mkdir(mode=0o700, parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"{self._where}: cannot create the store directory "
+                             f"({exc.strerror})") from None
+        self._check_directory()
+        try:
+            store_db.create(self.path)
+        except sqlite3.DatabaseError as exc:
+            if _is_full(exc):
+                raise _DiskFull from None
+            self._warn("created", f"cannot be created ({exc})")
+            return False
+        except OSError as exc:
+            if exc.errno == errno.ENOSPC:
+                raise _DiskFull from None
+            self._warn("created", f"cannot be created ({exc.strerror or exc})")
+            return False
+        return True
+
+    def _warn(self, what: str, text: str) -> None:
+        """One line on stderr per kind of trouble, never more."""
+        if what not in self._warned:
+            self._warned.add(what)
+            print(f"warning: run store {self.directory}: {text}; results are computed "
+                  "but not stored", file=sys.stderr)
+
     def _report_full(self) -> None:
-        if not self._full_reported:
-            self._full_reported = True
-            print(f"warning: run store {self.directory}: the disk is full; results are "
-                  "computed but not stored", file=sys.stderr)
+        self._warn("full", "the disk is full")
 
     def _query(self, sql: str, args=()) -> list:
         try:
@@ -241,19 +263,33 @@ class RunStore:
 
     # ------------------------------------------------------------ values
     def get(self, key: str):
-        """The stored value under ``key``, or None (also for a value this format
-        did not write: it is never interpreted, and replaced by the next put)."""
-        rows = self._query("SELECT value FROM runs WHERE key = ?", (key,))
+        """The stored value under ``key``, or None: also for an entry whose digest
+        does not match its key and value (named on stderr), one without a digest
+        (an older store) and a value this format did not write; none of them is
+        served, and the next :meth:`put` replaces it."""
+        if self._connect() is not None and self._legacy:
+            return None
+        rows = self._query("SELECT value, digest FROM runs WHERE key = ?", (key,))
         if not rows:
             return None
+        blob, stored = rows[0]
+        if not isinstance(blob, bytes) or stored != store_db.entry_digest(key, blob):
+            # Once per entry (a lookup may precede the computation); an entry
+            # without a digest is an older store's: silently redone.
+            if stored and f"digest {key}" not in self._warned:
+                self._warned.add(f"digest {key}")
+                print(f"warning: run store {str(self.path)!r}: entry {key[:16]} fails its "
+                      "digest check (changed after it was written); recomputed",
+                      file=sys.stderr)
+            return None
         try:
-            return decode(rows[0][0])
+            return decode(blob)
         except ForeignValue:
             return None
 
     def put(self, key: str, value, *, kind: str, label: str, cost: float,
             code: str = "") -> None:
-        """Store ``value`` unless ``key`` holds a readable value already (same key:
+        """Store ``value`` unless ``key`` holds a proven value already (same key:
         same result).  ``code``: the :func:`~compare.run.keys.code_version` of the key.
         A value the format cannot hold is not stored (one warning): the caller
         still has its result."""
@@ -267,51 +303,32 @@ class RunStore:
 
     def put_blob(self, key: str, blob: bytes, *, kind: str, label: str, cost: float,
                  code: str = "") -> None:
+        """Store raw bytes under ``key`` with their digest (see :meth:`put`).  Never
+        raises for the database: a store that cannot take the entry (full, cannot
+        grow, read-only, damaged) is reported once and the run goes on."""
         try:
             conn = self._connect(create=True)
+            if conn is None:
+                return
+            if self.readonly:
+                self._warn("readonly", self._readonly_why)
+                return
             conn.execute(
-                "INSERT INTO runs (key, kind, label, cost, created, value, code) "
-                "VALUES (?, ?, ?, ?, ?, ?, ?) ON CONFLICT(key) DO UPDATE SET "
+                "INSERT INTO runs (key, kind, label, cost, created, value, code, digest) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?, ?) ON CONFLICT(key) DO UPDATE SET "
                 "kind = excluded.kind, label = excluded.label, cost = excluded.cost, "
-                "created = excluded.created, value = excluded.value, code = excluded.code "
-                "WHERE substr(runs.value, 1, ?) != ?",
-                (key, kind, label, float(cost), time.time(), blob, code, len(MAGIC), MAGIC))
+                "created = excluded.created, value = excluded.value, code = excluded.code, "
+                "digest = excluded.digest WHERE substr(runs.value, 1, ?) != ? "
+                "OR runs.digest IS NOT trilith_digest(runs.key, runs.value)",
+                (key, kind, label, float(cost), time.time(), blob, code,
+                 store_db.entry_digest(key, blob), len(MAGIC), MAGIC))
         except _DiskFull:
             self._report_full()
         except sqlite3.DatabaseError as exc:
-            if not _is_full(exc):
-                raise self._damaged(exc) from None
-            self._report_full()
-
-    # ------------------------------------------------------------- figures
-    def count(self, kind: str | None = None, since: float | None = None) -> int:
-        """Entries (of ``kind``; created at or after ``since``, a ``time.time()``)."""
-        sql, args = "SELECT COUNT(*) FROM runs WHERE 1", []
-        if kind is not None:
-            sql, args = sql + " AND kind = ?", [*args, kind]
-        if since is not None:
-            sql, args = sql + " AND created >= ?", [*args, since]
-        rows = self._query(sql, args)
-        return int(rows[0][0]) if rows else 0
-
-    def created(self) -> dict[str, float]:
-        """Key -> creation time of every entry (tests: nothing was rewritten)."""
-        return dict(self._query("SELECT key, created FROM runs"))
-
-    def mean_costs(self, kind: str = "run") -> dict[str, tuple[float, int]]:
-        """Label -> (mean cost [s], count) over the stored entries of ``kind``."""
-        rows = self._query("SELECT label, AVG(cost), COUNT(*) FROM runs WHERE kind = ? "
-                           "GROUP BY label", (kind,))
-        return {label: (float(mean), int(n)) for label, mean, n in rows}
-
-    def by_code(self) -> list[tuple[str, int, int]]:
-        """``(code version, entries, value bytes)`` per code version; entries this
-        format did not write (old pickles) are grouped under ``'foreign'``."""
-        rows = self._query(
-            "SELECT CASE WHEN substr(value, 1, ?) = ? THEN code ELSE 'foreign' END AS c, "
-            "COUNT(*), SUM(length(value)) FROM runs GROUP BY c ORDER BY c",
-            (len(MAGIC), MAGIC))
-        return [(code or "unknown", int(n), int(size or 0)) for code, n, size in rows]
+            if _is_full(exc):
+                self._report_full()
+            else:  # cannot grow (a file size limit), I/O error, damage
+                self._warn("write", f"cannot store a result ({exc})")
 
     def files(self) -> list[Path]:
         """The store's files that exist (the database, its WAL and shared memory)."""
@@ -319,26 +336,41 @@ class RunStore:
                             self.path.with_name(DB_NAME + "-shm")) if p.exists()]
 
     def prune(self, keep: set[str]) -> int:
-        """Delete entries whose code version is not in ``keep`` (and foreign ones);
-        returns how many, and gives the space back to the filesystem."""
+        """Delete entries whose code version is not in ``keep``, foreign ones and
+        any that fail their digest; returns how many, and gives the space back to
+        the filesystem."""
         if self._connect() is None:
             return 0
+        if self.readonly:
+            raise ValueError(f"{self._where}: the store is read-only; nothing pruned")
         marks = ",".join("?" * len(keep)) or "''"
         before = self.count()
         self._query(f"DELETE FROM runs WHERE code NOT IN ({marks}) "
-                    "OR substr(value, 1, ?) != ?", (*sorted(keep), len(MAGIC), MAGIC))
+                    "OR substr(value, 1, ?) != ? "
+                    "OR digest IS NOT trilith_digest(key, value)",
+                    (*sorted(keep), len(MAGIC), MAGIC))
         self._query("VACUUM")
         return before - self.count()
 
     def clear(self) -> int:
         """Delete the store's files (nothing else in the directory); returns the
-        number of entries there were when readable, else -1."""
-        try:
-            n = self.count()
-        except ValueError:  # damaged: clearing is the cure
-            n = -1
+        number of entries there were when readable, else -1.  ``ValueError`` when
+        ``runs.sqlite`` is not this tool's: then nothing is deleted."""
+        n = -1
+        if self.path.exists() or self.path.is_symlink():
+            if self.path.is_symlink() or not self.path.is_file():
+                raise self._foreign("not a regular file")
+            try:
+                self._identify()
+                n = self.count()
+            except ValueError:
+                if not store_db.header_is_ours(self.path):  # foreign: left untouched
+                    raise
         self.close()
-        for p in self.files():
+        if self.files() and not os.access(self.directory, os.W_OK | os.X_OK):
+            raise ValueError(f"{self._where}: the store's directory is read-only; "
+                             "nothing cleared")
+        for p in (*self.files(), *store_db.stale_temporaries(self.directory, DB_NAME)):
             p.unlink()
         with contextlib.suppress(OSError):
             self.directory.rmdir()  # only when empty: the directory may hold user files

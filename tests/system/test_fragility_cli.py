@@ -56,7 +56,7 @@ def test_fragility_writes_consistent_outputs_and_resumes(tmp_path, capsys):
     (["--im-range", "5"], "error: --im-range expects LO:HI"),
     (["--im-range", "1g:x"], "error: --im-range"),
     (["--engine", "bullet"], "error: --engine: unknown engine 'bullet'"),
-    (["--rel-step", "0"], "error: rel_step must be in")])
+    (["--rel-step", "0"], "error: --rel-step must be in")])
 def test_bad_input_is_one_line(tmp_path, capsys, extra, message):
     suite = write_suite(tmp_path / "suite", n=1)
     argv = ["fragility", "--records", str(suite), "--out", str(tmp_path / "o"), "--no-cache",

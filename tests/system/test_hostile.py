@@ -24,30 +24,9 @@ from compare.cli.main import main
 from compare.run import atomic, runs
 from compare.run.store import DB_NAME, RunStore
 
+from tests.support.hostile import refused, snapshot
 from tests.support.paths import ROOT
 TRILITH = [sys.executable, "-m", "compare.cli.main"]
-
-
-def snapshot(directory: Path) -> dict:
-    """Every file and directory under ``directory`` with its bytes (files) and mode."""
-    out = {}
-    for p in sorted(directory.rglob("*")):
-        st = p.lstat()
-        out[str(p.relative_to(directory))] = (st.st_mode, p.read_bytes() if p.is_file() else None)
-    return out
-
-
-def refused(argv, capsys, needle: str) -> None:
-    """``trilith ARGV`` exits 2 with one ``error:`` line containing ``needle``."""
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse's own errors
-        code = exc.code
-    err = capsys.readouterr().err
-    lines = err.splitlines()
-    assert code == 2, err
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: ") and needle in lines[0], lines[0]
 
 
 @pytest.fixture
@@ -139,10 +118,30 @@ def test_record_with_bom_keeps_its_first_sample(here, capsys):
     (["report", "--quick", "--dt", "1e-5", "--out", "r"], "--dt: a pybullet run"),
     (["calibrate", "--engine", "pymunk", "--dt", "1e-9"], "--dt: a pymunk run"),
     (["calibrate", "--engine", "pymunk", "--dt", "-1"], "each step must be in (0, 0.1] s"),
+    (["calibrate", "--engine", "pymunk", "--omega", ""], "--omega must be a comma-separated"),
+    (["calibrate", "--engine", "pymunk", "--tolerance", "5"], "--tolerance must be in (0, 1]"),
+    (["fragility", "--records", "sample", "--rel-step", "50"], "--rel-step must be in (0, 10]"),
+    (["fragility", "--records", "sample", "--tail", "1000"], "--tail must be in (0, 600]"),
+    (["fragility", "--records", "sample", "--rtol", "0.5", "--rel-step", "0.2"],
+     "--rtol (0.5) must be below --rel-step"),
+    (["spectrum", "--omega", "10", "--cache", ""], "--cache must name a directory"),
 ])
 def test_option_refused_in_one_line(argv, needle, here, capsys):
     before = snapshot(here)
     refused(argv, capsys, needle)
+    assert snapshot(here) == before
+
+
+@pytest.mark.parametrize("argv, step", [
+    (["calibrate", "--engine", "pymunk"], "0.09"),
+    (["report", "--quick", "--engine", "pymunk", "--out", "r"], "1e-7"),
+    (["spectrum", "--engine", "pymunk", "--omega", "10"], "1e-7"),
+])
+def test_a_step_from_a_settings_file_is_blamed_on_the_file(argv, step, here, capsys):
+    (here / "s.toml").write_text(f"[pymunk]\ndt = {step}\n")
+    before = snapshot(here)
+    line = refused([*argv, "--settings", "s.toml"], capsys, "--settings 's.toml'")
+    assert "--dt" not in line
     assert snapshot(here) == before
 
 

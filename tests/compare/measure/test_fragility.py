@@ -62,3 +62,57 @@ def test_agreement():
     ag = agreement(a, b)
     assert ag["median_ratio"] == pytest.approx(2.0, rel=1e-9)  # the MLE median scales
     assert ag["max_distance_empirical"] > 0.5
+
+
+# ------------------------------------------------------------ argument checks
+@pytest.mark.parametrize("im, exc, needle", [
+    ([1.0, float("nan"), 2.0], ValueError, "im must hold intensities > 0.*nan at index 1"),
+    ([1.0, -2.0, 3.0], ValueError, "im must hold intensities > 0.*-2.0 at index 1"),
+    ([0.0, 1.0], ValueError, "im must hold intensities > 0"),
+    ([1.5], ValueError, "im must hold at least 2"),
+    ([], ValueError, "im must hold at least 2"),
+    ("12", TypeError, "im must be a sequence"),
+    ([[1.0, 2.0]], ValueError, "im must be one-dimensional"),
+    (["a", "b"], TypeError, "im must be a sequence of numbers"),
+])
+def test_fragility_refuses_bad_intensities(im, exc, needle):
+    with pytest.raises(exc, match=needle):
+        fragility(im, censored_at=10.0, n_boot=1)
+
+
+@pytest.mark.parametrize("kwargs, exc, needle", [
+    ({"censored_at": -1.0}, ValueError, "censored_at must be a finite number > 0"),
+    ({"censored_at": 0.0}, ValueError, "censored_at must be a finite number > 0"),
+    ({"censored_at": float("nan")}, ValueError, "censored_at"),
+    ({"censored_at": "10"}, TypeError, "censored_at must be a number"),
+    ({"n_boot": -5}, ValueError, r"n_boot must be in \[1, 100000\]"),
+    ({"n_boot": 0}, ValueError, "n_boot must be in"),
+    ({"n_boot": 2.5}, TypeError, "n_boot must be an integer"),
+    ({"level": 1.5}, ValueError, r"level must be in \(0, 1\)"),
+    ({"seed": "x"}, TypeError, "seed must be an integer"),
+    ({"grid": [1.0, float("inf")]}, ValueError, "grid must hold"),
+])
+def test_fragility_refuses_bad_settings(kwargs, exc, needle):
+    args = {"censored_at": 10.0, "n_boot": 2, **kwargs}
+    with pytest.raises(exc, match=needle):
+        fragility([1.0, 2.0, math.inf], **args)
+
+
+def test_sizes_are_capped_before_any_work():
+    import time
+
+    from analytic.spectrum import overturning_spectrum
+    from scenes import load_scene
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="im has 10000000 values, more than 100000"):
+        fragility(np.ones(10_000_000), censored_at=10.0)
+    with pytest.raises(ValueError, match="omegas has 1000000 frequencies, more than"):
+        overturning_spectrum(load_scene("fig5"), np.linspace(1.0, 20.0, 1_000_000))
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_fit_lognormal_and_empirical_curve_check_their_input():
+    with pytest.raises(ValueError, match="censored_at"):
+        fit_lognormal([1.0, 2.0], censored_at=-1.0)
+    with pytest.raises(ValueError, match="im must hold intensities > 0"):
+        empirical_curve([1.0, float("nan")])

@@ -96,8 +96,11 @@ def test_default_cache_dir(tmp_path):
 
 def test_not_a_store_is_a_clear_error(tmp_path):
     (tmp_path / "runs.sqlite").write_bytes(b"not sqlite" * 100)
-    with pytest.raises(ValueError, match="is not usable.*trilith cache clear"):
+    with pytest.raises(ValueError, match="not a trilith-xval run store.*left untouched"):
         RunStore(tmp_path)
+    with pytest.raises(ValueError, match="left untouched"):  # not proven ours: kept
+        RunStore(tmp_path, check_database=False).clear()
+    assert (tmp_path / "runs.sqlite").read_bytes() == b"not sqlite" * 100
     (tmp_path / "file").write_text("")
     with pytest.raises(ValueError, match="cannot create"):
         RunStore(tmp_path / "file" / "sub")
