@@ -125,3 +125,25 @@ def test_select_engines_keeps_their_rows_and_rejoins_whole():
     assert sorted(map(str, joined["cost"])) == sorted(map(str, stored["cost"]))
     with pytest.raises(ValueError, match="not in the atlas: nosuch"):
         select_engines(stored, ["nosuch"])
+
+
+def test_atlas_diff_counts_cause_changes_per_engine_and_step():
+    import copy
+    import json
+    from pathlib import Path
+
+    from compare.report.atlas_diff import cause_changes, markdown
+    old = json.loads((Path(__file__).parents[3] / "docs/validation/atlas.json").read_text())
+    new = copy.deepcopy(old)
+    engine = next(iter(new["steps"]))
+    dt = new["steps"][engine][1]
+    changed = 0
+    for pt in new["points"]:
+        for row in pt["engines"][engine]:
+            if abs(row["dt"] - dt) < 1e-12 and row["cause"] != "agrees" and changed < 3:
+                row["cause"] = "discretisation"
+                changed += 1
+    rows = {(r["engine"], r["dt"]): r for r in cause_changes(old, new, [engine])}
+    assert rows[(engine, round(dt, 12))]["changed"] == changed > 0
+    assert sum(r["changed"] for r in rows.values()) == changed
+    assert "-> discretisation" in markdown(list(rows.values()))
