@@ -34,7 +34,7 @@ def read_toml(path: Path, what: str) -> dict:
     (``what``: 'scene file', 'campaign file') when it is not a regular file, cannot
     be read, is over :data:`MAX_FILE_BYTES`, is not UTF-8 or not TOML (nesting too
     deep included)."""
-    from compare.run.safe_read import read_bytes
+    from scenes.safe_read import read_bytes
     where = f"{what} {str(path)!r}"
     data = read_bytes(path, where, MAX_FILE_BYTES)
     try:

@@ -42,7 +42,7 @@ _OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
 
 
 def _open_text(path: Path, where: str) -> list[str]:
-    from compare.run.safe_read import read_text
+    from scenes.safe_read import read_text
     if path.is_dir():
         raise ValueError(f"{where}: {str(path)!r} is a directory, not a record file")
     # A BOM is not data (read_text drops it); devices and FIFOs are refused unread.

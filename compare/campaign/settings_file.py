@@ -73,7 +73,7 @@ def read_settings_file(path) -> SettingsFile:
         per run (:data:`RUN_FIELDS`) or a value the engine refuses; the message
         starts with the file's name.
     """
-    from compare.run.safe_read import read_bytes
+    from scenes.safe_read import read_bytes
     p = Path(path)
     where = f"settings file {str(p)!r}"
     data = read_bytes(p, where, MAX_BYTES)

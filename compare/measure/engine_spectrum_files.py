@@ -161,7 +161,7 @@ def summary_table(paths) -> str:
     points within the tolerance, the agreement region (every point up to the first
     frequency with a disagreeing point), what lies beyond, isolated overturns, runs
     and CPU seconds when computed (the searches / with the convergence reruns)."""
-    from compare.run.safe_read import read_json
+    from scenes.safe_read import read_json
     lines = ["| engine | agree within 2 % | region | beyond (error, primary causes) "
              "| isolated overturns | runs | CPU s (search / all) | CPU per simulated s |",
              "|---|---|---|---|---|---|---|---|"]
@@ -177,7 +177,7 @@ def main(argv=None) -> int:
     import sys
     from pathlib import Path
 
-    from compare.run.safe_read import read_json
+    from scenes.safe_read import read_json
     args = list(sys.argv[1:] if argv is None else argv)
     if args[:1] == ["--plot"]:
         out, source = args[1], args[2]

@@ -57,6 +57,6 @@ def markdown(rows: list[dict]) -> str:
 
 
 if __name__ == "__main__":
-    from compare.run.safe_read import read_json
+    from scenes.safe_read import read_json
     old_doc, new_doc = (read_json(p, p) for p in sys.argv[1:3])
     print(markdown(cause_changes(old_doc, new_doc, sys.argv[3:] or None)))

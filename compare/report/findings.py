@@ -139,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
               "[docs/engine-trust.md]", file=sys.stderr)
         return 2
     from compare.campaign.summary import SCHEMA_VERSION
-    from compare.run.safe_read import read_json
+    from scenes.safe_read import read_json
     try:
         doc = read_json(args[0], f"summary file {args[0]!r}",
                         schema_versions=range(1, SCHEMA_VERSION + 1))

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from compare.campaign import summary
-from compare.run.safe_read import read_json
+from scenes.safe_read import read_json
 from scenes import load_record, read_toml
 
 from tests.support.hostile import refused, snapshot
