@@ -30,7 +30,8 @@ import importlib
 from functools import lru_cache
 
 __all__ = ["BACKENDS", "ENGINES", "ENGINE_CLASSES", "ENTRY_POINT_GROUP", "get_backend",
-           "simulate", "backend_names", "engine_names", "configure", "supports", "engine_list"]
+           "simulate", "backend_names", "engine_names", "default_engines", "configure",
+           "supports", "engine_list"]
 
 # The physics engines under validation: name -> "module:Class".
 ENGINE_CLASSES: dict[str, str] = {
@@ -65,6 +66,12 @@ def _installed() -> dict[str, str]:
 def engine_names() -> tuple[str, ...]:
     """Every physics engine: the built-in ones, then those installed as entry points."""
     return ENGINES + tuple(_installed())
+
+
+def default_engines() -> tuple[str, ...]:
+    """The engines a command runs when none are named for a multi-engine sweep
+    (atlas, trust): those whose class says ``affordable``."""
+    return tuple(e for e in engine_names() if getattr(get_backend(e), "affordable", True))
 
 
 def backend_names() -> tuple[str, ...]:

@@ -185,6 +185,9 @@ class Engine:
     marker: ClassVar[str]
     capabilities: ClassVar[frozenset[str]]
     known_failures: ClassVar[Mapping[str, str]] = {}
+    # Cheap enough for a default multi-engine run (atlas, trust): about a CPU
+    # second or less per threshold point at its threshold step.
+    affordable: ClassVar[bool] = True
     calibration_space: ClassVar[Mapping[str, Sequence]] = {}
     default_friction: ClassVar[float]
     Settings: ClassVar[type[EngineSettings]]

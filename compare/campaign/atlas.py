@@ -28,7 +28,7 @@ import math
 import os
 import resource
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,7 +47,7 @@ FIGURE = {"fig8": "Fig. 8", "fig9": "Fig. 9", "fig11": "Fig. 11", "fig5": "Fig. 
 class AtlasConfig:
     """What the atlas measures (module docstring)."""
 
-    engines: tuple[str, ...] = ("pymunk", "mujoco", "pybullet")
+    engines: tuple[str, ...] = field(default_factory=lambda: _default_engines())
     scenes: tuple = ATLAS_SCENES
     omegas: tuple[float, ...] = tuple(float(w) for w in np.arange(4.0, 28.5, 2.0))
     factors: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0)  # x the calibrated threshold step
@@ -77,6 +77,11 @@ class AtlasConfig:
                 "cases": list(self.cases), "rel_bracket": self.rel_bracket,
                 "rel_tol": self.rel_tol, "tol": self.tol,
                 "settings": {e: dict(o) for e, o in self.settings}}
+
+
+def _default_engines() -> tuple[str, ...]:
+    from engines import default_engines
+    return default_engines()
 
 
 def atlas_scenes(config: AtlasConfig) -> list[tuple[str, str]]:

@@ -22,7 +22,6 @@ from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_stor
                                  parse_engine_list, parse_omega_range, resolve_workers,
                                  settings_from_args, use_store)
 
-DEFAULT_ENGINES = ("pymunk", "mujoco", "pybullet")
 
 
 def add_parser(subparsers) -> None:
@@ -30,7 +29,7 @@ def add_parser(subparsers) -> None:
                                             "paper's scenes and coarser steps",
                               description=__doc__,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_engine_list_arg(p, DEFAULT_ENGINES)
+    add_engine_list_arg(p, None)
     p.add_argument("--omega", default="4:28:2", metavar="START:STOP:STEP",
                    help="pulse frequencies [rad/s]")
     p.add_argument("--factors", default="1,2,5,10", metavar="F[,F...]",

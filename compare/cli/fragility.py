@@ -228,7 +228,8 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
     from compare.run.atomic import savefig
     from compare.measure.fragility import empirical_curve
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    colours = {"analytic": "k", "pybullet": "C0", "pymunk": "C1", "mujoco": "C2"}
+    from compare.report.plots import color
+    colours = {b: "k" if b == "analytic" else color(b) for b in doc["backends"]}
     for b, body in doc["backends"].items():
         fit, c = body["fit"], colours.get(b, None)
         if fit is None:  # no record with a robust bracket: nothing to draw

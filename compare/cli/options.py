@@ -158,24 +158,32 @@ def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",
                         help=f"backend: {', '.join(names)}")
 
 
-def add_engine_list_arg(parser: argparse.ArgumentParser, default: tuple[str, ...],
+def add_engine_list_arg(parser: argparse.ArgumentParser, default: tuple[str, ...] | None,
                         none_ok: bool = False) -> None:
     """``--engine NAME[,NAME...]``, ``all`` (and ``none`` where ``none_ok``); read
-    with :func:`parse_engine_list`."""
+    with :func:`parse_engine_list`.  ``default`` None: the engines marked
+    affordable (:func:`engines.default_engines`), resolved when the command runs
+    (reading the flag imports every engine)."""
     from engines import engine_names
     extra = ", or none" if none_ok else ""
-    parser.add_argument("--engine", dest="engine", default=",".join(default),
+    parser.add_argument("--engine", dest="engine",
+                        default=None if default is None else ",".join(default),
                         metavar="NAME[,NAME...]",
                         help=f"comma-separated engines from {', '.join(engine_names())}, "
-                             f"all{extra}")
+                             f"all{extra}" + ("" if default is not None else
+                                              " (default: the engines marked affordable, "
+                                              "about a CPU second per threshold point)"))
 
 
-def parse_engine_list(text: str, option: str = "--engine",
+def parse_engine_list(text: str | None, option: str = "--engine",
                       none_ok: bool = False) -> tuple[str, ...]:
     """The door's one engine list: ``'a,b'``, ``'all'`` (every registered engine,
     :func:`engines.engine_list`) or, where ``none_ok``, ``'none'``; an empty list,
-    an unknown or a repeated name is refused naming ``option``."""
-    from engines import engine_list, engine_names
+    an unknown or a repeated name is refused naming ``option``; None (the flag not
+    given where its default is None) is :func:`engines.default_engines`."""
+    from engines import default_engines, engine_list, engine_names
+    if text is None:
+        return default_engines()
     if none_ok and text.strip() == "none":
         return ()
     names = [n.strip() for n in text.split(",")]

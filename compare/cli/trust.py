@@ -10,10 +10,6 @@ from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg
                                  check_output_path, info, parse_engine_list, resolve_workers,
                                  scene_from_args, use_store)
 
-# The three engines a first answer can afford on 2 cores (DART and Drake cost
-# 10-55 CPU s per threshold point: docs/atlas.md); `--engine all` adds them.
-DEFAULT_ENGINES = "pymunk,mujoco,pybullet"
-
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
@@ -29,9 +25,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "reference step. Writes trust.json, trust.csv and index.html into --out; "
                     "one progress line per stage on stderr.")
     add_scene_args(parser)
-    parser.add_argument("--engine", default=DEFAULT_ENGINES, metavar="NAME[,NAME...]|all",
-                        help=f"engines to judge (default {DEFAULT_ENGINES}; DART and Drake "
-                             "cost 10-55 CPU s per threshold point)")
+    parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]|all",
+                        help="engines to judge (default: the engines marked affordable, about "
+                             "a CPU second per threshold point; 'all' adds the others)")
     parser.add_argument("--record", default=None, metavar="FILE|DIR",
                         help="also each ground motion's first overturning intensity (PGA), "
                              "model against engine: a CSV/AT2 file or a folder of them")

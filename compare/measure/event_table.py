@@ -57,8 +57,8 @@ def rows(backends) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    backends = (argv if argv is not None else sys.argv[1:]) or ["analytic", "pymunk", "mujoco",
-                                                              "pybullet", "dart", "drake"]
+    from engines import engine_names
+    backends = (argv if argv is not None else sys.argv[1:]) or ["analytic", *engine_names()]
     load0 = os.getloadavg()
     table = rows(backends)
     print("| case | backend | verdict | uplift | impacts | past alpha for good | verdict time "

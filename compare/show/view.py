@@ -60,17 +60,17 @@ def record_hint(scene_name: str, engine: str, excitation) -> str:
     return f"trilith record --scene {scene_name} --engine {engine} {what} --out run.gif"
 
 
-def _pybullet_gui(scene: Scene, excitation, duration: float, options: dict | None = None) -> bool:
-    """Run PyBullet in its own GUI window if it declares the ``'gui'`` capability;
-    return whether it did."""
+def _own_gui(name: str, scene: Scene, excitation, duration: float,
+             options: dict | None = None) -> bool:
+    """Run engine ``name`` in its own GUI window if it declares the ``'gui'``
+    capability; return whether it did."""
     from engines import supports
     from compare.show.record import backend_settings, load_backend
 
-    if not supports("pybullet", "gui"):
+    if not supports(name, "gui"):
         return False
-    load_backend("pybullet").view(scene, excitation,
-                                  backend_settings("pybullet", duration, options),
-                                  duration=duration)
+    load_backend(name).view(scene, excitation, backend_settings(name, duration, options),
+                            duration=duration)
     return True
 
 
@@ -108,8 +108,8 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     for name in names:
         load_backend(name)
     span = settings.duration if settings.duration is not None else default_duration(excitation)
-    if names == ("pybullet",) and _pybullet_gui(scene, excitation, span,
-                                                settings.options("pybullet")):
+    if len(names) == 1 and _own_gui(names[0], scene, excitation, span,
+                                     settings.options(names[0])):
         return {}
     frame_times(span, settings.fps)  # validates the frame count before any run
     trajectories = {name: run_backend(name, scene, excitation, span, settings.options(name))

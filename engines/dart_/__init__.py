@@ -73,6 +73,7 @@ class DartEngine(Engine):
     label = "DART"
     color = "tab:cyan"
     marker = "v"
+    affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
     default_friction = 10.0
     Settings = Settings

@@ -144,6 +144,7 @@ class DrakeEngine(Engine):
     label = "Drake"
     color = "tab:brown"
     marker = "P"
+    affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
     known_failures = {
         "pendulum_follows_eq1": "compliant contact: the swinging pendulum tilts the frame "
