@@ -154,7 +154,28 @@ class _JobError:
     message: str
 
 
-def _progress(total: int):
+class _Lines:
+    """Progress for a reader who is not at a terminal (piped, logged): a stderr line
+    at each tenth of the jobs, with the count and the elapsed wall time."""
+
+    def __init__(self, total: int):
+        self.total, self.done, self.t0, self.next = total, 0, time.perf_counter(), 1
+
+    def update(self, n: int = 1) -> None:
+        self.done += n
+        if self.done * 10 >= self.next * self.total:
+            self.next = self.done * 10 // max(self.total, 1) + 1
+            print(f"report: {self.done}/{self.total} jobs, "
+                  f"{time.perf_counter() - self.t0:.0f} s", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        pass
+
+
+def _progress(total: int, lines: bool = False):
+    """tqdm at a terminal; with ``lines`` and no terminal, :class:`_Lines`."""
+    if lines and not sys.stderr.isatty():
+        return _Lines(total)
     try:
         from tqdm import tqdm
     except ImportError:  # pragma: no cover - tqdm is a dependency
@@ -163,9 +184,9 @@ def _progress(total: int):
                 leave=False)
 
 
-def _execute(jobs: list, workers: int) -> list:
+def _execute(jobs: list, workers: int, lines: bool = False) -> list:
     """Run ``jobs`` ((kind, args) pairs); results in job order."""
-    bar = _progress(len(jobs))
+    bar = _progress(len(jobs), lines)
     try:
         return list(runs.run_many(_run_one, jobs, workers=workers, lookup=_lookup,
                                   on_done=None if bar is None else lambda i, r: bar.update()))
@@ -228,8 +249,10 @@ class CampaignResult:
                 "threshold_domain": self.threshold_domain}
 
 
-def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
-    """Run the validation campaign described by ``config`` (default: full)."""
+def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -> CampaignResult:
+    """Run the validation campaign described by ``config`` (default: full);
+    ``progress``: a stderr line per tenth of the jobs when stderr is no terminal
+    (tqdm's bar when it is)."""
     from compare.campaign.verdicts import build_verdicts
 
     config = config or CampaignConfig()
@@ -298,7 +321,10 @@ def run_campaign(config: CampaignConfig | None = None) -> CampaignResult:
                 jobs.append(("long_run", (name, label, scene_name, amplitude, omega, config)))
                 labels.append(("long_run", False, name))
     t0 = time.perf_counter()
-    outputs = _execute(jobs, config.workers)
+    if progress and not sys.stderr.isatty():
+        print(f"report: reference spectra done, {len(jobs)} jobs to run", file=sys.stderr,
+              flush=True)
+    outputs = _execute(jobs, config.workers, progress)
     result.timings["engine_runs_wall"] = time.perf_counter() - t0
     cpu: dict[str, float] = {}
     spent: dict[str, float] = {}

@@ -128,7 +128,8 @@ def run(args: argparse.Namespace) -> int:
     if loaded is not None:
         provenance["settings_file"] = {"file": loaded.path, "sha256": loaded.sha256}
     with atomic.output_lock(out):  # a second report into the same --out: clear error
-        result = run_campaign(config)
+        from compare.cli import options as _options
+        result = run_campaign(config, progress=_options.VERBOSITY >= 0)
         provenance["versions"].update(result.versions)
         extra = {}
         if suite:

@@ -132,7 +132,7 @@ def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, s
                 {"metric": "verdicts", "backend": "pymunk", "value": 0, "tolerance": 0,
                  "passed": True, "unit": "count"}]
     monkeypatch.setattr(compare.campaign.validation, "run_campaign",
-                        lambda config: SimpleNamespace(verdicts=verdicts, versions={}))
+                        lambda config, progress=False: SimpleNamespace(verdicts=verdicts, versions={}))
     monkeypatch.setattr(compare.report.html, "write_report",
                         lambda result, out, provenance=None, extra=None:
                         {"html": Path(out) / "index.html"})
@@ -141,6 +141,24 @@ def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, s
     out = capsys.readouterr().out
     assert "FAIL pymunk: restitution vs Eq. 20 = 1.2 % (tolerance 0.5 %)" in out
     assert (tmp_path / "r").is_dir()  # --out created at the door
+
+
+def test_a_piped_report_says_how_far_it_is(tmp_path, capsys):
+    """stderr is no terminal here: one line per tenth of the jobs, with the count
+    and the elapsed time; -q keeps it silent."""
+    import re
+
+    from compare.campaign.validation import CampaignConfig, run_campaign
+    config = CampaignConfig.quick(engines=("pymunk",), n_frequencies=0, points=("A",),
+                                  restitution_lams=(5.0,))
+    run_campaign(config, progress=True)
+    err = capsys.readouterr().err
+    counts = [(int(a), int(b)) for a, b in re.findall(r"report: (\d+)/(\d+) jobs", err)]
+    assert "report: reference spectra done" in err
+    assert counts and counts[-1][0] == counts[-1][1] and len(counts) <= 11
+    assert [a for a, _ in counts] == sorted(a for a, _ in counts)
+    run_campaign(config)  # progress off (the CLI's -q): nothing on stderr
+    assert "report:" not in capsys.readouterr().err
 
 
 def test_workers_like_n_jobs():
