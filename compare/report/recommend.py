@@ -83,8 +83,17 @@ def _domain_sentence(trust: dict) -> str:
         (inside if dom.get("inside") else outside).append(label(e))
     if not inside and not outside:
         return ""
-    text = (". Calibrated threshold steps hold inside the domain of their calibration "
-            "(engines/NAME_/thresholds.toml, docs/calibrate.md)")
+    groups: dict[str, list[str]] = {}
+    for e, row in trust.items():
+        dom = row.get("threshold_domain") or {}
+        if dom.get("calibrated") and dom.get("domain"):
+            text = ", ".join(f"{k.replace('_over_', '/')} {v[0]:g}-{v[1]:g}"
+                             for k, v in dom["domain"].items() if isinstance(v, list))
+            groups.setdefault(text, []).append(label(e))
+    ranges = "; ".join(f"{', '.join(names)}: {text}" for text, names in groups.items())
+    text = (". Calibrated threshold steps hold inside the domain of their calibration"
+            + (f" ({ranges})" if ranges else "") + " (engines/NAME_/thresholds.toml, "
+            "docs/calibrate.md)")
     if outside:
         text += ("; this scene is outside it, so " + ", ".join(outside)
                  + " ran the reference step")
