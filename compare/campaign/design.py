@@ -65,7 +65,8 @@ def scene_omegas(scene) -> list[float]:
 
 def domain_table(ranges: dict | None = None) -> dict:
     """The ``[domain]`` table of a settings file calibrated on these ranges (both
-    curves); a range is widened by its rounding to 4 decimals."""
+    curves).  The sampled values are rounded to 4 decimals, so a design scene's
+    ratios (l/h, gap/h) may sit up to ~1e-4 outside these ranges."""
     ranges = dict(RANGES if ranges is None else ranges)
     return {**{k: [float(lo), float(hi)] for k, (lo, hi) in ranges.items()},
             "no_pendulum": True}

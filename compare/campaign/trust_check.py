@@ -27,6 +27,7 @@ simulated second.  Tolerances are the validation report's
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
@@ -213,7 +214,7 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     progress.next("model: spectrum and validity")
     band = _band(scene, workers)
     doc = {"schema_version": 1, "what": "trust of each engine on one scene",
-           "scene": scene.to_dict(), "band": band, "tolerances": tol.__dict__ | {},
+           "scene": scene.to_dict(), "band": band, "tolerances": dataclasses.asdict(tol),
            "engines": {}, "project": project_version()}
     for e in engines:
         choice = threshold_choice(e, scene)

@@ -78,6 +78,8 @@ def _run_cost(engine: str, dt: float, costs: dict) -> float:
 
     from engines.calibration import calibrated
 
+    # An estimate: the calibrated step whatever the scene (a scene outside its
+    # domain runs the finer reference step and costs more than estimated).
     dt = dt or getattr(configure(engine, **calibrated(engine).options), "dt", 1e-4)
     measured = {}
     for label, (mean, _n) in costs.items():

@@ -76,8 +76,9 @@ class RunSpec:
         try:
             settings = engines.configure(backend, **values)
         except (TypeError, ValueError) as exc:
-            where = sorted({origin[n] for n in values if n in str(exc)}) or sorted(
-                set(origin.values()))
+            import re
+            named = {origin[n] for n in values if re.search(rf"\b{re.escape(n)}\b", str(exc))}
+            where = sorted(named) or sorted(set(origin.values()))
             raise type(exc)(f"{exc} (from {', '.join(where)})" if where else str(exc)) from None
         friction = getattr(settings, "friction", None)
         if friction is not None:
