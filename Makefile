@@ -32,7 +32,7 @@ atlas: $(STAMP)
 	mkdir -p report
 	$(VENV)/bin/trilith atlas --engine $(ATLAS_ENGINES) --workers $(ATLAS_WORKERS) \
 		--json docs/validation/atlas.json --html report/atlas.html
-	$(PY) -m compare.report.atlas_findings docs/validation/atlas.json README.md \
+	$(PY) -m trilith_xval.compare.report.atlas_findings docs/validation/atlas.json README.md \
 		docs/engine-trust.md docs/atlas.md
 
 figures: $(STAMP)

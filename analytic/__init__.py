@@ -2,7 +2,7 @@
 
 Public API::
 
-    from analytic import Scene, Pulse, simulate, SimulationSettings
+    from trilith_xval.analytic import Scene, Pulse, simulate, SimulationSettings
 """
 from .excitation import Pulse, SampledRecord, Still
 from .parameters import Scene

@@ -6,7 +6,8 @@ notes).  The fast path compiles :mod:`analytic.equations` into
 :mod:`analytic._fast_kernels`, so an edit of the equations would leave stale
 machine code behind.  On import this module hashes the files the kernels are
 built from and, when the hash differs from the one recorded next to the cache,
-deletes the cached kernels so numba compiles them again.
+deletes the cached kernels so numba compiles them again.  The hash includes the
+package's import name (cached kernels name the modules they were compiled in).
 """
 from __future__ import annotations
 
@@ -19,7 +20,10 @@ PREFIXES = tuple(Path(name).stem + "." for name in SOURCES)
 
 
 def sources_digest() -> str:
-    h = hashlib.sha256()
+    # The import name too: numba's cached machine code names the modules it was
+    # compiled in, so the same files imported under another package name (a
+    # checkout renamed or installed elsewhere) must not load it.
+    h = hashlib.sha256(__name__.encode())
     for name in SOURCES:
         h.update((_HERE / name).read_bytes())
     return h.hexdigest()

@@ -86,8 +86,8 @@ def check_model(scene, pulse, friction: float | None = None) -> dict:
 
     Examples
     --------
-    >>> from analytic.excitation import Pulse
-    >>> from scenes import load_scene
+    >>> from trilith_xval.analytic.excitation import Pulse
+    >>> from trilith_xval.scenes import load_scene
     >>> check_model(load_scene("fig5"), Pulse(64.0, 24.0))["reason"]  # doctest: +ELLIPSIS
     'lintel normal force -0.26 of its weight (lintel + bob) at t = ...'
     """

@@ -52,7 +52,7 @@ def bob_clearance(scene, theta, psi, bob_radius: float = 0.0):
 
     Examples
     --------
-    >>> from analytic.parameters import Scene
+    >>> from trilith_xval.analytic.parameters import Scene
     >>> sc = Scene(b=0.6, lam=3.0, gamma=0.1)
     >>> round(float(bob_clearance(sc, 0.0, np.arcsin(0.9 / 1.2))), 12)
     0.0

@@ -78,7 +78,7 @@ class RunOptions:
 
     Examples
     --------
-    >>> from analytic.options import RunOptions
+    >>> from trilith_xval.analytic.options import RunOptions
     >>> RunOptions(t_max=2.0).t_max
     2.0
     >>> RunOptions(t_max=-1.0)

@@ -158,7 +158,7 @@ def analytic_map(scene: Scene, omegas, amplitudes, settings: SpectrumSettings | 
 
     Examples
     --------
-    >>> from scenes import load_scene
+    >>> from trilith_xval.scenes import load_scene
     >>> m = analytic_map(load_scene("fig5"), [7.0], [2.0, 3.0, 4.0], first_curve=False)
     >>> [m.labels[c] for c in m.cells[:, 0]]
     ['survived', 'survived', 'overturned (after-impact)']

@@ -166,10 +166,10 @@ def _compiled_accelerations():
     already run its kernels (a spectrum): numba is then set up and one more
     cached kernel loads in milliseconds.  None otherwise: setting numba up for
     this alone costs about 0.5 CPU s, more than the scalar loop of a few runs."""
-    kernels = sys.modules.get("analytic._fast_kernels")
+    kernels = sys.modules.get("trilith_xval.analytic._fast_kernels")
     if kernels is None or not (kernels.verdicts.signatures or kernels.run.signatures):
         return None
-    return sys.modules["analytic._fast_steps"].sample_accelerations
+    return sys.modules["trilith_xval.analytic._fast_steps"].sample_accelerations
 
 
 def _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args):

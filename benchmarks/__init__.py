@@ -35,7 +35,7 @@ def machine() -> dict:
 def write(name: str, payload: dict) -> Path:
     """Write ``benchmarks/out/<name>.json`` (strict JSON) whole, atomically, and
     return its path."""
-    from compare.run.atomic import write_text
+    from trilith_xval.compare.run.atomic import write_text
     OUT.mkdir(parents=True, exist_ok=True)
     path = OUT / f"{name}.json"
     write_text(path, json.dumps(payload, indent=1, allow_nan=False))

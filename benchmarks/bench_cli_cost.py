@@ -41,11 +41,11 @@ HEAVY = ("numba", "scipy", "matplotlib", "pybullet", "pymunk", "mujoco", "dartpy
 
 def _cpu_of(argv: list[str], root: Path) -> tuple[float, float, str]:
     """CPU seconds (user + system, the process and its children), wall seconds
-    and stdout of ``python -m compare.cli.main *argv`` run from ``root``."""
+    and stdout of ``python -m trilith_xval.compare.cli.main *argv`` run from ``root``."""
     import time
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", *argv], cwd=root,
+    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", *argv], cwd=root,
                           env={**os.environ, "PYTHONPATH": str(root)}, capture_output=True,
                           text=True, check=True)
     wall = time.perf_counter() - t0
@@ -84,9 +84,9 @@ def _pool_start_cpu() -> float:
     """CPU seconds per worker of a two-worker pool forked by a loaded parent."""
     code = (
         "import resource\n"
-        "from analytic import fast\n"
-        "from analytic._workers import fork_pool\n"
-        "import analytic.simulate\n"
+        "from trilith_xval.analytic import fast\n"
+        "from trilith_xval.analytic._workers import fork_pool\n"
+        "import trilith_xval.analytic.simulate\n"
         "fast.warm_up(record=False)\n"
         "def cpu(who):\n"
         "    r = resource.getrusage(who); return r.ru_utime + r.ru_stime\n"
@@ -102,7 +102,7 @@ def _pool_start_cpu() -> float:
 
 def _help() -> tuple[float, list[str]]:
     cpu, _, _ = _cpu_of(["--help"], ROOT)
-    code = ("import sys; from compare.cli.main import build_parser; build_parser(); "
+    code = ("import sys; from trilith_xval.compare.cli.main import build_parser; build_parser(); "
             f"print(','.join(m for m in {HEAVY!r} if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, check=True, text=True,
                          env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True)
@@ -157,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _pool_constant() -> float:
-    from analytic._workers import POOL_START_CPU_S
+    from trilith_xval.analytic._workers import POOL_START_CPU_S
     return POOL_START_CPU_S
 
 

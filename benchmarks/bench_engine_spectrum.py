@@ -17,9 +17,9 @@ import time
 
 import numpy as np
 
-from analytic.spectrum import overturning_spectrum
-from compare.measure import engine_spectrum as es
-from scenes import load_scene
+from trilith_xval.analytic.spectrum import overturning_spectrum
+from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.scenes import load_scene
 
 from . import machine, write
 

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import sys
 
-from analytic import fast
-from analytic import simulate as accurate
-from analytic.excitation import Pulse
-from analytic.trajectory import OverturnCriterion
-from scenes import load_scene
+from trilith_xval.analytic import fast
+from trilith_xval.analytic import simulate as accurate
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.trajectory import OverturnCriterion
+from trilith_xval.scenes import load_scene
 
 from . import machine, median_time, write
 

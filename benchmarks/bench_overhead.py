@@ -34,9 +34,9 @@ import sys
 import time
 from dataclasses import replace
 
-import engines
-from analytic.excitation import Pulse
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.scenes import load_scene
 
 from . import machine, write
 

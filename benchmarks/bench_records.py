@@ -19,8 +19,8 @@ DT = 5e-4  # s
 
 
 def tiled_record(n: int):
-    from analytic.excitation import SampledRecord
-    from scenes.records.make_sample import synthetic_record
+    from trilith_xval.analytic.excitation import SampledRecord
+    from trilith_xval.scenes.records.make_sample import synthetic_record
     t0, a0 = synthetic_record()
     tf = np.arange(0.0, 10.0, DT)
     af = 0.5 * np.interp(tf, t0, a0)
@@ -29,8 +29,8 @@ def tiled_record(n: int):
 
 
 def main(argv: list[str] | None = None) -> int:
-    import engines
-    from scenes import load_scene
+    from trilith_xval import engines
+    from trilith_xval.scenes import load_scene
     sizes = [10_000, 100_000] + [int(x) for x in (argv or [])]
     fig5 = load_scene("fig5")
     bad = 0

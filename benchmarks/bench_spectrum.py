@@ -20,9 +20,9 @@ import time
 
 import numpy as np
 
-from analytic import fast
-from analytic.spectrum import SpectrumSettings, overturning_spectrum
-from scenes import load_scene
+from trilith_xval.analytic import fast
+from trilith_xval.analytic.spectrum import SpectrumSettings, overturning_spectrum
+from trilith_xval.scenes import load_scene
 
 from . import machine, median_time, write
 

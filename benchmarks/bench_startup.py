@@ -12,7 +12,7 @@ from pathlib import Path
 from . import machine, write
 
 ROOT = Path(__file__).resolve().parent.parent
-CMD = [sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10"]
+CMD = [sys.executable, "-m", "trilith_xval.compare.cli.main", "spectrum", "--omega", "10"]
 
 
 def _env() -> dict:
@@ -36,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
             top.append((int(parts[1]) / 1e6, parts[2].strip()))
     top.sort(reverse=True)
     probe = subprocess.run([sys.executable, "-c", (
-        "import time; t=time.perf_counter(); from analytic import fast; t1=time.perf_counter();"
+        "import time; t=time.perf_counter(); from trilith_xval.analytic import fast; t1=time.perf_counter();"
         "fast.warm_up(record=False); print(t1-t, time.perf_counter()-t1)")],
         env=_env(), capture_output=True, text=True, check=True).stdout.split()
     print(f"trilith spectrum --omega 10: median {walls[1]:.3f} s of 3 (min {walls[0]:.3f})")

@@ -58,7 +58,7 @@ def _report(out: Path, *store_args: str) -> tuple[float, float, dict, int | None
     import resource
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "report", "--quick", "-v",
+    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", "report", "--quick", "-v",
                            "--out", str(out), *store_args], cwd=ROOT, capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     wall = time.perf_counter() - t0
@@ -76,12 +76,12 @@ def per_run_overhead() -> dict:
     (a difference of two noisy run times would drown a sub-millisecond cost):
     key (canonical JSON + SHA-256), a missed lookup, the insert (encode + commit)
     on a miss; the lookup (select + decode) on a hit; against the run itself."""
-    from analytic.excitation import Pulse
-    from compare.run.codec import decode, encode
-    from compare.run.keys import run_key
-    from compare.run.store import RunStore
-    from engines import get_backend
-    from scenes import load_scene
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.run.codec import decode, encode
+    from trilith_xval.compare.run.keys import run_key
+    from trilith_xval.compare.run.store import RunStore
+    from trilith_xval.engines import get_backend
+    from trilith_xval.scenes import load_scene
 
     scene = load_scene("fig5")
     out = {}

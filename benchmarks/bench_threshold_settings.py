@@ -21,13 +21,13 @@ import time
 
 import numpy as np
 
-from analytic.spectrum import overturning_spectrum
-from compare.campaign.settings_file import threshold_options
-from compare.measure import engine_spectrum as es
-from compare.run import runs
-from compare.run.jsonable import plain
-from engines import configure
-from scenes import load_scene
+from trilith_xval.analytic.spectrum import overturning_spectrum
+from trilith_xval.compare.campaign.settings_file import threshold_options
+from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.engines import configure
+from trilith_xval.scenes import load_scene
 
 from . import machine, write
 
@@ -35,7 +35,7 @@ DEFAULT_ENGINE = "pymunk"  # the cheapest engine
 
 
 def _engines() -> list[str]:
-    from engines import engine_names
+    from trilith_xval.engines import engine_names
     text = os.environ.get("BENCH_ENGINES", DEFAULT_ENGINE)
     if text.strip() == "calibrated":
         return [e for e in engine_names() if threshold_options(e, load_scene("fig5"))]

@@ -30,7 +30,7 @@ def main(argv: list[str] | None = None) -> int:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         load0, t0 = os.getloadavg(), time.perf_counter()
         proc = subprocess.run(
-            [sys.executable, "-m", "compare.cli.main", "trust", "--scene", "fig5", "--engine",
+            [sys.executable, "-m", "trilith_xval.compare.cli.main", "trust", "--scene", "fig5", "--engine",
              ENGINES, "--out", str(out), "--cache", str(Path(tmp) / "store"), "-q"],
             capture_output=True, text=True, check=False)
         wall = time.perf_counter() - t0

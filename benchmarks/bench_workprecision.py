@@ -25,7 +25,7 @@ import sys
 import time
 from pathlib import Path
 
-from compare.run import atomic
+from trilith_xval.compare.run import atomic
 
 from .workprecision_common import OUT_DIR, Point, machine_info, mark_front, \
     plot_work_precision, write_json
@@ -52,7 +52,7 @@ def run(quick: bool = False, out: Path | None = None, engines=None,
 
     out = Path(out) if out is not None else OUT_DIR
     if engines is None:
-        from engines import engine_names
+        from trilith_xval.engines import engine_names
         engines = engine_names()
     machine = machine_info()
     start = time.perf_counter()
@@ -219,7 +219,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.regenerate is not None:
         regenerate(args.regenerate, args.out)
         return 0
-    from engines import engine_list
+    from trilith_xval.engines import engine_list
     engines = () if args.engines == "none" else engine_list(args.engines)
     run(quick=args.quick, out=args.out, engines=engines, analytic=not args.no_analytic)
     return 0

@@ -36,14 +36,14 @@ import math
 import sys
 import time
 
-from engines._quiet_pybullet import pybullet as pb
+from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
-import engines
-from analytic.excitation import Pulse
-from compare.run.jsonable import plain
-from compare.measure.restitution import measure_restitution
-from engines.pybullet_ import PyBulletEngine
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.engines.pybullet_ import PyBulletEngine
+from trilith_xval.scenes import load_scene
 
 from . import machine, write
 

@@ -20,10 +20,10 @@ import math
 
 import numpy as np
 
-from analytic import Scene, Pulse, fast
-from analytic.simulate import Settings as AccSettings
-from analytic.simulate import simulate as simulate_acc
-from compare.run import runs  # untimed references only: through the run store
+from trilith_xval.analytic import Scene, Pulse, fast
+from trilith_xval.analytic.simulate import Settings as AccSettings
+from trilith_xval.analytic.simulate import simulate as simulate_acc
+from trilith_xval.compare.run import runs  # untimed references only: through the run store
 
 from .workprecision_common import Point, bisect_threshold, timed
 

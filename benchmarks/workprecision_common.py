@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Callable
 
 
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
-from compare.run import atomic
+from trilith_xval.compare.run import atomic
 
 __all__ = ["Point", "timed", "pareto_front", "mark_front", "bisect_threshold", "machine_info",
            "write_json", "plot_work_precision", "OUT_DIR"]
@@ -160,7 +160,7 @@ def machine_info() -> dict:
         except Exception:  # noqa: BLE001 -- a missing optional library is reported, not fatal
             versions[mod] = "missing"
     try:
-        from engines._quiet_pybullet import pybullet
+        from trilith_xval.engines._quiet_pybullet import pybullet
         versions["pybullet"] = f"API {pybullet.getAPIVersion()}"
     except Exception:  # noqa: BLE001
         versions["pybullet"] = "missing"

@@ -29,11 +29,11 @@ import math
 
 import numpy as np
 
-from analytic import Pulse, Scene
-from analytic.simulate import Settings as AccSettings
-from compare.run import runs  # untimed references only: through the run store
-from engines import get_backend
-from compare.measure.restitution import measure_restitution
+from trilith_xval.analytic import Pulse, Scene
+from trilith_xval.analytic.simulate import Settings as AccSettings
+from trilith_xval.compare.run import runs  # untimed references only: through the run store
+from trilith_xval.engines import get_backend
+from trilith_xval.compare.measure.restitution import measure_restitution
 
 from .workprecision_common import Point, bisect_threshold
 

@@ -12,7 +12,7 @@ from :func:`engine_names`, display metadata from the class (``label``, ``color``
 
 Examples
 --------
->>> import engines
+>>> from trilith_xval import engines
 >>> s = engines.configure("pymunk", dt=5e-5, t_max=1.0)
 >>> (s.dt, s.t_max, s.iterations)
 (5e-05, 1.0, 30)
@@ -35,15 +35,15 @@ __all__ = ["BACKENDS", "ENGINES", "ENGINE_CLASSES", "ENTRY_POINT_GROUP", "get_ba
 
 # The physics engines under validation: name -> "module:Class".
 ENGINE_CLASSES: dict[str, str] = {
-    "pybullet": "engines.pybullet_:PyBulletEngine",
-    "pymunk": "engines.pymunk_:PymunkEngine",
-    "mujoco": "engines.mujoco_:MujocoEngine",
-    "dart": "engines.dart_:DartEngine",
-    "drake": "engines.drake_:DrakeEngine",
+    "pybullet": "trilith_xval.engines.pybullet_:PyBulletEngine",
+    "pymunk": "trilith_xval.engines.pymunk_:PymunkEngine",
+    "mujoco": "trilith_xval.engines.mujoco_:MujocoEngine",
+    "dart": "trilith_xval.engines.dart_:DartEngine",
+    "drake": "trilith_xval.engines.drake_:DrakeEngine",
 }
 BACKENDS: dict[str, str] = {
-    "analytic": "engines.analytic_:Analytic",
-    "analytic-fast": "engines.analytic_:AnalyticFast",
+    "analytic": "trilith_xval.engines.analytic_:Analytic",
+    "analytic-fast": "trilith_xval.engines.analytic_:AnalyticFast",
     **ENGINE_CLASSES,
 }
 ENGINES: tuple[str, ...] = tuple(ENGINE_CLASSES)
@@ -168,7 +168,7 @@ def configure(name_or_class, settings=None, **options):
                              f"{', '.join(sorted(known))}")
     crit = options.get("criterion")
     if isinstance(crit, str):
-        from analytic.trajectory import OverturnCriterion
+        from trilith_xval.analytic.trajectory import OverturnCriterion
         options["criterion"] = OverturnCriterion(crit, base.criterion.topple_angle)
     if isinstance(options.get("monitor"), dict):
         options["monitor"] = dataclasses.replace(base.monitor, **options["monitor"])

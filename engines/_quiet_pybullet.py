@@ -1,7 +1,7 @@
 """pybullet, imported without its banner: its C library prints "pybullet build
 time: ..." on stderr at import, which would clutter every run and break the CLI's
 one-line errors.  fd 2 goes to /dev/null for the import only.  Import ``pybullet``
-from here (``from engines._quiet_pybullet import pybullet as pb``)."""
+from here (``from trilith_xval.engines._quiet_pybullet import pybullet as pb``)."""
 from __future__ import annotations
 
 import os

@@ -48,7 +48,7 @@ class AnalyticBackend:
 class Analytic(AnalyticBackend):
     """The accurate analytic model (:mod:`analytic.simulate`, SciPy DOP853)."""
 
-    module = "analytic.simulate"
+    module = "trilith_xval.analytic.simulate"
     name = "analytic"
     label = "analytic model (scipy)"
     color = "k"
@@ -58,7 +58,7 @@ class Analytic(AnalyticBackend):
 class AnalyticFast(AnalyticBackend):
     """The compiled fast path (:mod:`analytic.fast`, numba)."""
 
-    module = "analytic.fast"
+    module = "trilith_xval.analytic.fast"
     name = "analytic-fast"
     label = "analytic model (compiled)"
     color = "tab:green"

@@ -19,13 +19,13 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from analytic.bounds import required_friction
-from analytic.excitation import Pulse, SampledRecord, Still
-from analytic.mavroeidis_papageorgiou import MavroeidisPapageorgiou
-from analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
-from analytic.parameters import Scene
-from analytic.ricker import Ricker
-from analytic.trajectory import Trajectory
+from trilith_xval.analytic.bounds import required_friction
+from trilith_xval.analytic.excitation import Pulse, SampledRecord, Still
+from trilith_xval.analytic.mavroeidis_papageorgiou import MavroeidisPapageorgiou
+from trilith_xval.analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.ricker import Ricker
+from trilith_xval.analytic.trajectory import Trajectory
 
 from .diagnostics import Diagnostics, PlaneState
 from .monitor import MonitorSettings, RunMonitor

@@ -33,7 +33,7 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 
-from analytic.parameters import G_STANDARD
+from trilith_xval.analytic.parameters import G_STANDARD
 
 __all__ = ["Domain", "Calibrated", "StepChoice", "calibrated", "threshold_choice", "reference_dt",
            "scene_coordinates", "COORDINATES", "FIXED", "RESERVED_TABLES"]
@@ -159,7 +159,7 @@ class StepChoice:
 def _resource(engine: str, metric: str):
     from importlib import resources
 
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     package = get_backend(engine).__module__
     return resources.files(package).joinpath(f"{metric}.toml")
 
@@ -174,7 +174,7 @@ def calibrated(engine: str, metric: str = "thresholds") -> Calibrated:
         The file is missing from the engine's folder, not TOML, or holds a
         setting the engine refuses or a malformed domain.
     """
-    import engines
+    from trilith_xval import engines
     res = _resource(engine, metric)
     where = f"{engine}'s calibration {metric}.toml"
     try:
@@ -223,5 +223,5 @@ def threshold_choice(engine: str, scene) -> StepChoice:
 def reference_dt(engine: str) -> float:
     """The engine's reference step [s]: the default ``dt`` of its ``Settings``, at
     which its accuracy for every metric was measured (docs/engine-trust.md)."""
-    import engines
+    from trilith_xval import engines
     return float(engines.configure(engine).dt)

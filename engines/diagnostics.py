@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from analytic.excitation import Pulse
+from trilith_xval.analytic.excitation import Pulse
 
 from . import geometry
 

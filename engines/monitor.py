@@ -22,11 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from analytic import equations as eq
-from analytic.events import free_pendulum_period
-from analytic.options import check_real
-from analytic.sampled_events import EventRule, read_events
-from analytic.trajectory import Event, Trajectory, Verdict
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.events import free_pendulum_period
+from trilith_xval.analytic.options import check_real
+from trilith_xval.analytic.sampled_events import EventRule, read_events
+from trilith_xval.analytic.trajectory import Event, Trajectory, Verdict
 
 __all__ = ["RunMonitor", "MonitorSettings", "propagate_to_zero"]
 

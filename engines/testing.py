@@ -54,14 +54,14 @@ def makris_vassiliou(alpha: float, gamma_mv: float) -> float:
 
 
 def _fig5(**changes):
-    from scenes import load_scene
+    from trilith_xval.scenes import load_scene
     return load_scene("fig5", **changes)
 
 
 def _refused_before_work(backend, match: str, exc, *args, **options) -> None:
     """``backend`` refuses (``exc`` matching ``match``) without building a world."""
-    import engines
-    from engines.base import Engine
+    from trilith_xval import engines
+    from trilith_xval.engines.base import Engine
     built = []
     if issubclass(backend, Engine):
         class Probe(backend):
@@ -80,8 +80,8 @@ def _refused_before_work(backend, match: str, exc, *args, **options) -> None:
 
 # ---------------------------------------------------------------------- checks
 def _contract(backend) -> None:
-    from analytic.options import RunOptions
-    from engines.base import CAPABILITIES, Engine, EngineSettings
+    from trilith_xval.analytic.options import RunOptions
+    from trilith_xval.engines.base import CAPABILITIES, Engine, EngineSettings
     assert isinstance(backend.name, str) and backend.name
     assert all(isinstance(getattr(backend, k), str) for k in ("label", "color", "marker"))
     assert issubclass(backend.Settings, RunOptions)
@@ -107,7 +107,7 @@ def _contract(backend) -> None:
 
 
 def _bad_run_options(backend) -> None:
-    import engines
+    from trilith_xval import engines
     for option, value, exc in (("t_max", -1.0, ValueError), ("t_max", math.nan, ValueError),
                                ("t_max", "2", TypeError), ("theta0", 2.0, ValueError),
                                ("psi0", 4.0, ValueError), ("early_stop", 1, TypeError),
@@ -121,7 +121,7 @@ def _bad_run_options(backend) -> None:
 
 
 def _bad_engine_settings(backend) -> None:
-    import engines
+    from trilith_xval import engines
     for option, value, word in (("dt", 0.0, "dt"), ("dt", 0.5, "dt"),
                                 ("sample_every", 0, "sample_every"),
                                 ("base_motion", "shake", "base_motion"),
@@ -137,7 +137,7 @@ def _bad_engine_settings(backend) -> None:
 
 
 def _bad_input_before_work(backend) -> None:
-    from analytic.excitation import Pulse
+    from trilith_xval.analytic.excitation import Pulse
     scene = _fig5()
     _refused_before_work(backend, "friction must be >=", ValueError, scene, Pulse(25.0, 11.0),
                          friction=0.5)
@@ -152,9 +152,9 @@ def _bad_input_before_work(backend) -> None:
 def _friction_follows_the_excitation(backend) -> None:
     """The documented pulse range (|A| <= 1e4 m/s^2) never fails on friction the
     user did not set; an explicit friction below the bound is still refused."""
-    from analytic.bounds import required_friction
-    from analytic.excitation import Pulse
-    from engines.base import FRICTION_MARGIN
+    from trilith_xval.analytic.bounds import required_friction
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.engines.base import FRICTION_MARGIN
     scene = _fig5()
     for pulse in (Pulse(100.0, 11.0), Pulse(-1e4, 100.0)):
         need = required_friction(scene, pulse)
@@ -164,7 +164,7 @@ def _friction_follows_the_excitation(backend) -> None:
 
 
 def _paper_points(backend) -> None:
-    from scenes import PAPER_OUTCOMES, point_pulse
+    from trilith_xval.scenes import PAPER_OUTCOMES, point_pulse
     fig5 = _fig5()
     for (point, pendulum), expected in PAPER_OUTCOMES.items():
         scene = fig5 if pendulum else fig5.without_pendulum()
@@ -179,8 +179,8 @@ def _free_rocking_impacts(backend, scene, n: int) -> tuple:
     in ``backend``, run to midway between the analytic model's impacts ``n`` and
     ``n + 1`` (the run's impact velocities are the monitor's, propagated to
     ``theta = 0`` from samples away from the impact)."""
-    import engines
-    from analytic.excitation import Still
+    from trilith_xval import engines
+    from trilith_xval.analytic.excitation import Still
     theta0 = 0.5 * scene.alpha
     ref = engines.simulate("analytic", scene, Still(), theta0=theta0, early_stop=False,
                            sample_dt=None, t_cap=60.0)
@@ -205,7 +205,7 @@ def _restitution_eq20(lam: float, mu: float) -> Callable[[type], None]:
 
 def _restitution_eq19(lam: float) -> Callable[[type], None]:
     def check(backend) -> None:
-        from analytic import equations as eq
+        from trilith_xval.analytic import equations as eq
         scene = _fig5(lam=lam)
         b, h, mu, gamma, j, _, _ = scene.model_args()
         impacts = _free_rocking_impacts(backend, scene, 4)
@@ -217,7 +217,7 @@ def _restitution_eq19(lam: float) -> Callable[[type], None]:
 
 
 def _reruns_bit_identical(backend) -> None:
-    from analytic.excitation import Pulse
+    from trilith_xval.analytic.excitation import Pulse
     s = dataclasses.replace(backend.Settings(), t_max=1.0)
     a = backend.simulate(_fig5(), Pulse(19.0, 15.0), s)
     b = backend.simulate(_fig5(), Pulse(19.0, 15.0), s)
@@ -227,8 +227,8 @@ def _reruns_bit_identical(backend) -> None:
 
 
 def _trajectory_carries_settings(backend) -> None:
-    from analytic.excitation import Pulse
-    from engines.base import Engine
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.engines.base import Engine
     s = dataclasses.replace(backend.Settings(), t_max=0.3)
     tr = backend.simulate(_fig5(), Pulse(5.0, 10.0), s)
     assert tr.backend == backend.name and tr.t_max == 0.3 and tr.criterion == s.criterion
@@ -244,8 +244,8 @@ def _moving_ground_agrees(backend) -> None:
     """d'Alembert load vs a moving ground (DESIGN.md): peak angle within 0.1 %
     (measured 0.07 % PyBullet, 0.03 % Pymunk; both are exact for a rigid base,
     the rest is the engines' contact solution)."""
-    import engines
-    from analytic.excitation import Pulse
+    from trilith_xval import engines
+    from trilith_xval.analytic.excitation import Pulse
     pulse = Pulse(12.0, 12.0)
     a = engines.simulate(backend, _fig5(), pulse, t_max=1.0)
     b = engines.simulate(backend, _fig5(), pulse, t_max=1.0, base_motion="ground")
@@ -254,8 +254,8 @@ def _moving_ground_agrees(backend) -> None:
 
 
 def _early_stop_off_runs_to_t_max(backend) -> None:
-    import engines
-    from analytic.excitation import Pulse
+    from trilith_xval import engines
+    from trilith_xval.analytic.excitation import Pulse
     on = engines.simulate(backend, _fig5(), Pulse(5.0, 10.0))
     off = engines.simulate(backend, _fig5(), Pulse(5.0, 10.0), t_max=on.t[-1] + 0.5,
                            early_stop=False)
@@ -269,11 +269,11 @@ def _pendulum_follows_eq1(backend) -> None:
     Tolerances 1e-4 rad and 5e-4 rad/s: measured 2026-11-23 at most 2.0e-5 rad
     (Pymunk; PyBullet and MuJoCo 1.1e-5) and 6.8e-5 rad/s (PyBullet) over 1 s;
     5x headroom for the step error."""
-    import engines
+    from trilith_xval import engines
     from scipy.integrate import solve_ivp
 
-    from analytic import equations as eq
-    from analytic.excitation import Still
+    from trilith_xval.analytic import equations as eq
+    from trilith_xval.analytic.excitation import Still
     fig5 = _fig5()
     tr = engines.simulate(backend, fig5, Still(), psi0=0.1, t_max=1.0, early_stop=False)
     assert tr.max_abs_theta < 1e-6  # the trilith stayed down
@@ -306,7 +306,7 @@ CHECKS: tuple[Check, ...] = (
 
 def checks_for(backend) -> list[Check]:
     """The checks that apply to ``backend`` (a class), by kind and capabilities."""
-    from engines.base import Engine
+    from trilith_xval.engines.base import Engine
     is_engine = issubclass(backend, Engine)
     return [c for c in CHECKS
             if (is_engine or not c.engine) and c.needs <= set(backend.capabilities)]
@@ -316,7 +316,7 @@ def check_backend(name_or_class, slow: bool = True) -> None:
     """Run every applicable check on a backend; ``AssertionError`` naming the first
     that fails (or a known failure that now passes).  ``slow=False`` skips the
     paper points and the restitution grids (minutes)."""
-    import engines
+    from trilith_xval import engines
     backend = engines.get_backend(name_or_class)
     known = getattr(backend, "known_failures", {})
     for check in checks_for(backend):
@@ -338,7 +338,7 @@ def backend_checks(names=None):
     (or ``names``): slow checks marked ``slow``, known failures ``xfail(strict=True)``."""
     import pytest
 
-    import engines
+    from trilith_xval import engines
     params = []
     for name in (names if names is not None else engines.backend_names()):
         backend = engines.get_backend(name)

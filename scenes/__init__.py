@@ -15,7 +15,7 @@ import math
 import tomllib
 from pathlib import Path
 
-from analytic.parameters import Scene
+from trilith_xval.analytic.parameters import Scene
 
 from .ground_motion import load_record
 from .points import PAPER_OUTCOMES, POINTS, point_pulse
@@ -34,7 +34,7 @@ def read_toml(path: Path, what: str) -> dict:
     (``what``: 'scene file', 'campaign file') when it is not a regular file, cannot
     be read, is over :data:`MAX_FILE_BYTES`, is not UTF-8 or not TOML (nesting too
     deep included)."""
-    from scenes.safe_read import read_bytes
+    from trilith_xval.scenes.safe_read import read_bytes
     where = f"{what} {str(path)!r}"
     data = read_bytes(path, where, MAX_FILE_BYTES)
     try:

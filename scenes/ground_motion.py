@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
+from trilith_xval.analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
 
 __all__ = ["load_record", "load_suite", "time_scaled", "G_PEER", "TIME_SCALE_RANGE"]
 
@@ -42,7 +42,7 @@ _OLD_NPTS_DT = re.compile(r"^\s*([0-9]+)\s+([0-9.eE+-]+)\s+NPTS\s*,\s*DT", re.I)
 
 
 def _open_text(path: Path, where: str) -> list[str]:
-    from scenes.safe_read import read_text
+    from trilith_xval.scenes.safe_read import read_text
     if path.is_dir():
         raise ValueError(f"{where}: {str(path)!r} is a directory, not a record file")
     # A BOM is not data (read_text drops it); devices and FIFOs are refused unread.
@@ -167,7 +167,7 @@ def load_record(path, option: str | None = None) -> SampledRecord:
 
     Examples
     --------
-    >>> from scenes import SCENE_DIR
+    >>> from trilith_xval.scenes import SCENE_DIR
     >>> rec = load_record(SCENE_DIR.parent / "records" / "sample.csv")
     >>> rec.end_time
     10.0

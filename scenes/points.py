@@ -8,7 +8,7 @@ survives; C overturns after an impact; D overturns without one.
 """
 from __future__ import annotations
 
-from analytic.excitation import Pulse
+from trilith_xval.analytic.excitation import Pulse
 
 __all__ = ["POINTS", "PAPER_OUTCOMES", "point_pulse"]
 

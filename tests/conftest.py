@@ -11,9 +11,9 @@ import tempfile
 
 import pytest
 
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from scenes import load_scene
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.scenes import load_scene
 
 # Every CLI run of the suite (in process or a subprocess) uses a throwaway run
 # store, never the user's cache.
@@ -36,8 +36,8 @@ def fig5_bare(fig5) -> Scene:
 @functools.lru_cache(maxsize=64)
 def _cached_run(scene: Scene, amplitude: float, omega: float, kind: str,
                 t_max: float | None, criterion: str):
-    from analytic.simulate import Settings, simulate
-    from analytic.trajectory import OverturnCriterion
+    from trilith_xval.analytic.simulate import Settings, simulate
+    from trilith_xval.analytic.trajectory import OverturnCriterion
     settings = Settings(t_max=t_max, criterion=OverturnCriterion(criterion))
     return simulate(scene, Pulse(amplitude, omega, kind), settings)
 
@@ -59,16 +59,17 @@ class WorkStarted(AssertionError):
 @pytest.fixture
 def no_work(monkeypatch):
     """Make every entry point that does real work fail the test."""
-    import analytic.fast
-    import analytic.simulate
-    import analytic.spectrum
-    import compare.campaign.validation
-    import compare.cli.bench
-    import compare.cli.record
-    import compare.cli.view
-    import compare.measure.restitution
-    import compare.report.figures
-    import engines.base
+    import trilith_xval.analytic.fast
+    import trilith_xval.analytic.simulate
+    import trilith_xval.analytic.spectrum
+    import trilith_xval.compare.campaign.validation
+    import trilith_xval.compare.cli.bench
+    import trilith_xval.compare.cli.record
+    import trilith_xval.compare.cli.view
+    import trilith_xval.compare.measure.restitution
+    import trilith_xval.compare.report.figures
+    import trilith_xval.engines.base
+    from trilith_xval import analytic, compare, engines
 
     def boom(*args, **kwargs):
         raise WorkStarted("work started before the input was checked")

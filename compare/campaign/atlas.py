@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compare.run import runs
+from trilith_xval.compare.run import runs
 
 __all__ = ["AtlasConfig", "ATLAS_SCENES", "atlas_scenes", "run_atlas", "base_step"]
 
@@ -58,7 +58,7 @@ class AtlasConfig:
     settings: tuple = ()  # (engine, ((field, value), ...)): a settings file's tables
 
     def __post_init__(self) -> None:
-        from engines import ENGINES
+        from trilith_xval.engines import ENGINES
         for e in self.engines:
             if e not in ENGINES:
                 raise ValueError(f"engines: unknown engine {e!r}; allowed: {', '.join(ENGINES)}")
@@ -80,13 +80,13 @@ class AtlasConfig:
 
 
 def _default_engines() -> tuple[str, ...]:
-    from engines import default_engines
+    from trilith_xval.engines import default_engines
     return default_engines()
 
 
 def atlas_scenes(config: AtlasConfig) -> list[tuple[str, str]]:
     """``(scene name, pulse)`` of every atlas scene, globs resolved."""
-    from scenes import scene_names
+    from trilith_xval.scenes import scene_names
     out = []
     for pattern, pulse in config.scenes:
         hits = [n for n in scene_names() if fnmatch.fnmatchcase(n, pattern)]
@@ -100,10 +100,10 @@ def base_step(engine: str, config: AtlasConfig) -> float:
     """The engine's threshold step [s] for the atlas: its calibrated step when every
     atlas scene lies in the calibration's domain, else its reference step (a
     settings file's step over either)."""
-    from engines import configure
+    from trilith_xval.engines import configure
 
-    from compare.campaign.settings_file import threshold_options
-    from compare.campaign.study import _scene
+    from trilith_xval.compare.campaign.settings_file import threshold_options
+    from trilith_xval.compare.campaign.study import _scene
     per_scene = [threshold_options(engine, _scene(n, c)) for n, _ in atlas_scenes(config)
                  for c in config.cases]
     common = per_scene[0] if all(o == per_scene[0] for o in per_scene) else {}
@@ -112,10 +112,10 @@ def base_step(engine: str, config: AtlasConfig) -> float:
 
 def _validity(job: tuple) -> dict:
     """The model's validity on its run at the threshold, through the store."""
-    from analytic.threshold_validity import point_validity
+    from trilith_xval.analytic.threshold_validity import point_validity
 
-    from compare.campaign.study import _scene
-    from compare.run.keys import scene_dict
+    from trilith_xval.compare.campaign.study import _scene
+    from trilith_xval.compare.run.keys import scene_dict
     name, case, pulse, omega, a_ref = job
     scene = _scene(name, case)
     return runs.memo("point-validity", {"scene": scene_dict(scene), "omega": float(omega),
@@ -193,8 +193,8 @@ def _run_round(todo0: list[int], points: list[dict], config: AtlasConfig, steps:
     by ``deadline`` is counted in ``not_run`` at its step (its coarser steps are
     not run either); a job in ``done`` (an identical trick measured before) runs
     once."""
-    from compare.campaign.study import ThresholdJob, run_threshold
-    from compare.run.keys import digest
+    from trilith_xval.compare.campaign.study import ThresholdJob, run_threshold
+    from trilith_xval.compare.run.keys import digest
 
     for e in config.engines:
         todo = list(todo0)
@@ -235,8 +235,8 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     :func:`spread_order`, each round through every step, so a budget leaves a
     coarser Omega grid on every scene, measured at every step.
     """
-    from compare.campaign.study import run_reference
-    from compare.run.keys import backend_version, project_version
+    from trilith_xval.compare.campaign.study import run_reference
+    from trilith_xval.compare.run.keys import backend_version, project_version
 
     t0, c0, load0 = time.perf_counter(), time.process_time(), os.getloadavg()[0]
     w0 = _workers_cpu_s()

@@ -83,7 +83,7 @@ def check_atlas(doc, where: str) -> dict:
     ValueError
         Naming ``where`` and the first missing or mistyped key.
     """
-    from scenes.safe_read import check_schema
+    from trilith_xval.scenes.safe_read import check_schema
     check_schema(doc, where, ATLAS_SCHEMAS)
     for name in ("config", "steps", "points"):
         if name not in doc:
@@ -119,6 +119,6 @@ def check_atlas(doc, where: str) -> dict:
 def read_atlas(path: str, option: str = "--from") -> dict:
     """A stored atlas read safely (:func:`scenes.safe_read.read_json`) and
     checked (:func:`check_atlas`); ``ValueError`` naming ``option`` and the file."""
-    from scenes.safe_read import read_json
+    from trilith_xval.scenes.safe_read import read_json
     where = f"{option} {str(path)!r}"
     return check_atlas(read_json(path, where), where)

@@ -107,7 +107,7 @@ def merge_atlases(docs: list[dict], names: list[str] | None = None) -> dict:
         points.append({**pt, "engines": {e: rows[e] for e in engines}})
     parts = [part for doc in docs for part in _parts_of(doc)]
     loads = [x for part in parts for x in (part.get("load_average") or [])]
-    from engines import engine_names
+    from trilith_xval.engines import engine_names
     return {"schema_version": first.get("schema_version", 1), "what": first.get("what"),
             "config": {**first["config"], "engines": engines,
                        "settings": {e: s for doc in docs

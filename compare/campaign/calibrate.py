@@ -41,7 +41,7 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from analytic._workers import cpu_seconds
+from trilith_xval.analytic._workers import cpu_seconds
 
 __all__ = ["METRICS", "ValidationSet", "Evaluation", "Calibration", "calibrate",
            "default_space", "default_tolerance", "pareto_front"]
@@ -158,7 +158,7 @@ class Calibration:
 
 def default_tolerance(metric: str) -> float:
     """The validation campaign's tolerance for ``metric`` (one source for both)."""
-    from compare.campaign.config import Tolerances
+    from trilith_xval.compare.campaign.config import Tolerances
     t = Tolerances()
     return {"restitution": t.restitution, "thresholds": t.threshold,
             "histories": t.theta_rms_first}[metric]
@@ -180,7 +180,7 @@ def default_space(engine: str, step_only: bool = False, base: dict | None = None
     :data:`DT_FACTORS`, plus (unless ``step_only``) the engine's own declared
     search ranges (``calibration_space`` on its class: each includes the
     calibrated default)."""
-    import engines
+    from trilith_xval import engines
     base = engines.configure(engine, **(base or {}))
     space = {"dt": [base.dt * f for f in DT_FACTORS]}
     if not step_only:
@@ -196,7 +196,7 @@ def _candidates(space: dict) -> list[dict]:
 
 # ------------------------------------------------------------------ the three metrics
 def _restitution(engine, scene, vs: ValidationSet, options):
-    from compare.measure.restitution import measure_restitution
+    from trilith_xval.compare.measure.restitution import measure_restitution
     cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
              for lam, mu in vs.releases]
     if scene.has_pendulum:
@@ -212,7 +212,7 @@ def _restitution(engine, scene, vs: ValidationSet, options):
 
 
 def _thresholds(engine, scene, reference, options, workers):
-    from compare.measure.engine_spectrum import engine_spectrum
+    from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
     es = engine_spectrum(engine, scene, reference, workers=workers, **options)
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for curve, points in es.curves.items():
@@ -230,9 +230,9 @@ def _thresholds(engine, scene, reference, options, workers):
 
 
 def _histories(engine, scene, vs: ValidationSet, options):
-    import engines
-    from compare.measure.trajectories import compare_trajectories
-    from scenes import point_pulse
+    from trilith_xval import engines
+    from trilith_xval.compare.measure.trajectories import compare_trajectories
+    from trilith_xval.scenes import point_pulse
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for sc in (scene, scene.without_pendulum()) if scene.has_pendulum else (scene,):
         for point in vs.points:
@@ -286,9 +286,9 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     -------
     Calibration
     """
-    import engines
-    from compare.run import runs
-    from scenes import load_scene
+    from trilith_xval import engines
+    from trilith_xval.compare.run import runs
+    from trilith_xval.scenes import load_scene
     if metric not in METRICS:
         raise ValueError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
     if tolerance is None:
@@ -319,9 +319,9 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
             return _restitution(engine, sc, vs, cand)
         if metric == "thresholds":
             if id(sc) not in reference:
-                from analytic.spectrum import overturning_spectrum
+                from trilith_xval.analytic.spectrum import overturning_spectrum
 
-                from compare.campaign.design import scene_omegas
+                from trilith_xval.compare.campaign.design import scene_omegas
                 reference[id(sc)] = overturning_spectrum(
                     sc, list(vs.omegas) if vs.omegas else scene_omegas(sc))
             return _thresholds(engine, sc, reference[id(sc)], cand, workers)
@@ -362,7 +362,7 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
 def _candidate_description(engine: str, metric: str, vs: ValidationSet, scenes,
                            cand: dict) -> dict:
     """Everything that determines one candidate's evaluation (its store key)."""
-    from compare.run.keys import backend_version, scene_dict
+    from trilith_xval.compare.run.keys import backend_version, scene_dict
     return {"engine": engine, "version": backend_version(engine), "metric": metric,
             "validation": dataclasses.asdict(vs), "scenes": [scene_dict(sc) for sc in scenes],
             "candidate": dict(sorted(cand.items()))}

@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from analytic.options import MAX_ENGINE_DT
-from engines import ENGINES, configure
-from scenes import POINTS
+from trilith_xval.analytic.options import MAX_ENGINE_DT
+from trilith_xval.engines import ENGINES, configure
+from trilith_xval.scenes import POINTS
 
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
 __all__ = ["Tolerances", "CampaignConfig", "engine_options", "backend_settings"]
 
@@ -131,10 +131,10 @@ def engine_options(name: str, config: CampaignConfig, thresholds: bool = False,
     threshold settings where the scene lies in their domain
     (:func:`compare.campaign.settings_file.threshold_options`) first, then its
     settings-file table, then ``engine_dt`` (engines only)."""
-    from compare.campaign.settings_file import threshold_options
+    from trilith_xval.compare.campaign.settings_file import threshold_options
     options = {}
     if thresholds and name in ENGINES:
-        from scenes import load_scene
+        from trilith_xval.scenes import load_scene
         options = threshold_options(name, scene if scene is not None
                                     else load_scene(config.scene))
     options.update(config.engine_settings.get(name, {}))

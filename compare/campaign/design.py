@@ -39,7 +39,7 @@ def design_scenes(n: int, seed: int = SEED, ranges: dict | None = None,
     named ``prefix1`` ... ``prefixN``; values rounded to 4 decimals (SI)."""
     from scipy.stats import qmc
 
-    from analytic.parameters import Scene
+    from trilith_xval.analytic.parameters import Scene
     if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 200:
         raise ValueError(f"n must be an integer in [1, 200], got {n!r}")
     ranges = dict(RANGES if ranges is None else ranges)

@@ -44,7 +44,7 @@ def parse_range(spec: str, option: str, unit: str = "rad/s", lo: float = 0.0,
 def parse_omega_range(spec: str, option: str = "--omega"):
     """``'START:STOP:STEP'`` (STOP included) or ``'W1,W2,...'`` -> frequencies in
     ``analytic.excitation.OMEGA_RANGE`` [rad/s] (a pulse lasts at most 2 pi / 0.1 s)."""
-    from analytic.excitation import OMEGA_RANGE
+    from trilith_xval.analytic.excitation import OMEGA_RANGE
     lo, hi = OMEGA_RANGE
     values = parse_range(spec, option, "rad/s", 0.0, hi)
     if values.min() < lo:

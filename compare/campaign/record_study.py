@@ -39,7 +39,7 @@ class RecordAxis:
 
     def records(self):
         """The records, loaded (checked at the door already)."""
-        from scenes.ground_motion import load_suite
+        from trilith_xval.scenes.ground_motion import load_suite
         return load_suite(self.suite)
 
 
@@ -47,8 +47,8 @@ def parse_records(table, where: str) -> RecordAxis:
     """The ``[campaign.records]`` table as a :class:`RecordAxis`; ``ValueError``
     naming the file and key (an unknown key, a missing suite, a bad range, an
     unreadable record)."""
-    from analytic.ida import IDASettings
-    from scenes.ground_motion import load_suite
+    from trilith_xval.analytic.ida import IDASettings
+    from trilith_xval.scenes.ground_motion import load_suite
 
     if not isinstance(table, dict):
         raise ValueError(f"{where}: campaign.records must be a table ([campaign.records])")

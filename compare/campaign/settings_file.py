@@ -73,7 +73,7 @@ def read_settings_file(path) -> SettingsFile:
         per run (:data:`RUN_FIELDS`) or a value the engine refuses; the message
         starts with the file's name.
     """
-    from scenes.safe_read import read_bytes
+    from trilith_xval.scenes.safe_read import read_bytes
     p = Path(path)
     where = f"settings file {str(p)!r}"
     data = read_bytes(p, where, MAX_BYTES)
@@ -85,8 +85,8 @@ def read_settings_file(path) -> SettingsFile:
 
 
 def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
-    import engines
-    from engines.calibration import RESERVED_TABLES
+    from trilith_xval import engines
+    from trilith_xval.engines.calibration import RESERVED_TABLES
     known = engines.engine_names()
     out = {}
     for name, table in doc.items():
@@ -117,14 +117,14 @@ def threshold_options(engine: str, scene) -> dict:
     engine's calibrated threshold settings when ``scene`` lies in their domain,
     else none (the reference settings; :func:`engines.calibration.threshold_choice`).
     A ``--settings`` file and ``--dt`` go over them."""
-    from engines.calibration import threshold_choice
+    from trilith_xval.engines.calibration import threshold_choice
     return threshold_choice(engine, scene).options
 
 
 def domain_notes(engines, scenes) -> list[str]:
     """One line per (engine, scene) whose calibrated threshold step does not hold
     there (the reference step runs), for a command to print before it works."""
-    from engines.calibration import threshold_choice
+    from trilith_xval.engines.calibration import threshold_choice
     out = []
     for e in engines:
         for sc in scenes:

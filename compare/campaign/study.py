@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analytic.options import MAX_ENGINE_DT
-from engines import ENGINES
-from scenes import load_scene, read_toml, scene_names
+from trilith_xval.analytic.options import MAX_ENGINE_DT
+from trilith_xval.engines import ENGINES
+from trilith_xval.scenes import load_scene, read_toml, scene_names
 
 __all__ = ["Study", "ThresholdJob", "load_study", "reference_jobs", "threshold_jobs",
            "run_reference",
@@ -103,8 +103,8 @@ def load_study(path) -> Study:
     it picks the default output folder ``campaign-<name>`` in the working
     directory, which a file must not be able to point elsewhere.
     """
-    from analytic.pulses import PULSE_FAMILY
-    from compare.campaign.grids import parse_omega_range
+    from trilith_xval.analytic.pulses import PULSE_FAMILY
+    from trilith_xval.compare.campaign.grids import parse_omega_range
 
     path = Path(path)
     where = str(path)
@@ -142,7 +142,7 @@ def load_study(path) -> Study:
             raise ValueError(f"{where}: pulses: {p!r} is not one of {', '.join(PULSE_FAMILY)}")
     records = None
     if "records" in table:
-        from compare.campaign.record_study import parse_records
+        from trilith_xval.compare.campaign.record_study import parse_records
         records = parse_records(table["records"], where)
     omega = table.get("omega")
     if omega is None and records is not None:
@@ -199,10 +199,10 @@ def reference_jobs(study: Study) -> list[tuple]:
 def run_reference(job: tuple) -> tuple[float, str | None]:
     """The analytic first overturning amplitude and mode, through the store (the
     same entry as the validation report's reference spectra)."""
-    from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
+    from trilith_xval.analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
-    from compare.run import runs
-    from compare.run.keys import scene_dict
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import scene_dict
 
     name, case, pulse, omega = job
     scene, ss = _scene(name, case), SpectrumSettings(pulse=pulse)
@@ -237,8 +237,8 @@ class ThresholdJob:
     def spec(self):
         """The search's run: calibration (in its domain), the settings file, ``dt``,
         and friction for the largest pulse of the bisection (2 ``a_ref``)."""
-        from analytic.pulses import pulse_of
-        from compare.run.spec import RunSpec
+        from trilith_xval.analytic.pulses import pulse_of
+        from trilith_xval.compare.run.spec import RunSpec
         scene = _scene(self.scene, self.case)
         return RunSpec.resolve(self.engine, scene, pulse_of(self.pulse, 2.0 * self.a_ref,
                                                             self.omega),
@@ -248,7 +248,7 @@ class ThresholdJob:
 
     def description(self) -> dict:
         """Everything that determines the job's result (its store key)."""
-        from compare.run.keys import backend_version, scene_dict, settings_dict
+        from trilith_xval.compare.run.keys import backend_version, scene_dict, settings_dict
         return {"engine": self.engine, "version": backend_version(self.engine),
                 "scene": scene_dict(self.spec.scene), "pulse": self.pulse,
                 "omega": self.omega, "a_ref": self.a_ref, "mode_ref": self.mode_ref,
@@ -279,8 +279,8 @@ def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
     resolves them: the engine's calibrated threshold settings (in their domain),
     ``options`` (a settings file's table) over them, at time step ``dt`` (0: the
     table's step, else the calibrated one), friction for pulses up to 2 ``a_ref``."""
-    from analytic.pulses import pulse_of
-    from compare.run.spec import RunSpec
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.compare.run.spec import RunSpec
     return RunSpec.resolve(engine, scene, pulse_of(pulse, 2.0 * a_ref, omega), calibrated=True,
                            file_options=dict(options), file_name="file",
                            overrides={"dt": dt} if dt else None).settings
@@ -293,8 +293,8 @@ def threshold_description(job: ThresholdJob) -> dict:
 
 def run_threshold(job: ThresholdJob) -> dict:
     """One engine threshold (a row of the combined report), through the store."""
-    from compare.run import runs
-    from compare.measure.engine_spectrum import measure_point
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.measure.engine_spectrum import measure_point
 
     n, c, p, w, a_ref, mode, e, dt = (job.scene, job.case, job.pulse, job.omega, job.a_ref,
                                       job.mode_ref, job.engine, job.dt)

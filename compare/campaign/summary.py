@@ -369,7 +369,7 @@ def load(path: str | Path) -> Summary:
     """Read ``summary.json`` at ``path`` into a :class:`Summary`; ``ValueError``
     naming the file when it is not a regular file, too large, nested too deep,
     of a schema this version does not read, or not shaped like a summary."""
-    from scenes.safe_read import read_json
+    from trilith_xval.scenes.safe_read import read_json
     where = f"summary file {str(path)!r}"
     doc = read_json(path, where, schema_versions=range(1, SCHEMA_VERSION + 1))
     try:

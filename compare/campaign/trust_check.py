@@ -63,8 +63,8 @@ class _Progress:
 
 def _band(scene, workers: int) -> dict:
     """The model's spectrum and validity; per curve the valid frequencies."""
-    from analytic.spectrum import overturning_spectrum
-    from analytic.threshold_validity import spectrum_validity
+    from trilith_xval.analytic.spectrum import overturning_spectrum
+    from trilith_xval.analytic.threshold_validity import spectrum_validity
     p = math.sqrt(3.0 * scene.g / (4.0 * scene.R))
     omegas = [round(p * f, 4) for f in GRID_OVER_P]
     spec = overturning_spectrum(scene, omegas, workers=workers)
@@ -92,7 +92,7 @@ def _spread(rows: list[dict], n: int) -> list[dict]:
 
 
 def _thresholds(engine, scene, band, options, progress) -> list[dict]:
-    from compare.measure.engine_spectrum import measure_point
+    from trilith_xval.compare.measure.engine_spectrum import measure_point
     jobs = [(case, r) for case, rows in band["curves"].items()
             for r in _spread(rows, N_THRESHOLDS)]
     out = []
@@ -113,7 +113,7 @@ def _thresholds(engine, scene, band, options, progress) -> list[dict]:
 
 
 def _restitution(engine, scene, tol) -> list[dict]:
-    from compare.measure.restitution import measure_restitution
+    from trilith_xval.compare.measure.restitution import measure_restitution
     cases = [("Eq. 20", scene.without_pendulum(), tol.restitution)]
     if scene.has_pendulum:
         cases.append(("Eq. 19", scene, tol.restitution_pendulum))
@@ -128,10 +128,10 @@ def _restitution(engine, scene, tol) -> list[dict]:
 
 
 def _histories(engine, scene, band, tol) -> list[dict]:
-    import engines
-    from analytic.excitation import Pulse
-    from compare.measure.trajectories import compare_trajectories
-    from compare.run import runs
+    from trilith_xval import engines
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.measure.trajectories import compare_trajectories
+    from trilith_xval.compare.run import runs
     out = []
     for case, rows in band["curves"].items():
         picked = _spread(rows, 3)
@@ -156,8 +156,8 @@ def _histories(engine, scene, band, tol) -> list[dict]:
 def _records(engine, scene, records, options) -> list[dict]:
     """Each record's first overturning intensity: the model's (window-aware IDA,
     the accurate model) against the engine's robust one under the step rule."""
-    from analytic.ida import IDASettings, first_overturn_intensity, model_verdict
-    from compare.measure.record_threshold import STEP_TOL, engine_intensity
+    from trilith_xval.analytic.ida import IDASettings, first_overturn_intensity, model_verdict
+    from trilith_xval.compare.measure.record_threshold import STEP_TOL, engine_intensity
     st = IDASettings()
     out = []
     for rec in records:
@@ -178,7 +178,7 @@ def _verdict(points: list[dict]) -> dict:
     failing point is 'discretisation'), or not (the first other cause); points
     where the model is no fair reference (the report's excused causes: invalid,
     a mode jump, an overturning window) are listed, never held against it."""
-    from compare.report.trust import EXCUSED
+    from trilith_xval.compare.report.trust import EXCUSED
     judged = [p for p in points if p["cause"] not in EXCUSED]
     excused = [p for p in points if p["cause"] in EXCUSED]
     note = (f"; {len(excused)} point(s) where the model is no fair reference: "
@@ -203,11 +203,11 @@ def _verdict(points: list[dict]) -> dict:
 
 def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = False) -> dict:
     """The trust document of ``scene`` for ``engines`` (module docstring)."""
-    from engines import configure, get_backend
-    from engines.calibration import threshold_choice
+    from trilith_xval.engines import configure, get_backend
+    from trilith_xval.engines.calibration import threshold_choice
 
-    from compare.campaign.config import Tolerances
-    from compare.run.keys import project_version
+    from trilith_xval.compare.campaign.config import Tolerances
+    from trilith_xval.compare.run.keys import project_version
     tol = Tolerances()
     t0, c0, load0 = time.perf_counter(), _cpu(), os.getloadavg()[0]
     progress = _Progress(1 + 3 * len(engines) + (len(engines) if records else 0), quiet)
@@ -255,5 +255,5 @@ def _cost(entry: dict) -> dict:
 
 
 def _cpu() -> float:
-    from analytic._workers import cpu_seconds
+    from trilith_xval.analytic._workers import cpu_seconds
     return cpu_seconds()

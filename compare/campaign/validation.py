@@ -23,22 +23,22 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from analytic.excitation import Pulse
-from engines import configure
-from scenes import POINTS, load_scene
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.engines import configure
+from trilith_xval.scenes import POINTS, load_scene
 
 
-from compare.measure import trajectories as metrics
+from trilith_xval.compare.measure import trajectories as metrics
 
 
-from compare.campaign.config import CampaignConfig, backend_settings, engine_options
-from compare.campaign.config import Tolerances  # noqa: F401  (in __all__)
-from compare.run import runs
-from compare.run.jsonable import plain
-from compare.run.keys import backend_version
-from compare.measure.restitution import RestitutionResult, measure_restitution
-from compare.measure.reference_spectra import choose_frequencies, reference_spectrum
-from compare.measure.jump_shift import engine_jump_frequency
+from trilith_xval.compare.campaign.config import CampaignConfig, backend_settings, engine_options
+from trilith_xval.compare.campaign.config import Tolerances  # noqa: F401  (in __all__)
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.compare.run.keys import backend_version
+from trilith_xval.compare.measure.restitution import RestitutionResult, measure_restitution
+from trilith_xval.compare.measure.reference_spectra import choose_frequencies, reference_spectrum
+from trilith_xval.compare.measure.jump_shift import engine_jump_frequency
 
 __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
            "engine_options", "free_rocking_restitution"]
@@ -48,7 +48,7 @@ __all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
 def _domain_entry(engine: str, scene) -> dict:
     """Whether ``scene`` lies in the domain of ``engine``'s calibrated threshold
     step, the domain and the held-out result it was validated with."""
-    from engines.calibration import calibrated, threshold_choice
+    from trilith_xval.engines.calibration import calibrated, threshold_choice
     cal, choice = calibrated(engine), threshold_choice(engine, scene)
     return {"calibrated": bool(cal.options), "inside": choice.inside, "note": choice.note,
             "domain": cal.domain.as_dict() if cal.options else None,
@@ -73,13 +73,13 @@ def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = N
 def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omega: float):
     """Calibrated settings (with the campaign's ``engine_dt``) and the friction raised
     for the largest pulse of the job (:func:`compare.measure.engine_spectrum.pulse_settings`)."""
-    from compare.measure.engine_spectrum import pulse_settings
+    from trilith_xval.compare.measure.engine_spectrum import pulse_settings
     return pulse_settings(name, scene, a_max, omega, **engine_options(name, config))
 
 
 def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
     """The one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`)."""
-    from compare.measure.engine_spectrum import measure_point
+    from trilith_xval.compare.measure.engine_spectrum import measure_point
     return measure_point(name, scene, omega, a_ref, mode_ref, case=case,
                          tol=config.tolerances.threshold, rel_tol=config.rel_tol,
                          convergence=True,
@@ -93,7 +93,7 @@ def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
 
 
 def _job_long_run(name, label, scene_name, amplitude, omega, config):
-    from compare.measure.long_runs import long_run
+    from trilith_xval.compare.measure.long_runs import long_run
     return long_run(name, label, scene_name, amplitude, omega, config.long_run_t_max,
                     backend_settings(name, config))
 
@@ -199,7 +199,7 @@ def _memo(kind: str, scene, config: CampaignConfig, compute):
     """A model-side result (reference spectrum, chosen frequencies) through the run
     store, keyed by the scene and the config (but its worker count: no number
     depends on it)."""
-    from compare.run.keys import scene_dict
+    from trilith_xval.compare.run.keys import scene_dict
     described = {k: v for k, v in config.to_dict().items() if k != "workers"}
     return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute,
                      code=runs.ALL_CODE)
@@ -253,7 +253,7 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
     """Run the validation campaign described by ``config`` (default: full);
     ``progress``: a stderr line per tenth of the jobs when stderr is no terminal
     (tqdm's bar when it is)."""
-    from compare.campaign.verdicts import build_verdicts
+    from trilith_xval.compare.campaign.verdicts import build_verdicts
 
     config = config or CampaignConfig()
     t_start = time.perf_counter()
@@ -315,7 +315,7 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
                 labels.append(("restitution", True, name))
 
     if config.long_runs:
-        from compare.measure.long_runs import LONG_RUNS
+        from trilith_xval.compare.measure.long_runs import LONG_RUNS
         for name in config.engines:
             for label, scene_name, amplitude, omega in LONG_RUNS:
                 jobs.append(("long_run", (name, label, scene_name, amplitude, omega, config)))

@@ -94,7 +94,7 @@ def build_verdicts(result) -> list[dict]:
                              why["theta_rms_first"], "fraction of alpha", n_cases))
         longs = [r for r in getattr(result, "long_runs", []) if r["backend"] == name]
         if longs:
-            from compare.measure.long_runs import MAX_CREEP
+            from trilith_xval.compare.measure.long_runs import MAX_CREEP
             bad = [r for r in longs if not r["passed"]]
             rows.append({
                 "id": "long_run", "metric": "long runs (fixed window, no early stop): verdict "

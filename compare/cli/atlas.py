@@ -17,7 +17,7 @@ import argparse
 import json
 import sys
 
-from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_store_args,
+from trilith_xval.compare.cli.options import (add_engine_list_arg, add_settings_arg, add_store_args,
                                  add_workers_arg, check_output_path, info,
                                  parse_engine_list, parse_omega_range, resolve_workers,
                                  settings_from_args, use_store)
@@ -71,7 +71,7 @@ def _join_command(args: argparse.Namespace, sources: list) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.campaign.atlas import AtlasConfig, run_atlas
+    from trilith_xval.compare.campaign.atlas import AtlasConfig, run_atlas
 
     if args.json is not None:
         check_output_path(args.json, "--json", suffixes=(".json",))
@@ -81,11 +81,11 @@ def run(args: argparse.Namespace) -> int:
     if sources is not None:
         if args.html is None and args.json is None:
             raise ValueError("--from reads stored atlases: give --html FILE and/or --json FILE")
-        from compare.campaign.atlas_check import read_atlas
+        from trilith_xval.compare.campaign.atlas_check import read_atlas
         docs = [read_atlas(path) for path in sources]
         if len(docs) > 1:
-            from compare.campaign.atlas_merge import merge_atlases
-            from compare.run.provenance import collect
+            from trilith_xval.compare.campaign.atlas_merge import merge_atlases
+            from trilith_xval.compare.run.provenance import collect
             doc = merge_atlases(docs, [f"--from {p!r}" for p in sources])
             doc["provenance"] = collect(args)
             # A join runs nothing: engines, grid, workers and store do not apply.
@@ -112,23 +112,23 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"--time-budget must be in [0, 1e5] min, got {budget!r}")
         workers = resolve_workers(args.workers)
         use_store(args)
-        from compare.campaign.atlas import atlas_scenes
-        from compare.campaign.study import _scene
-        from compare.cli.options import step_notes
+        from trilith_xval.compare.campaign.atlas import atlas_scenes
+        from trilith_xval.compare.campaign.study import _scene
+        from trilith_xval.compare.cli.options import step_notes
         step_notes(engines, [_scene(n, c) for n, _ in atlas_scenes(config)
                              for c in config.cases])
         doc = run_atlas(config, workers, None if budget is None else 60.0 * budget)
-        from engines import engine_names
+        from trilith_xval.engines import engine_names
         doc["engines_not_run"] = [e for e in engine_names() if e not in engines]
         doc["settings_file"] = None if loaded is None else loaded.describe()
-        from compare.run.provenance import collect
+        from trilith_xval.compare.run.provenance import collect
         doc["provenance"] = collect(args)
         doc["command"] = doc["provenance"]["command"]
         page = _render(doc, args, "the atlas")
         if args.json is not None:
             _write_json(args.json, doc)
     if page is not None:
-        from compare.run import atomic
+        from trilith_xval.compare.run import atomic
         atomic.write_text(args.html, page)
         info(f"wrote {args.html}")
     _print(doc)
@@ -139,7 +139,7 @@ def _render(doc: dict, args: argparse.Namespace, where: str) -> str | None:
     """The HTML page (when ``--html``) and the printed rows, built in memory before
     any file is written: a document the checks let through but the renderer
     cannot read is still refused with nothing written."""
-    from compare.report.atlas_page import page_html, trusted_rows
+    from trilith_xval.compare.report.atlas_page import page_html, trusted_rows
     try:
         trusted_rows(doc)
         return page_html(doc) if args.html is not None else None
@@ -149,8 +149,8 @@ def _render(doc: dict, args: argparse.Namespace, where: str) -> str | None:
 
 
 def _write_json(path: str, doc: dict) -> None:
-    from compare.run import atomic
-    from compare.run.jsonable import plain
+    from trilith_xval.compare.run import atomic
+    from trilith_xval.compare.run.jsonable import plain
     atomic.write_text(path, json.dumps(plain(doc), separators=(",", ":"), allow_nan=False)
                       + "\n")
     info(f"wrote {path}")
@@ -158,7 +158,7 @@ def _write_json(path: str, doc: dict) -> None:
 
 def _print(doc: dict) -> None:
     """The trusted region per engine and step, one line each."""
-    from compare.report.atlas_page import trusted_rows
+    from trilith_xval.compare.report.atlas_page import trusted_rows
     print("engine, step [s]: points that agree / valid points reached (share), worst |error|; "
           "where not", file=sys.stdout)
     for engine, dt, agree, share, worst, where in trusted_rows(doc):

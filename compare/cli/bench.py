@@ -14,11 +14,11 @@ import importlib
 import math
 from pathlib import Path
 
-from compare.cli.options import (add_engine_list_arg, add_store_args, check_output_path, info,
+from trilith_xval.compare.cli.options import (add_engine_list_arg, add_store_args, check_output_path, info,
                       parse_engine_list, use_store)
 
 ROOT = Path(__file__).resolve().parents[2]
-from engines import engine_names
+from trilith_xval.engines import engine_names
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
                                                           files=())
     bench = _load_bench()
     if out is not None:
-        from compare.run.atomic import check_into
+        from trilith_xval.compare.run.atomic import check_into
         check_into(out, bench.output_names(), "--out")
     use_store(args)
     payload = bench.run(quick=args.quick, out=out, engines=engines,

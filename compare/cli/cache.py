@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 
-from compare.cli.options import envelope, info, print_json
+from trilith_xval.compare.cli.options import envelope, info, print_json
 
 
 def add_parser(subparsers) -> None:
@@ -39,8 +39,8 @@ def _mib(n: int) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.cli.options import store_location
-    from compare.run.store import RunStore
+    from trilith_xval.compare.cli.options import store_location
+    from trilith_xval.compare.run.store import RunStore
 
     directory, source = store_location(args)
     store = RunStore(directory, check_database=args.action != "clear", source=source)
@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _act(store, args) -> int:
-    from compare.run.keys import CODE_SETS, code_version
+    from trilith_xval.compare.run.keys import CODE_SETS, code_version
     current = {code_version(packages) for packages in CODE_SETS}
     if args.action == "clear":
         n = store.clear()

@@ -5,20 +5,20 @@ import argparse
 import math
 import sys
 
-from analytic.options import MAX_ENGINE_DT
+from trilith_xval.analytic.options import MAX_ENGINE_DT
 
-from compare.cli import options as _common
-from compare.cli.excitation_args import check_run_budget
-from compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_settings_arg,
+from trilith_xval.compare.cli import options as _common
+from trilith_xval.compare.cli.excitation_args import check_run_budget
+from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add_settings_arg,
                                  add_store_args, add_workers_arg, check_output_path, envelope,
                                  file_options, info, resolve_workers,
                                  settings_from_args, settings_line, sig, use_store)
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from compare.campaign.calibrate import DT_FACTORS, METRICS
-    from engines import engine_names
+    from trilith_xval.compare.campaign.calibrate import DT_FACTORS, METRICS
+    from trilith_xval.engines import engine_names
     parser = subparsers.add_parser(
         "calibrate",
         help="the cheapest engine settings meeting a tolerance on a validation set: "
@@ -92,7 +92,7 @@ def _omegas(text: str) -> tuple[float, ...]:
 
 
 def _space(args, engine: str, base: dict) -> dict:
-    from compare.campaign.calibrate import MAX_CANDIDATES, default_space
+    from trilith_xval.compare.campaign.calibrate import MAX_CANDIDATES, default_space
     space = default_space(engine, step_only=args.step_only, base=base)
     if args.dt is not None:
         space["dt"] = [float(_number(v.strip(), "--dt")) for v in args.dt.split(",") if v.strip()]
@@ -122,8 +122,8 @@ def _check_budget(engine: str, space: dict, vs, base: dict, source: str = "--dt"
     step the default search multiplies)."""
     import dataclasses
 
-    from analytic.excitation import Pulse
-    from engines import configure
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.engines import configure
 
     settings = configure(engine, **base)
     for dt in space.get("dt", [settings.dt]):
@@ -136,16 +136,16 @@ def _check_budget(engine: str, space: dict, vs, base: dict, source: str = "--dt"
 
 def _lowest_omega(vs, scenes) -> float:
     """The lowest validation frequency (the longest pulse) [rad/s]."""
-    from compare.campaign.design import scene_omegas
+    from trilith_xval.compare.campaign.design import scene_omegas
     if vs.omegas:
         return min(vs.omegas)
     return min(w for sc in scenes for w in scene_omegas(sc))
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.campaign.calibrate import ValidationSet, calibrate
-    from compare.campaign.settings_file import settings_toml
-    from compare.run import atomic
+    from trilith_xval.compare.campaign.calibrate import ValidationSet, calibrate
+    from trilith_xval.compare.campaign.settings_file import settings_toml
+    from trilith_xval.compare.run import atomic
 
     engine = _common.parse_engine_list(args.engine)
     if len(engine) != 1:
@@ -211,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
         atomic.write_text(args.csv, _csv(cal))
         info(f"wrote {args.csv}")
     if args.plot is not None:
-        from compare.report.calibration_plot import pareto_plot
+        from trilith_xval.compare.report.calibration_plot import pareto_plot
         pareto_plot(cal, args.plot)
         info(f"wrote {args.plot}")
     rec = cal.recommended
@@ -256,7 +256,7 @@ def _design(args):
         if args.seed is not None:
             raise ValueError("--seed: only with --design")
         return None
-    from compare.campaign.design import SEED, design_scenes
+    from trilith_xval.compare.campaign.design import SEED, design_scenes
     if args.metric != "thresholds":
         raise ValueError("--design: only for --metric thresholds")
     if args.scene or args.overrides or args.no_pendulum:
@@ -278,7 +278,7 @@ def _design(args):
 
 def _held_out(engine, args, cal, held, vs, base, workers):
     """The recommended settings' worst error on the held-out scenes (one candidate)."""
-    from compare.campaign.calibrate import ValidationSet, calibrate
+    from trilith_xval.compare.campaign.calibrate import ValidationSet, calibrate
     names = tuple(sc.name for sc in held)
     ev = calibrate(engine, "thresholds", validation=ValidationSet(scene=names, omegas=vs.omegas),
                    space={k: [v] for k, v in cal.recommended.options.items()},
@@ -294,7 +294,7 @@ def _held_out(engine, args, cal, held, vs, base, workers):
 
 def _domain_tables(args, cal, design, held) -> str:
     """The ``[domain]`` and ``[calibration]`` tables of a design's settings file."""
-    from compare.campaign.design import OMEGA_OVER_P, domain_table
+    from trilith_xval.compare.campaign.design import OMEGA_OVER_P, domain_table
     rec = cal.recommended
     lines = ["", "# The ranges the design sampled: a scene uses these settings only inside",
              "# every one (engines/calibration.py); outside, the reference step runs.",

@@ -16,8 +16,8 @@ import sys
 import time
 from pathlib import Path
 
-from compare.cli.excitation_args import check_run_budget
-from compare.cli.options import (add_settings_arg, add_store_args, check_output_path,
+from trilith_xval.compare.cli.excitation_args import check_run_budget
+from trilith_xval.compare.cli.options import (add_settings_arg, add_store_args, check_output_path,
                                  settings_from_args, use_store)
 
 # Cost of one engine run [s] before the store has measured any (median of the
@@ -48,10 +48,10 @@ def check_budget(study, file, loaded=None) -> None:
     is the ``--settings`` file's step (else the calibrated one)."""
     import dataclasses
 
-    from analytic.pulses import pulse_of
-    from engines import configure
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.engines import configure
 
-    from compare.cli.options import file_options
+    from trilith_xval.compare.cli.options import file_options
 
     motions = [pulse_of(p, 1.0, min(study.omegas)) for p in study.pulses] if study.omegas else []
     if study.records is not None:  # a record runs its fixed window: end + tail
@@ -74,9 +74,9 @@ def _run_cost(engine: str, dt: float, costs: dict) -> float:
     threshold step): the mean measured in the store at that step, else the measured
     step nearest to it scaled by the step ratio (steps per simulated second), else a
     prior."""
-    from engines import configure
+    from trilith_xval.engines import configure
 
-    from engines.calibration import calibrated
+    from trilith_xval.engines.calibration import calibrated
 
     # An estimate: the calibrated step whatever the scene (a scene outside its
     # domain runs the finer reference step and costs more than estimated).
@@ -96,7 +96,7 @@ def _run_cost(engine: str, dt: float, costs: dict) -> float:
 
 def _estimates(jobs, store) -> list[float]:
     """Expected cost [s] of each threshold job: runs per job x the run cost."""
-    from compare.campaign.study import JOB_RUNS
+    from trilith_xval.compare.campaign.study import JOB_RUNS
 
     costs = store.mean_costs("run") if store is not None else {}
     return [JOB_RUNS * _run_cost(job.engine, job.dt or dict(job.options).get("dt", 0.0), costs)
@@ -104,9 +104,9 @@ def _estimates(jobs, store) -> list[float]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.run import atomic
-    from compare.run import runs
-    from compare.campaign.study import (load_study, reference_jobs, run_reference, run_threshold,
+    from trilith_xval.compare.run import atomic
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.campaign.study import (load_study, reference_jobs, run_reference, run_threshold,
                                threshold_jobs)
 
     study = load_study(args.file)
@@ -119,8 +119,8 @@ def run(args: argparse.Namespace) -> int:
     loaded = settings_from_args(args, study.engines)
     check_budget(study, args.file, loaded)
     if not study.steps or 0 in study.steps:  # a calibrated step is asked for
-        from compare.campaign.study import _scene
-        from compare.cli.options import step_notes
+        from trilith_xval.compare.campaign.study import _scene
+        from trilith_xval.compare.cli.options import step_notes
         step_notes(study.engines, [_scene(n, c) for n in study.scenes for c in study.cases])
     store = use_store(args)
     t0 = time.perf_counter()
@@ -148,7 +148,7 @@ def run(args: argparse.Namespace) -> int:
         rows = [{**done[i], "scene": job.scene, "case": job.case} for job, i in zip(jobs, index)]
         record_refs: list = []
         if study.records is not None:
-            from compare.cli.campaign_records import record_rows
+            from trilith_xval.compare.cli.campaign_records import record_rows
             record_refs, more = record_rows(study, workers)
             rows += more
         doc = {"study": study.describe(), "references": [
@@ -169,7 +169,7 @@ def distinct(jobs: list) -> tuple[list, list[int]]:
     """The jobs with distinct store keys, and for each job the index of its
     distinct one (e.g. the no-pendulum Fig. 8 scenes of one lam are one trilith:
     the scene name is a label)."""
-    from compare.run.keys import digest
+    from trilith_xval.compare.run.keys import digest
 
 
     seen: dict[str, int] = {}
@@ -199,7 +199,7 @@ def _bar(total: float):
 
 
 def _versions(study) -> dict:
-    from compare.run.keys import backend_version, project_version
+    from trilith_xval.compare.run.keys import backend_version, project_version
     return {"project": project_version(), "analytic-fast": backend_version("analytic-fast"),
             **{e: backend_version(e) for e in study.engines}}
 
@@ -227,9 +227,9 @@ def write_campaign(doc: dict, out: Path) -> None:
     import html
     import json
 
-    from compare.run import atomic
+    from trilith_xval.compare.run import atomic
 
-    from compare.run.jsonable import plain
+    from trilith_xval.compare.run.jsonable import plain
 
     atomic.write_text(out / "campaign.json", json.dumps(plain(doc), indent=1,
                                                         allow_nan=False))

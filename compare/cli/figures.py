@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from compare.cli.options import add_workers_arg, check_output_path, info, resolve_workers
-from compare.report.figure_options import DEFAULT_DPI, FORMATS
+from trilith_xval.compare.cli.options import add_workers_arg, check_output_path, info, resolve_workers
+from trilith_xval.compare.report.figure_options import DEFAULT_DPI, FORMATS
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -32,7 +32,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.report.figures import (FigureSettings, check_output_options, make_figures,
+    from trilith_xval.compare.report.figures import (FigureSettings, check_output_options, make_figures,
                                         output_names, quick_settings)
     workers = resolve_workers(args.workers)
     # Only this tool's own earlier files are rewritten; nothing is created yet.

@@ -17,9 +17,9 @@ import math
 import re
 import time
 
-from analytic.excitation import G_STANDARD
-from analytic.ida import IM_UNITS, IDASettings
-from compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
+from trilith_xval.analytic.excitation import G_STANDARD
+from trilith_xval.analytic.ida import IM_UNITS, IDASettings
+from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
                                  add_workers_arg, check_output_path, file_options, info,
                                  parse_engine_list, resolve_workers, scene_from_args,
                                  settings_from_args, use_store)
@@ -28,7 +28,7 @@ IM_TEXT = {"pga": "PGA", "pgv": "PGV", "scale": "scale factor"}
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from engines import ENGINES
+    from trilith_xval.engines import ENGINES
     parser = subparsers.add_parser(
         "fragility", help="IDA over a record suite; fragility curves of the model and engines",
         description=__doc__)
@@ -51,7 +51,7 @@ DEFAULT_RANGES = {"pga": (0.5, 20.0), "pgv": (0.05, 2.0), "scale": (0.1, 10.0)}
 
 
 def _im_range(args) -> tuple[float, float]:
-    from compare.cli.units import parse_acceleration, parse_velocity
+    from trilith_xval.compare.cli.units import parse_acceleration, parse_velocity
     if args.im_range is None:
         return DEFAULT_RANGES[args.im]
     lo, sep, hi = args.im_range.partition(":")
@@ -70,11 +70,11 @@ def ida_job(item):
     """One record, one backend (with ``options``, a ``--settings`` table): its
     :class:`analytic.ida.IDAResult` as plain data, through the run store (each run
     stored, the whole search memoised)."""
-    import engines
+    from trilith_xval import engines
 
-    from analytic.ida import first_overturn_intensity
-    from compare.run import runs
-    from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
+    from trilith_xval.analytic.ida import first_overturn_intensity
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
     backend, scene, record, st, *rest = item
     options = rest[0] if rest else {}
     extra = {"sample_dt": 0.01} if backend == "analytic" else dict(options)
@@ -98,11 +98,11 @@ def robust_job(item):
     """One record, one engine: its robust first overturning intensity around the
     model's (:func:`compare.measure.record_threshold.engine_intensity`), through
     the run store (each run stored, the whole search memoised)."""
-    import engines
+    from trilith_xval import engines
 
-    from compare.measure.record_threshold import engine_intensity
-    from compare.run import runs
-    from compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
+    from trilith_xval.compare.measure.record_threshold import engine_intensity
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
     backend, scene, record, st, im_model, *rest = item
     options = rest[0] if rest else {}  # e.g. {"dt": ...}: a campaign's time step
     what = {"backend": backend, "scene": scene_dict(scene),
@@ -128,7 +128,7 @@ def intensities(scene, suite, backends, st: IDASettings, workers: int, scheduler
 
 
 def run(args: argparse.Namespace) -> int:
-    from scenes.ground_motion import load_suite
+    from trilith_xval.scenes.ground_motion import load_suite
 
     scene = scene_from_args(args)
     engines_ = parse_engine_list(args.engine, none_ok=True)
@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
     _write(out, doc, st)
     _print(doc, st)
     if store is not None:
-        from compare.run.runs import stats_line
+        from trilith_xval.compare.run.runs import stats_line
         info(stats_line())
     return 0
 
@@ -157,7 +157,7 @@ def _run_all(items, workers: int, scheduler, job=None):
 
     from tqdm import tqdm
 
-    from compare.run.runs import run_many
+    from trilith_xval.compare.run.runs import run_many
     bar = tqdm(total=len(items), unit="record", desc="fragility",
                disable=not sys.stderr.isatty())
     try:
@@ -168,7 +168,7 @@ def _run_all(items, workers: int, scheduler, job=None):
 
 
 def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
-    from compare.measure.fragility import agreement, fragility
+    from trilith_xval.compare.measure.fragility import agreement, fragility
     n = len(suite)  # results come in the order of the items: backend-major
     per = {b: results[i * n:(i + 1) * n] for i, b in enumerate(backends)}
     # A record with no robust bracket has no intensity: listed, left out of the fit.
@@ -192,7 +192,7 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
 def _write(out, doc: dict, st: IDASettings) -> None:
     import json
 
-    from compare.run.atomic import report_dir
+    from trilith_xval.compare.run.atomic import report_dir
     with report_dir(out) as tmp:
         _write_files(tmp, doc, st)
 
@@ -200,8 +200,8 @@ def _write(out, doc: dict, st: IDASettings) -> None:
 def _write_files(out, doc: dict, st: IDASettings) -> None:
     import json
 
-    from compare.run.atomic import write_text
-    from compare.run.jsonable import plain
+    from trilith_xval.compare.run.atomic import write_text
+    from trilith_xval.compare.run.jsonable import plain
     write_text(out / "fragility.json", json.dumps(plain(doc), indent=1, allow_nan=False))
     rows = ["backend,record,im,unit,im_overturn,im_safe,censored,islands,n_runs,robust_bracket,"
             "n_isolated"]
@@ -225,10 +225,10 @@ def _plot(path, doc: dict, st: IDASettings) -> None:
     import numpy as np
     from scipy import stats
 
-    from compare.run.atomic import savefig
-    from compare.measure.fragility import empirical_curve
+    from trilith_xval.compare.run.atomic import savefig
+    from trilith_xval.compare.measure.fragility import empirical_curve
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    from compare.report.plots import color
+    from trilith_xval.compare.report.plots import color
     colours = {b: "k" if b == "analytic" else color(b) for b in doc["backends"]}
     for b, body in doc["backends"].items():
         fit, c = body["fit"], colours.get(b, None)
@@ -349,10 +349,10 @@ def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int
     """``trilith spectrum --record FILE``: the record's first overturning intensity
     (and islands) for each backend, as the scale factor of the file's record and
     the PGA it means; ``--json`` prints them as one object."""
-    from analytic.ida import intensity_of
-    from compare.cli.excitation_args import scaled_record
-    from compare.cli.options import print_json
-    from scenes.ground_motion import load_record
+    from trilith_xval.analytic.ida import intensity_of
+    from trilith_xval.compare.cli.excitation_args import scaled_record
+    from trilith_xval.compare.cli.options import print_json
+    from trilith_xval.scenes.ground_motion import load_record
     st = ida_settings(args)
     loaded = settings_from_args(args, backends[1:])
     given = load_record(args.record, option="--record")

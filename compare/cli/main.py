@@ -22,8 +22,8 @@ import os
 import re
 import sys
 
-from compare.cli import COMMANDS
-from engines import engine_names
+from trilith_xval.compare.cli import COMMANDS
+from trilith_xval.engines import engine_names
 
 
 # Errors of a write that found no room or no device.
@@ -36,7 +36,7 @@ def _version() -> str:
     fails: without git, or outside a checkout, the version alone."""
     from pathlib import Path
 
-    from compare.run.provenance import git_commit
+    from trilith_xval.compare.run.provenance import git_commit
     try:
         from importlib.metadata import PackageNotFoundError, version
         text = version("trilith-xval")
@@ -133,7 +133,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     modules = {}
     for name in COMMANDS:
-        module = importlib.import_module(f"compare.cli.{name}")
+        module = importlib.import_module(f"trilith_xval.compare.cli.{name}")
         module.add_parser(sub)
         modules[name] = module
     return parser, modules
@@ -202,7 +202,7 @@ def _main(argv: list[str] | None) -> int:
     if not args.command:
         parser.print_help()
         return 2
-    from compare.cli import options as _common
+    from trilith_xval.compare.cli import options as _common
     _common.VERBOSITY = args.verbosity
     try:
         code = int(modules[args.command].run(args) or 0)
@@ -226,18 +226,18 @@ def _main(argv: list[str] | None) -> int:
               file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        runs = sys.modules.get("compare.run.runs")
+        runs = sys.modules.get("trilith_xval.compare.run.runs")
         kept = "; finished runs are kept in the run store" if runs and runs.active() else ""
         print(f"interrupted: cancelled{kept}", file=sys.stderr)
         return 130
     finally:
         # A command's run store and scheduler end with it (main() is also called
         # in-process, by tests and scripts).
-        if "compare.run.runs" in sys.modules:
-            store = sys.modules["compare.run.runs"].activate(None)
+        if "trilith_xval.compare.run.runs" in sys.modules:
+            store = sys.modules["trilith_xval.compare.run.runs"].activate(None)
             if store is not None:
                 store.close()
-            sys.modules["compare.run.runs"].set_scheduler(None)
+            sys.modules["trilith_xval.compare.run.runs"].set_scheduler(None)
 
 
 if __name__ == "__main__":

@@ -5,16 +5,16 @@ from __future__ import annotations
 import argparse
 import math
 
-from engines import engine_names
+from trilith_xval.engines import engine_names
 
-from compare.cli import options as _options
-from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
+from trilith_xval.compare.cli import options as _options
+from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args,
                                  add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
-from compare.cli.map_plot import plot_maps, print_map_summary, subsample
-from compare.measure.map_thresholds import LEAST_RUNS
-from compare.run.jsonable import plain
+from trilith_xval.compare.cli.map_plot import plot_maps, print_map_summary, subsample
+from trilith_xval.compare.measure.map_thresholds import LEAST_RUNS
+from trilith_xval.compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:0.5"
 DEFAULT_AMPLITUDE = "0.5:100:0.5"
@@ -57,7 +57,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--csv", metavar="FILE",
                         help="write the cells and the engines' robust thresholds as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write the map as a PNG")
-    from compare.cli.record_map import add_record_map_args
+    from trilith_xval.compare.cli.record_map import add_record_map_args
     add_record_map_args(parser)
     add_store_args(parser)
     return parser
@@ -91,9 +91,9 @@ class _EngineRun:
             self.options.update(t_max=t_max, early_stop=False)
 
     def __call__(self, amplitude: float, omega: float):
-        from analytic.pulses import pulse_of
-        from compare.measure.engine_spectrum import pulse_settings
-        from compare.run import runs
+        from trilith_xval.analytic.pulses import pulse_of
+        from trilith_xval.compare.measure.engine_spectrum import pulse_settings
+        from trilith_xval.compare.run import runs
         settings = pulse_settings(self.name, self.scene, amplitude, omega, self.pulse,
                                   verdict_only=True, **self.options)
         return runs.simulate(self.name, self.scene, pulse_of(self.pulse, amplitude, omega),
@@ -116,7 +116,7 @@ def _threshold_row(name: str, p) -> str:
 
 
 def _print_thresholds(name: str, points) -> None:
-    from compare.measure.map_thresholds import threshold_cost
+    from trilith_xval.compare.measure.map_thresholds import threshold_cost
     cost = threshold_cost(points)
     print(f"{name}: robust thresholds at {cost['points']} frequencies, {cost['runs']} runs, "
           f"{cost['cpu_s']:.1f} CPU s when computed ({cost['cpu_s_spent']:.1f} spent now)")
@@ -141,19 +141,19 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.csv, "--csv")
     if args.plot:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
-    from compare.cli.pulse_shape import shape_from_args
+    from trilith_xval.compare.cli.pulse_shape import shape_from_args
     shape = shape_from_args(args)
     engines, eng_grid = (), None
     if args.record is not None:
-        from compare.cli.record_map import record_map
+        from trilith_xval.compare.cli.record_map import record_map
         return record_map(args, scene, workers,
                           parse_engine_list(args.engine) if args.engine is not None else ())
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
     loaded = _options.settings_from_args(args, engines)
-    from analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
-    from analytic.spectrum import SpectrumSettings
+    from trilith_xval.analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
+    from trilith_xval.analytic.spectrum import SpectrumSettings
     settings = SpectrumSettings(pulse=shape)
     top = MAX_CELLS if settings.compiled else MAX_ACCURATE_CELLS
     if omegas.size * amps.size > top:
@@ -169,8 +169,8 @@ def run(args: argparse.Namespace) -> int:
                                 backend=name, pulse=settings.pulse, workers=workers))
     thresholds = {}
     if engines:
-        from compare.campaign.settings_file import threshold_options
-        from compare.measure.map_thresholds import map_thresholds, model_thresholds
+        from trilith_xval.compare.campaign.settings_file import threshold_options
+        from trilith_xval.compare.measure.map_thresholds import map_thresholds, model_thresholds
         reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers)
         _options.step_notes(engines, [scene])
         for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
@@ -179,7 +179,7 @@ def run(args: argparse.Namespace) -> int:
                                               t_max=args.t_max, reference=reference,
                                               **{**threshold_options(name, scene),
                                                  **_options.file_options(loaded, name)})
-    from analytic.threshold_validity import curve_validity
+    from trilith_xval.analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
 
@@ -188,7 +188,7 @@ def run(args: argparse.Namespace) -> int:
         return "" if v is None else str(v)
 
     if args.csv:
-        from compare.run.atomic import write_text
+        from trilith_xval.compare.run.atomic import write_text
         blank = "," * (len(THRESHOLD_COLUMNS) - 1)
         rows = [",".join(CSV_COLUMNS)] + [
             f"{m.backend},{w:.12g},{a:.12g},{lab},{valid_text(w)},{blank}"
@@ -198,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         plot_maps(maps, args.plot, validity, thresholds)
     if args.json:
-        from compare.measure.map_thresholds import threshold_cost
+        from trilith_xval.compare.measure.map_thresholds import threshold_cost
         first = {**maps[0].to_dict(), "model_validity_first_overturning": validity}
         engine_maps = [{**m.to_dict(),
                         "thresholds": [p.to_dict() for p in thresholds[m.backend]],

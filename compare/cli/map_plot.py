@@ -30,7 +30,7 @@ def _hatch_invalid(ax, first, validity) -> None:
     not checked one by one)."""
     import numpy as np
 
-    from analytic.threshold_validity import invalid_spans
+    from trilith_xval.analytic.threshold_validity import invalid_spans
 
     w, a = np.asarray(first.omega, float), np.asarray(first.first, float)
     top = float(np.max(first.amplitude))
@@ -45,7 +45,7 @@ def _hatch_invalid(ax, first, validity) -> None:
 def _draw_thresholds(ax, points, colour) -> None:
     """An engine's robust brackets: survives at the open mark, overturns at the
     filled one, joined; the cause beside a point outside the tolerance."""
-    from compare.measure.engine_spectrum_files import SHORT_CAUSE
+    from trilith_xval.compare.measure.engine_spectrum_files import SHORT_CAUSE
     label = "engine's robust threshold (survives / overturns)"
     for p in points:
         if not p.point.bracketed:
@@ -92,7 +92,7 @@ def plot_maps(maps, path, validity=None, thresholds=None, xlabel=r"$\Omega$ [rad
         if validity:
             _hatch_invalid(ax, first, validity)
         if thresholds and thresholds.get(m.backend):
-            from compare.report.plots import color
+            from trilith_xval.compare.report.plots import color
             _draw_thresholds(ax, thresholds[m.backend], color(m.backend) or "tab:blue")
         present = [i for i, n in enumerate(np.bincount(m.cells.ravel(),
                                                        minlength=len(m.labels))) if n]
@@ -111,6 +111,6 @@ def plot_maps(maps, path, validity=None, thresholds=None, xlabel=r"$\Omega$ [rad
         for ax in used:
             getattr(ax, set_)(min(lo for lo, _ in lims), max(hi for _, hi in lims))
     fig.tight_layout()
-    from compare.run.atomic import savefig
+    from trilith_xval.compare.run.atomic import savefig
     savefig(fig, path, dpi=150)
     plt.close(fig)

@@ -17,12 +17,12 @@ import sys
 import tempfile
 from pathlib import Path
 
-from analytic.parameters import Scene, glossary_text
-from scenes import load_scene
+from trilith_xval.analytic.parameters import Scene, glossary_text
+from trilith_xval.scenes import load_scene
 
-from compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
-from compare.run.atomic import check_name_length, check_replaceable
-from compare.run.jsonable import plain
+from trilith_xval.compare.campaign.grids import parse_omega_range, parse_range  # noqa: F401  (the CLI's parsers)
+from trilith_xval.compare.run.atomic import check_name_length, check_replaceable
+from trilith_xval.compare.run.jsonable import plain
 
 SETTABLE = ("b", "lam", "mu", "gamma", "l", "column_mass", "J_G", "gap", "lintel_height",
             "hinge_x", "depth", "g")
@@ -50,7 +50,7 @@ def step_notes(engines, scenes) -> None:
     silences it."""
     import sys
 
-    from compare.campaign.settings_file import domain_notes
+    from trilith_xval.compare.campaign.settings_file import domain_notes
     if VERBOSITY >= 0:
         for line in domain_notes(engines, scenes):
             print(f"note: {line}", file=sys.stderr)
@@ -114,7 +114,7 @@ def scenes_from_args(args: argparse.Namespace) -> list[Scene]:
     the ``--set`` overrides and ``--no-pendulum``."""
     import fnmatch
 
-    from scenes import scene_names
+    from trilith_xval.scenes import scene_names
     names: list[str] = []
     for item in args.scene or ["fig5"]:
         if any(c in item for c in "*?[") and not Path(item).exists():
@@ -152,7 +152,7 @@ def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
 
 def add_engine_arg(parser: argparse.ArgumentParser, default: str = "analytic",
                    allowed: tuple[str, ...] | None = None) -> None:
-    from engines import backend_names
+    from trilith_xval.engines import backend_names
     names = allowed or backend_names()
     parser.add_argument("--engine", default=default, metavar="NAME",
                         help=f"backend: {', '.join(names)}")
@@ -164,7 +164,7 @@ def add_engine_list_arg(parser: argparse.ArgumentParser, default: tuple[str, ...
     with :func:`parse_engine_list`.  ``default`` None: the engines marked
     affordable (:func:`engines.default_engines`), resolved when the command runs
     (reading the flag imports every engine)."""
-    from engines import engine_names
+    from trilith_xval.engines import engine_names
     extra = ", or none" if none_ok else ""
     parser.add_argument("--engine", dest="engine",
                         default=None if default is None else ",".join(default),
@@ -181,7 +181,7 @@ def parse_engine_list(text: str | None, option: str = "--engine",
     :func:`engines.engine_list`) or, where ``none_ok``, ``'none'``; an empty list,
     an unknown or a repeated name is refused naming ``option``; None (the flag not
     given where its default is None) is :func:`engines.default_engines`."""
-    from engines import default_engines, engine_list, engine_names
+    from trilith_xval.engines import default_engines, engine_list, engine_names
     if text is None:
         return default_engines()
     if none_ok and text.strip() == "none":
@@ -256,7 +256,7 @@ def _check_output_path(p: Path, text: str, option: str, directory: bool, replace
             if replace:
                 check_replaceable(p, option)
             else:
-                from compare.run.atomic import check_into
+                from trilith_xval.compare.run.atomic import check_into
                 check_into(p, files, option)
             ancestor = next(a for a in (p.absolute(), *p.absolute().parents) if a.exists())
             try:
@@ -344,7 +344,7 @@ def print_json(obj) -> None:
 # --- run store, scheduler and interruption ---
 def add_store_args(parser: argparse.ArgumentParser, scheduler: bool = False) -> None:
     """``--cache DIR``, ``--no-cache`` and, with ``scheduler``, ``--scheduler ADDRESS``."""
-    from compare.run.store import default_cache_dir
+    from trilith_xval.compare.run.store import default_cache_dir
 
     group = parser.add_mutually_exclusive_group()
     group.add_argument("--cache", metavar="DIR", default=None,
@@ -362,8 +362,8 @@ def use_store(args: argparse.Namespace):
     """Activate the run store (and scheduler) the options ask for; returns the store
     (None with ``--no-cache``).  Call before any work: a bad ``--cache`` or
     ``--scheduler`` is a usage error."""
-    from compare.run import runs
-    from compare.run.store import RunStore
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.store import RunStore
 
     address = getattr(args, "scheduler", None)
     if address is not None and not (address.startswith(("tcp://", "tls://", "inproc://",
@@ -385,7 +385,7 @@ def store_location(args: argparse.Namespace) -> tuple[str, str]:
     """The run store's directory and what named it (``'--cache'``,
     ``'TRILITH_CACHE'`` or ``'the default store'``), for messages; an empty
     ``--cache`` is refused (it would silently mean the default store)."""
-    from compare.run.store import default_cache_dir, default_cache_source
+    from trilith_xval.compare.run.store import default_cache_dir, default_cache_source
     cache = getattr(args, "cache", None)
     if cache is not None:
         if not cache.strip():
@@ -413,7 +413,7 @@ def settings_from_args(args: argparse.Namespace, engines: tuple[str, ...]):
     path = getattr(args, "settings", None)
     if path is None:
         return None
-    from compare.campaign.settings_file import read_settings_file
+    from trilith_xval.compare.campaign.settings_file import read_settings_file
     try:
         loaded = read_settings_file(path)
     except ValueError as exc:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from analytic.pulses import MP_GAMMA_RANGE, PULSE_FAMILY, PulseShape
+from trilith_xval.analytic.pulses import MP_GAMMA_RANGE, PULSE_FAMILY, PulseShape
 
 __all__ = ["add_pulse_shape_args", "shape_from_args", "PULSE_HELP"]
 
@@ -72,7 +72,7 @@ def shaped_pulse(shape: PulseShape, amplitude: float, omega: float, option: str,
     """``shape.at(amplitude, omega)``: ``|amplitude| <= 1e4 m/s^2`` named with
     ``amplitude_option``, then a shape's own bound on the frequency (a Ricker
     period of at most 19.7 s, an M-P pulse of at most 62.8 s) with ``option``."""
-    from analytic.excitation import MAX_ACCELERATION
+    from trilith_xval.analytic.excitation import MAX_ACCELERATION
     if not (math.isfinite(amplitude) and abs(amplitude) <= MAX_ACCELERATION):
         raise ValueError(f"{amplitude_option} must be finite with |A| <= "
                          f"{MAX_ACCELERATION:g} m/s^2, got {amplitude!r}")

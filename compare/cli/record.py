@@ -3,16 +3,16 @@ from __future__ import annotations
 
 import argparse
 
-from engines import backend_names
+from trilith_xval.engines import backend_names
 
-from compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, FORMATS,
+from trilith_xval.compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DEFAULT_OMEGA, FORMATS,
                            RecordSettings, check_output, default_duration, record,
                            resolve_engines)
 
-from compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
+from trilith_xval.compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
                                          excitation_from_args)
-from compare.cli.options import add_scene_args, check_output_path, scene_from_args
-from compare.cli.options import add_settings_arg, file_options, settings_from_args
+from trilith_xval.compare.cli.options import add_scene_args, check_output_path, scene_from_args
+from trilith_xval.compare.cli.options import add_settings_arg, file_options, settings_from_args
 
 
 def add_watch_args(parser: argparse.ArgumentParser) -> None:
@@ -39,7 +39,7 @@ def add_watch_args(parser: argparse.ArgumentParser) -> None:
 def watch_inputs(args: argparse.Namespace) -> tuple:
     """``(scene, excitation, settings)``, all checked, and the run budget of each
     backend over the recorded span."""
-    from engines import configure, engine_names
+    from trilith_xval.engines import configure, engine_names
 
     scene = scene_from_args(args)
     excitation = excitation_from_args(args, default=(DEFAULT_AMPLITUDE, DEFAULT_OMEGA))

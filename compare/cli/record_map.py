@@ -55,11 +55,11 @@ class _RecordRun:
                                                                      im, tail)
 
     def __call__(self, value: float, k: float):
-        import engines
+        from trilith_xval import engines
 
-        from analytic.ida import scale_to
-        from compare.run import runs
-        from scenes.ground_motion import time_scaled
+        from trilith_xval.analytic.ida import scale_to
+        from trilith_xval.compare.run import runs
+        from trilith_xval.scenes.ground_motion import time_scaled
         motion = scale_to(time_scaled(self.record, k), self.im, value)
         extra = {"sample_dt": 0.01} if self.backend == "analytic" else {"verdict_only": False}
         settings = engines.configure(self.backend, t_max=motion.end_time + self.tail, **extra)
@@ -67,8 +67,8 @@ class _RecordRun:
 
 
 def _grids(args, record):
-    from compare.campaign.grids import parse_range
-    from scenes.ground_motion import TIME_SCALE_RANGE
+    from trilith_xval.compare.campaign.grids import parse_range
+    from trilith_xval.scenes.ground_motion import TIME_SCALE_RANGE
     unit = {"pga": "m/s^2", "pgv": "m/s", "scale": ""}[args.im]
     values = parse_range(args.intensity or DEFAULT_INTENSITY[args.im], "--intensity", unit,
                          hi=1e4)
@@ -90,12 +90,12 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
 
     import numpy as np
 
-    from analytic.overturn_map import verdict_map
-    from compare.cli.map_plot import plot_maps, print_map_summary, subsample
-    from compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
+    from trilith_xval.analytic.overturn_map import verdict_map
+    from trilith_xval.compare.cli.map_plot import plot_maps, print_map_summary, subsample
+    from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
                                      use_store)
-    from compare.run.jsonable import plain
-    from scenes.ground_motion import load_record
+    from trilith_xval.compare.run.jsonable import plain
+    from trilith_xval.scenes.ground_motion import load_record
 
     pulse_options = [f for f, v in (("--omega", args.omega != "3:30:0.5" or None),
                                     ("--amplitude", args.amplitude != "0.5:100:0.5" or None),
@@ -141,7 +141,7 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
                   ylabel=f"{args.im.upper() if args.im != 'scale' else 'scale factor'}"
                          + (f" [{unit}]" if unit else ""), subject="")
     if args.csv:
-        from compare.run.atomic import write_text
+        from trilith_xval.compare.run.atomic import write_text
         rows = ["backend,time_scale,intensity,im,verdict"] + [
             f"{m.backend},{k:.12g},{v:.12g},{args.im},{lab}"
             for m in maps for k, v, lab in m.csv_rows()]

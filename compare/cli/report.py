@@ -16,18 +16,18 @@ import sys
 import time
 from pathlib import Path
 
-from analytic.options import MAX_ENGINE_DT
-from engines import engine_names
-from scenes import load_scene
+from trilith_xval.analytic.options import MAX_ENGINE_DT
+from trilith_xval.engines import engine_names
+from trilith_xval.scenes import load_scene
 
-from compare.cli.options import (add_engine_list_arg, add_settings_arg, add_workers_arg,
+from trilith_xval.compare.cli.options import (add_engine_list_arg, add_settings_arg, add_workers_arg,
                                  check_output_path, detail, format_quantity, parse_engine_list,
                                  resolve_workers, scene_group, settings_from_args)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
 # contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
 
-from compare.cli.options import add_store_args, use_store
+from trilith_xval.compare.cli.options import add_store_args, use_store
 
 
 def add_parser(subparsers) -> None:
@@ -63,11 +63,11 @@ def _check_budget(config, loaded=None) -> None:
     of the campaign (its lowest threshold frequency, or a labelled point's).  The
     message names where the step came from: ``--dt``, the ``--settings`` file
     (``loaded``) or the engine's calibrated step."""
-    from analytic.excitation import Pulse
-    from scenes import POINTS
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.scenes import POINTS
 
-    from compare.campaign.config import backend_settings
-    from compare.cli.excitation_args import check_run_budget
+    from trilith_xval.compare.campaign.config import backend_settings
+    from trilith_xval.compare.cli.excitation_args import check_run_budget
 
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
     for name in config.engines:
@@ -82,7 +82,7 @@ def _check_budget(config, loaded=None) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.cli.excitation_args import record_suite
+    from trilith_xval.compare.cli.excitation_args import record_suite
 
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
@@ -96,13 +96,13 @@ def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out, "--out", directory=True, replace=True)
     suite = record_suite(args.record)
 
-    from compare.run import atomic
+    from trilith_xval.compare.run import atomic
 
-    from compare.run import runs
-    from compare.campaign.config import CampaignConfig
-    from compare.campaign.validation import run_campaign
-    from compare.run.provenance import collect
-    from compare.report.html import write_report
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.campaign.config import CampaignConfig
+    from trilith_xval.compare.campaign.validation import run_campaign
+    from trilith_xval.compare.run.provenance import collect
+    from trilith_xval.compare.report.html import write_report
 
     changes = dict(scene=args.scene, engines=engines, workers=workers, engine_dt=args.dt,
                    engine_settings={} if loaded is None else
@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     config = CampaignConfig.quick(**changes) if args.quick else CampaignConfig(**changes)
     _check_budget(config, loaded)
     if args.dt is None:
-        from compare.cli.options import step_notes
+        from trilith_xval.compare.cli.options import step_notes
         sc = load_scene(config.scene)
         step_notes(config.engines, [sc, sc.without_pendulum()] if sc.has_pendulum else [sc])
     use_store(args)
@@ -119,13 +119,13 @@ def run(args: argparse.Namespace) -> int:
     if loaded is not None:
         provenance["settings_file"] = {"file": loaded.path, "sha256": loaded.sha256}
     with atomic.output_lock(out):  # a second report into the same --out: clear error
-        from compare.cli import options as _options
+        from trilith_xval.compare.cli import options as _options
         result = run_campaign(config, progress=_options.VERBOSITY >= 0)
         provenance["versions"].update(result.versions)
         extra = {}
         if suite:
-            from analytic.ida import IDASettings
-            from compare.report.record_section import record_section
+            from trilith_xval.analytic.ida import IDASettings
+            from trilith_xval.compare.report.record_section import record_section
             st = IDASettings(rel_step=0.25) if args.quick else IDASettings()
             extra["records"] = record_section(load_scene(args.scene), suite, engines, st,
                                               workers)

@@ -4,12 +4,12 @@ from __future__ import annotations
 import argparse
 import math
 
-from engines import engine_names
+from trilith_xval.engines import engine_names
 
-from compare.cli.options import (add_scene_args, add_settings_arg, add_store_args, detail,
+from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args, detail,
                                  envelope, file_options, info, print_json, scene_from_args,
                                  settings_from_args, settings_line, sig, use_store)
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
 # Half the static overturning angle: large, clean impacts far from toppling.
 DEFAULT_THETA0_FRACTION = 0.5
@@ -40,7 +40,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.measure.restitution import DEFAULT_N_IMPACTS, MAX_N_IMPACTS, measure_restitution
+    from trilith_xval.compare.measure.restitution import DEFAULT_N_IMPACTS, MAX_N_IMPACTS, measure_restitution
 
     scene = scene_from_args(args)
     theta0 = args.theta0 if args.theta0 is not None else DEFAULT_THETA0_FRACTION * scene.alpha

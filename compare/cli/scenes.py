@@ -6,10 +6,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from analytic.parameters import GLOSSARY, glossary_text
-from scenes import SCENE_DIR, load_scene, scene_names
+from trilith_xval.analytic.parameters import GLOSSARY, glossary_text
+from trilith_xval.scenes import SCENE_DIR, load_scene, scene_names
 
-from compare.cli.options import add_scene_args, envelope, print_json, scenes_from_args
+from trilith_xval.compare.cli.options import add_scene_args, envelope, print_json, scenes_from_args
 
 # Unit of each value shown, beside the number ('' for ratios).
 UNITS = {"lam": "", "b": "m", "h": "m", "mu": "", "gamma": "", "l": "m", "gap": "m",

@@ -4,16 +4,16 @@ from __future__ import annotations
 import argparse
 import math
 
-from analytic.contact_forces import violations
+from trilith_xval.analytic.contact_forces import violations
 
-from compare.cli.units import acceleration_text, frequency_text, velocity_text
-from compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
+from trilith_xval.compare.cli.units import acceleration_text, frequency_text, velocity_text
+from trilith_xval.compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
                                          excitation_from_args)
-from compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_scene_args, add_settings_arg,
+from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_scene_args, add_settings_arg,
                                  check_output_path, detail, envelope, file_options, info,
                                  print_json, scene_from_args, settings_from_args, settings_line,
                                  sig)
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -49,7 +49,7 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
     """Backend ``name``'s calibrated settings with ``base`` (a ``--settings`` table)
     and ``--criterion``/``--t-max`` applied (``--t-max`` fixes the run's window: no
     early stop, in every backend)."""
-    from engines import configure
+    from trilith_xval.engines import configure
     if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
     options = dict(base or {})
@@ -69,7 +69,7 @@ def _plot(runs: list, scene, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from compare.show.history import plot_psi, plot_theta
+    from trilith_xval.compare.show.history import plot_psi, plot_theta
 
     rows = 2 if scene.has_pendulum else 1
     fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.8 * rows + 0.4),
@@ -86,7 +86,7 @@ def _plot(runs: list, scene, path: str) -> None:
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
     fig.tight_layout()
-    from compare.run.atomic import savefig
+    from trilith_xval.compare.run.atomic import savefig
     savefig(fig, path, dpi=120)
     plt.close(fig)
 
@@ -107,7 +107,7 @@ def _describe_excitation(excitation) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
 
     # Every check before the run: scene, excitation, engine, settings, budget, outputs.
     scene = scene_from_args(args)
@@ -129,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
     traj = backend.simulate(scene, excitation, settings)
     if args.csv is not None:
-        from compare.run.atomic import atomic_path
+        from trilith_xval.compare.run.atomic import atomic_path
         with atomic_path(args.csv) as tmp:
             traj.to_csv(tmp)
     if args.plot is not None:

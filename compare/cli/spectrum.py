@@ -5,18 +5,18 @@ import argparse
 import math
 import sys
 
-from analytic.options import MAX_ENGINE_DT
-from engines import engine_names
+from trilith_xval.analytic.options import MAX_ENGINE_DT
+from trilith_xval.engines import engine_names
 
-from compare.cli import options as _common
-from compare.cli.fragility import add_ida_args, record_spectrum
-from compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
+from trilith_xval.compare.cli import options as _common
+from trilith_xval.compare.cli.fragility import add_ida_args, record_spectrum
+from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
                                  add_workers_arg, check_output_path, parse_engine_list, envelope,
                                  file_options, info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
                                  settings_line, use_store)
-from compare.cli.spectrum_plot import plot_spectrum
-from compare.run.jsonable import plain
+from trilith_xval.compare.cli.spectrum_plot import plot_spectrum
+from trilith_xval.compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5
 ENGINE = "analytic-fast"  # the spectra's backend (compiled model, same verdicts)
@@ -76,7 +76,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def _cached_frequency(payload):
     """One frequency (both curves) through the run store: the key is the scene,
     the search settings (pulse kind included) and Omega."""
-    from compare.run import runs
+    from trilith_xval.compare.run import runs
     fn, description, omega = payload
     return runs.memo("spectrum-point", {**description, "omega": omega}, lambda: fn(omega))
 
@@ -84,7 +84,7 @@ def _cached_frequency(payload):
 def _stored_frequency(payload):
     """The stored result of :func:`_cached_frequency`, or None (looked up in this
     process: a warm rerun starts no pool and loads no kernel)."""
-    from compare.run import runs
+    from trilith_xval.compare.run import runs
     _fn, description, omega = payload
     return runs.lookup("spectrum-point", {**description, "omega": omega})
 
@@ -97,8 +97,8 @@ def _map_fn(scene, settings, workers: int, scheduler: str | None):
     frequency is computed here first (after the kernels are loaded, so forked
     workers inherit them) and its CPU time decides how many workers the others
     are worth (:func:`analytic._workers.pool_size`)."""
-    from compare.run import runs
-    from compare.run.keys import scene_dict
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import scene_dict
 
     description = {"scene": scene_dict(scene), "settings": settings.describe()}
 
@@ -116,14 +116,14 @@ def _local_map(payloads, workers: int):
     """:func:`_cached_frequency` of every payload, yielded in order (see :func:`_map_fn`)."""
     import time
 
-    from analytic._workers import pool_size
-    from compare.run import runs
+    from trilith_xval.analytic._workers import pool_size
+    from trilith_xval.compare.run import runs
 
     found = [_stored_frequency(p) for p in payloads]
     todo = [i for i, f in enumerate(found) if f is None]
     computed = iter(())
     if todo:  # (only then numba: a rerun the store serves whole never loads it)
-        from analytic import fast
+        from trilith_xval.analytic import fast
         fast.warm_up(record=False)
         first = max(todo, key=lambda i: payloads[i][2])
         t0 = time.process_time()
@@ -137,8 +137,8 @@ def _local_map(payloads, workers: int):
 
 
 def _settings(args: argparse.Namespace):
-    from analytic.spectrum import SpectrumSettings, search_run_settings
-    from analytic.trajectory import OverturnCriterion
+    from trilith_xval.analytic.spectrum import SpectrumSettings, search_run_settings
+    from trilith_xval.analytic.trajectory import OverturnCriterion
 
     if args.t_max is not None and not (math.isfinite(args.t_max) and 0 < args.t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {args.t_max!r}")
@@ -147,7 +147,7 @@ def _settings(args: argparse.Namespace):
     if args.scan_step is not None and not (math.isfinite(args.scan_step)
                                            and 1e-4 < args.scan_step <= 100):
         raise ValueError(f"--scan-step must be in (0.0001, 100] m/s^2, got {args.scan_step!r}")
-    from compare.cli.pulse_shape import shape_from_args
+    from trilith_xval.compare.cli.pulse_shape import shape_from_args
     fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
     kw = {"pulse": shape_from_args(args), "fast": fast}
     if args.tol is not None:
@@ -174,9 +174,9 @@ def _number(value: float, width: int) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from analytic.fast_settings import version
-    from analytic.spectrum import overturning_spectrum
-    from compare.run import atomic
+    from trilith_xval.analytic.fast_settings import version
+    from trilith_xval.analytic.spectrum import overturning_spectrum
+    from trilith_xval.compare.run import atomic
 
     scene = scene_from_args(args)
     if args.record is not None:
@@ -198,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
                                 map_fn=_map_fn(scene, settings, workers, args.scheduler))
     if engines_wanted:
         return _run_engines(args, scene, spec, engines_wanted, workers, loaded)
-    from analytic.threshold_validity import spectrum_validity
+    from trilith_xval.analytic.threshold_validity import spectrum_validity
     validity = spectrum_validity(spec, workers=workers)
     if args.csv is not None:
         with atomic.atomic_path(args.csv) as tmp:
@@ -291,10 +291,10 @@ def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
     the lowest Omega, at the finest step (``--convergence`` reruns at dt/4)."""
     import dataclasses
 
-    from analytic.pulses import pulse_of
-    from engines import configure
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.engines import configure
 
-    from compare.cli.excitation_args import check_run_budget
+    from trilith_xval.compare.cli.excitation_args import check_run_budget
 
     for name in names:
         settings = configure(name, **file_options(loaded, name))
@@ -316,19 +316,19 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
     where the scene is in their domain, else its reference ones
     (:func:`compare.campaign.settings_file.threshold_options`), the ``--settings``
     file's table over them, ``--dt``/``--t-max`` over both."""
-    from compare.campaign.settings_file import threshold_options
+    from trilith_xval.compare.campaign.settings_file import threshold_options
     from pathlib import Path
 
-    from compare.run import atomic
-    from compare.measure import engine_spectrum as es
-    from compare.measure import engine_spectrum_files as files
+    from trilith_xval.compare.run import atomic
+    from trilith_xval.compare.measure import engine_spectrum as es
+    from trilith_xval.compare.measure import engine_spectrum_files as files
 
     import os
     import time
 
     options = {} if args.dt is None else {"dt": args.dt}
     if args.dt is None:
-        from compare.cli.options import step_notes
+        from trilith_xval.compare.cli.options import step_notes
         step_notes(names, [scene, scene.without_pendulum()] if scene.has_pendulum else [scene])
     if args.t_max is not None:  # the model's window, fixed, in every engine run
         options.update(t_max=args.t_max, early_stop=False)
@@ -347,7 +347,7 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
         with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
             files.plot(spec, results, tmp)
     if args.json:
-        from analytic.fast_settings import version
+        from trilith_xval.analytic.fast_settings import version
         analytic = spec.to_dict()
         timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
                    "engine_cpu_s": {r.engine: r.cost() for r in results},

@@ -15,8 +15,8 @@ def plot_spectrum(spec, path, validity: dict | None = None) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from compare.report.figures import shade_validity
-    from compare.report.units import g_hz_axes
+    from trilith_xval.compare.report.figures import shade_validity
+    from trilith_xval.compare.report.units import g_hz_axes
 
     both = len(spec.curves) == 2  # without a pendulum: its one curve, no gain panel
     if both:
@@ -47,6 +47,6 @@ def plot_spectrum(spec, path, validity: dict | None = None) -> None:
         ax2.set_ylabel(r"gain $\Delta$ [%]")
     (ax2 or ax1).set_xlabel(r"$\Omega$ [rad/s]")
     fig.tight_layout()
-    from compare.run.atomic import savefig
+    from trilith_xval.compare.run.atomic import savefig
     savefig(fig, path, dpi=150)
     plt.close(fig)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
+from trilith_xval.compare.cli.options import (add_scene_args, add_store_args, add_workers_arg,
                                  check_output_path, info, parse_engine_list, resolve_workers,
                                  scene_from_args, use_store)
 
@@ -39,9 +39,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from compare.cli import options as _options
-    from compare.cli.excitation_args import record_suite
-    from compare.run import atomic
+    from trilith_xval.compare.cli import options as _options
+    from trilith_xval.compare.cli.excitation_args import record_suite
+    from trilith_xval.compare.run import atomic
 
     scene = scene_from_args(args)
     engines = parse_engine_list(args.engine)
@@ -51,9 +51,9 @@ def run(args: argparse.Namespace) -> int:
                             replace=True)
     use_store(args)
     _options.step_notes(engines, [scene])
-    from compare.campaign.trust_check import trust_scene
-    from compare.report.trust_page import trust_csv, trust_html
-    from compare.run.jsonable import plain
+    from trilith_xval.compare.campaign.trust_check import trust_scene
+    from trilith_xval.compare.report.trust_page import trust_csv, trust_html
+    from trilith_xval.compare.run.jsonable import plain
     with atomic.output_lock(out):
         doc = trust_scene(scene, engines, records=records, workers=workers,
                           quiet=_options.VERBOSITY < 0)

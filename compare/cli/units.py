@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import re
 
-from analytic.excitation import G_STANDARD
+from trilith_xval.analytic.excitation import G_STANDARD
 
 __all__ = ["parse_acceleration", "parse_frequency", "parse_period", "parse_velocity",
            "acceleration_text", "frequency_text", "velocity_text"]

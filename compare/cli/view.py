@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import argparse
 
-from compare.show.view import view
+from trilith_xval.compare.show.view import view
 
-from compare.cli.record import add_watch_args, watch_inputs
+from trilith_xval.compare.cli.record import add_watch_args, watch_inputs
 
 
 def add_parser(subparsers) -> None:

@@ -52,10 +52,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engines import configure, supports
+from trilith_xval.engines import configure, supports
 
-from compare.measure.threshold_point import ThresholdPoint
-from compare.measure.thresholds import SEARCH, Search, engine_threshold
+from trilith_xval.compare.measure.threshold_point import ThresholdPoint
+from trilith_xval.compare.measure.thresholds import SEARCH, Search, engine_threshold
 
 __all__ = ["Classification", "classify", "model_validity", "model_jump", "model_island",
            "explain_isolated", "sensitivity_detail", "PRIMARY_ORDER", "JUMP_REL"]
@@ -86,10 +86,10 @@ class Classification:
 def model_validity(scene, omega: float, kind: str, amplitudes: dict, friction) -> list[dict]:
     """The model's validity at each ``{where: amplitude}``: contact forces and
     friction (:func:`analytic.bounds.check_model`) and the bob's clearance."""
-    from analytic.clearance import check_clearance
-    from analytic.pulses import pulse_of
-    from analytic.bounds import check_model
-    from analytic.simulate import simulate
+    from trilith_xval.analytic.clearance import check_clearance
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.analytic.bounds import check_model
+    from trilith_xval.analytic.simulate import simulate
     out, seen = [], {}
     for where, a in amplitudes.items():
         if not (a is not None and math.isfinite(a)):
@@ -111,8 +111,8 @@ def model_validity(scene, omega: float, kind: str, amplitudes: dict, friction) -
 
 
 def _model_threshold(scene, omega, kind):
-    from analytic.first_overturn import first_overturn_amplitude
-    from analytic.spectrum import SpectrumSettings
+    from trilith_xval.analytic.first_overturn import first_overturn_amplitude
+    from trilith_xval.analytic.spectrum import SpectrumSettings
     a, _, mode, _, _ = first_overturn_amplitude(scene, omega, SpectrumSettings(pulse=kind))
     return a, mode
 
@@ -150,8 +150,8 @@ def model_island(scene, omega, point: ThresholdPoint, kind, n: int = 40) -> str 
     somewhere in between (a safe island)?  ``n`` compiled verdicts (~0.1 ms each)
     resolve islands down to ``(a_engine - a_reference) / n``; None for the shapes
     the compiled kernels do not cover (Ricker, M-P)."""
-    from analytic import fast
-    from analytic.excitation import Pulse
+    from trilith_xval.analytic import fast
+    from trilith_xval.analytic.excitation import Pulse
     if not _compiled(kind):
         return None
     lo, hi = point.a_reference, point.a_engine
@@ -168,7 +168,7 @@ def model_island(scene, omega, point: ThresholdPoint, kind, n: int = 40) -> str 
 
 def _compiled(kind) -> bool:
     """True for the shapes of the compiled model (one-sine, one-cosine)."""
-    from analytic.excitation import PULSE_KINDS
+    from trilith_xval.analytic.excitation import PULSE_KINDS
     return isinstance(kind, str) and kind in PULSE_KINDS
 
 
@@ -208,8 +208,8 @@ _NOISE = {"pivot_sliding_max": 1e-5, "penetration_max": 1e-4, "lintel_rotation_m
 def contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
     """The diagnostic farthest beyond its noise level in a run at ``amplitude``
     (and the verdict's own reason when that run collapsed)."""
-    from analytic.pulses import pulse_of
-    from compare.run import runs
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.compare.run import runs
     tr = runs.simulate(engine, scene, pulse_of(kind, amplitude, omega),
                        configure(engine, settings, verdict_only=True))
     ratios = {k: (tr.diagnostics.get(k) or 0.0) / n for k, n in _NOISE.items()}
@@ -223,10 +223,10 @@ def contact_detail(engine, scene, omega, amplitude, settings, kind) -> str:
 def explain_isolated(engine, scene, omega, iso: dict, settings, kind) -> str:
     """What made an isolated overturn: the impact of a full run at its amplitude
     (same perturbation) whose restitution is farthest off Eq. 19/20."""
-    from analytic.pulses import pulse_of
-    from compare.measure.restitution import restitution_from_trajectory
-    from compare.measure.thresholds import TILT
-    from compare.run import runs
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.compare.measure.restitution import restitution_from_trajectory
+    from trilith_xval.compare.measure.thresholds import TILT
+    from trilith_xval.compare.run import runs
     extra = {"theta0": TILT} if iso.get("perturbation") == "tilt" else {}
     run = configure(engine, settings, verdict_only=False, **extra)
     tr = runs.simulate(engine, scene, pulse_of(kind, iso["amplitude"], omega), run)

@@ -24,13 +24,13 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from engines import configure
+from trilith_xval.engines import configure
 
-from compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
+from trilith_xval.compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
                                     sensitivity_detail)
-from compare.measure.step_rule import passes, rule_out_step
-from compare.measure.threshold_point import ThresholdPoint
-from compare.measure.thresholds import SEARCH, engine_threshold
+from trilith_xval.compare.measure.step_rule import passes, rule_out_step
+from trilith_xval.compare.measure.threshold_point import ThresholdPoint
+from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
 __all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "engine_points", "measure_point",
            "pulse_settings", "CAUSES", "DEFAULT_TOL", "DEFAULT_REL_TOL"]
@@ -93,8 +93,8 @@ def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "
     :data:`engines.base.FRICTION_MARGIN` times the no-sliding bound of the largest
     pulse a bracket may try (a friction of None is the engine's own default for
     each run, which follows the same rule): :meth:`compare.run.spec.RunSpec.resolve`."""
-    from analytic.pulses import pulse_of
-    from compare.run.spec import RunSpec
+    from trilith_xval.analytic.pulses import pulse_of
+    from trilith_xval.compare.run.spec import RunSpec
     return RunSpec.resolve(engine, scene, pulse_of(kind, a_max, omega), overrides=options,
                            overrides_from="the options given").settings
 
@@ -240,7 +240,7 @@ def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", worker
     -------
     EngineSpectrum
     """
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     settings = configure(engine, **options)  # validates the options up front
     omegas = [float(w) for w in reference.omega]
     jobs, keys = [], []
@@ -281,5 +281,5 @@ def _map(fn, items: list, workers: int) -> list:
     """``[fn(x) for x in items]``, in order, through :func:`compare.run.runs.run_many`:
     local workers that die with their parent and stop at Ctrl-C, or the Dask
     cluster of ``--scheduler``; each engine run inside goes through the run store."""
-    from compare.run.runs import run_many
+    from trilith_xval.compare.run.runs import run_many
     return list(run_many(fn, items, workers=max(1, workers)))

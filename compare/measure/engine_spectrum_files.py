@@ -1,12 +1,12 @@
 """Engine spectra as files: CSV rows and the plot (analytic curves, every engine's
 points, relative error vs Omega with the cause of each point outside tolerance),
 and from stored ``spectrum --engine --json`` documents the summary table and the
-plot again (``python -m compare.measure.engine_spectrum_files``)."""
+plot again (``python -m trilith_xval.compare.measure.engine_spectrum_files``)."""
 from __future__ import annotations
 
 import math
 
-from compare.measure.engine_spectrum import DEFAULT_TOL, EngineSpectrum
+from trilith_xval.compare.measure.engine_spectrum import DEFAULT_TOL, EngineSpectrum
 
 __all__ = ["write_csv", "plot", "plot_document", "summary_table", "CSV_FIELDS",
            "SHORT_CAUSE"]
@@ -46,7 +46,7 @@ def plot(reference, spectra: list[EngineSpectrum], path, tol: float = DEFAULT_TO
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from compare.report.units import g_hz_axes
+    from trilith_xval.compare.report.units import g_hz_axes
 
     fig, (top, low) = plt.subplots(2, 1, sharex=True, figsize=(7.0, 6.4),
                                    gridspec_kw={"height_ratios": [2, 1]})
@@ -161,7 +161,7 @@ def summary_table(paths) -> str:
     points within the tolerance, the agreement region (every point up to the first
     frequency with a disagreeing point), what lies beyond, isolated overturns, runs
     and CPU seconds when computed (the searches / with the convergence reruns)."""
-    from scenes.safe_read import read_json
+    from trilith_xval.scenes.safe_read import read_json
     lines = ["| engine | agree within 2 % | region | beyond (error, primary causes) "
              "| isolated overturns | runs | CPU s (search / all) | CPU per simulated s |",
              "|---|---|---|---|---|---|---|---|"]
@@ -177,11 +177,11 @@ def main(argv=None) -> int:
     import sys
     from pathlib import Path
 
-    from scenes.safe_read import read_json
+    from trilith_xval.scenes.safe_read import read_json
     args = list(sys.argv[1:] if argv is None else argv)
     if args[:1] == ["--plot"]:
         out, source = args[1], args[2]
-        from compare.run.atomic import atomic_path
+        from trilith_xval.compare.run.atomic import atomic_path
         doc = read_json(source, f"spectrum file {source!r}", schema_versions=(1,))
         with atomic_path(out, Path(out).suffix) as tmp:
             plot_document(doc, tmp)

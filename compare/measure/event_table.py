@@ -1,6 +1,6 @@
 """The shared event rule on every backend: the paper's points A-D and the sample record.
 
-``python -m compare.measure.event_table [BACKEND ...]`` prints a Markdown table: for
+``python -m trilith_xval.compare.measure.event_table [BACKEND ...]`` prints a Markdown table: for
 each case and backend the uplift, the number of impacts and the overturn read by
 :mod:`analytic.sampled_events` (each time +- its resolution), the verdict's own time,
 and the run's CPU seconds; the model's exact lift-off and impact count are in the
@@ -19,9 +19,9 @@ RECORD = "scenes/records/sample.csv"
 
 
 def _cases():
-    from scenes import load_scene
-    from scenes.ground_motion import load_record
-    from scenes.points import POINTS, point_pulse
+    from trilith_xval.scenes import load_scene
+    from trilith_xval.scenes.ground_motion import load_record
+    from trilith_xval.scenes.points import POINTS, point_pulse
 
     scene = load_scene("fig5")
     for point in POINTS:
@@ -34,7 +34,7 @@ def _cases():
 
 def rows(backends) -> list[dict]:
     """One row per case and backend (calibrated settings, each backend's own stop rule)."""
-    import engines
+    from trilith_xval import engines
 
     out = []
     for case, scene, excitation in _cases():
@@ -57,7 +57,7 @@ def rows(backends) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    from engines import engine_names
+    from trilith_xval.engines import engine_names
     backends = (argv if argv is not None else sys.argv[1:]) or ["analytic", *engine_names()]
     load0 = os.getloadavg()
     table = rows(backends)

@@ -13,9 +13,9 @@ import math
 import time
 from dataclasses import dataclass
 
-from compare.measure import thresholds
-from compare.measure.thresholds import _check_positive
-from compare.measure.trajectories import Provenance, settings_provenance
+from trilith_xval.compare.measure import thresholds
+from trilith_xval.compare.measure.thresholds import _check_positive
+from trilith_xval.compare.measure.trajectories import Provenance, settings_provenance
 
 __all__ = ["JumpShift", "engine_jump_frequency"]
 

@@ -28,10 +28,10 @@ def long_run(backend: str, label: str, scene_name: str, amplitude: float, omega:
              t_max: float = LONG_T_MAX, settings=None) -> dict:
     """One fixed-window run of ``backend`` and of the model; the row of the trust
     table's long-run line (:class:`compare.campaign.summary.LongRun`)."""
-    from analytic.excitation import Pulse, Still
-    from engines import configure
-    from scenes import load_scene
-    from compare.run import runs
+    from trilith_xval.analytic.excitation import Pulse, Still
+    from trilith_xval.engines import configure
+    from trilith_xval.scenes import load_scene
+    from trilith_xval.compare.run import runs
     scene = load_scene(scene_name)
     exc = Pulse(amplitude, omega) if amplitude > 0.0 else Still()
     s = configure(backend, settings, t_max=t_max, early_stop=False)

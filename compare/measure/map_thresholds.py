@@ -22,8 +22,8 @@ LEAST_RUNS = 7
 
 
 def _model_point(args):
-    from analytic.first_overturn import first_overturn_amplitude
-    from analytic.spectrum import SpectrumSettings
+    from trilith_xval.analytic.first_overturn import first_overturn_amplitude
+    from trilith_xval.analytic.spectrum import SpectrumSettings
     scene, omega, kind = args
     a, _, mode, _, _ = first_overturn_amplitude(scene, omega, SpectrumSettings(pulse=kind))
     return float(a), mode
@@ -32,7 +32,7 @@ def _model_point(args):
 def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1):
     """``[(a_reference, mode)]``: the model's first overturning amplitude [m/s^2]
     and mode at each of ``omegas`` (NaN, None when nothing overturns)."""
-    from compare.measure.engine_spectrum import _map
+    from trilith_xval.compare.measure.engine_spectrum import _map
     return _map(_model_point, [(scene, float(w), kind) for w in omegas], workers)
 
 
@@ -47,7 +47,7 @@ def map_thresholds(engine: str, scene, omegas, kind: str = "sine", *, workers: i
     early stop, as in the map's cells.  ``options``: engine settings
     (:func:`engines.configure`) the search runs with.
     """
-    from compare.measure.engine_spectrum import engine_points
+    from trilith_xval.compare.measure.engine_spectrum import engine_points
     reference = model_thresholds(scene, omegas, kind, workers) if reference is None else reference
     if t_max is not None:
         options = {**options, "t_max": t_max, "early_stop": False}

@@ -73,10 +73,10 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
         missed the model's intensity by more than :data:`STEP_TOL`: the result is
         then the coarsest finer step's that agrees, or the reference step's).
     """
-    import engines
-    from analytic.ida import scale_to
-    from compare.measure.step_rule import rule_out_step
-    from compare.measure.thresholds import engine_threshold
+    from trilith_xval import engines
+    from trilith_xval.analytic.ida import scale_to
+    from trilith_xval.compare.measure.step_rule import rule_out_step
+    from trilith_xval.compare.measure.thresholds import engine_threshold
 
     settings = engines.configure(backend, t_max=motion.end_time + st.tail, **(options or {}))
     centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
@@ -114,10 +114,10 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
 def _long_run(backend, scene, motion, st, settings, p, over: bool) -> dict | None:
     """The diagnostics of the nominal run at the highest robust survival (module
     docstring), beside the model's residual tilt at the same intensity."""
-    import engines
-    from analytic.ida import scale_to
-    from analytic.simulate import Settings, simulate
-    from compare.run import runs
+    from trilith_xval import engines
+    from trilith_xval.analytic.ida import scale_to
+    from trilith_xval.analytic.simulate import Settings, simulate
+    from trilith_xval.compare.run import runs
 
     alive = [q.amplitude for q in p.probes if not q.perturbation and q.status == "survived"
              and (not over or q.amplitude <= p.a_survives)]

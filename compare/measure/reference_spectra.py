@@ -35,10 +35,10 @@ def first_overturning_amplitude(scene, omega: float) -> tuple[float, str | None]
 def _amplitudes(scene, omegas: np.ndarray) -> tuple[list, list]:
     """:func:`analytic.spectrum.first_overturn_amplitude` (scan + bisection with
     the compiled path, default :class:`~analytic.spectrum.SpectrumSettings`)."""
-    from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
+    from trilith_xval.analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
-    from compare.run import runs
-    from compare.run.keys import scene_dict
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import scene_dict
 
     ss = SpectrumSettings()
     # One stored threshold point per frequency (the run store).
@@ -70,7 +70,7 @@ def reference_spectrum(scene, config) -> dict:
     with the largest threshold step, measured in engines), ``backend``, ``tol``.
     """
     omegas = _grid(config)
-    from analytic.spectrum import SpectrumSettings
+    from trilith_xval.analytic.spectrum import SpectrumSettings
 
     tol = SpectrumSettings().tol
     amps, modes = _amplitudes(scene, omegas)
@@ -93,8 +93,8 @@ def monotone_above(scene, omega: float, a_ref: float, span: float, n: int = 12) 
     region) a bisection in an engine would find *a* transition, not the first
     one, and the comparison would mean nothing.
     """
-    from analytic import fast
-    from analytic.excitation import Pulse
+    from trilith_xval.analytic import fast
+    from trilith_xval.analytic.excitation import Pulse
 
     return all(fast.verdict_for(scene, Pulse(a_ref * (1.0 + r), omega)).overturned
                for r in np.linspace(span / n, span, n))
@@ -108,8 +108,8 @@ def model_valid_at(scene, omega: float, amplitude: float) -> bool:
     Where one turns negative the real columns hop or the lintel is thrown off,
     the engines (which let them) are no longer comparable to the model, and an
     engine-vs-model threshold error would blame the engine for the model."""
-    from analytic.excitation import Pulse
-    from compare.run.runs import simulate
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.run.runs import simulate
 
     return bool(simulate("analytic", scene, Pulse(amplitude, omega)).diagnostics.get(
         "model_valid", True))
@@ -129,8 +129,8 @@ def locate_tongue_tip(scene, jump: dict, d_omega: float = 0.02, rel_da: float = 
     edge).  Returns ``omega_tip``, ``probe_amplitude`` and a bracket
     ``omega_lo``/``omega_hi`` of +-0.25 rad/s around the tip.
     """
-    from analytic import fast
-    from analytic.excitation import Pulse
+    from trilith_xval.analytic import fast
+    from trilith_xval.analytic.excitation import Pulse
 
     a0, a1 = jump["a_lo"], jump["a_hi"]
     left = a0 < a1  # the tongue (lower branch) lies below the jump frequency

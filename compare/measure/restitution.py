@@ -16,9 +16,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from analytic import equations as eq
-from analytic.excitation import Still
-from analytic.trajectory import Trajectory
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Still
+from trilith_xval.analytic.trajectory import Trajectory
 
 __all__ = ["ImpactRestitution", "RestitutionResult", "measure_restitution",
            "restitution_from_trajectory", "analytic_impact_times", "DEFAULT_N_IMPACTS",
@@ -110,12 +110,12 @@ def analytic_impact_times(scene, theta0: float, psi0: float, n: int) -> list[flo
 
     Examples
     --------
-    >>> from scenes import load_scene
+    >>> from trilith_xval.scenes import load_scene
     >>> scene = load_scene("fig5", gamma=0.0)
     >>> [round(t, 4) for t in analytic_impact_times(scene, 0.5 * scene.alpha, 0.0, 2)]
     [0.6721, 1.8117]
     """
-    from analytic.simulate import Settings, simulate
+    from trilith_xval.analytic.simulate import Settings, simulate
     # early_stop off: released inside the well, the energy is below the barrier at
     # t = 0 and the exact rules would stop at once; 60 s is far past the impacts
     # of interest (fig5: the fourth impact comes at ~3.7 s) and costs ~0.2 s.
@@ -179,12 +179,12 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
 
     Examples
     --------
-    >>> from scenes import load_scene
+    >>> from trilith_xval.scenes import load_scene
     >>> r = measure_restitution("pymunk", load_scene("fig5", gamma=0.0), n_impacts=2)
     >>> r.equation, r.n_impacts, r.max_rel_error < 0.005
     ('Eq. 20', 2, True)
     """
-    from engines import configure, get_backend, supports
+    from trilith_xval.engines import configure, get_backend, supports
 
     module = get_backend(backend)
     if not supports(backend, "initial_tilt"):
@@ -212,7 +212,7 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
              else times[-1] + 0.5)
     run = configure(backend, settings, **options)
     run = configure(backend, run, theta0=theta0, psi0=psi0, t_max=t_max, early_stop=False)
-    from compare.run.runs import simulate  # through the run store
+    from trilith_xval.compare.run.runs import simulate  # through the run store
     traj = simulate(backend, scene, Still(), run)
     return RestitutionResult(
         engine=backend, version=module.version(), lam=scene.lam, mu=scene.mu,

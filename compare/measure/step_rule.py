@@ -28,11 +28,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from engines import configure
-from engines.calibration import reference_dt as reference_step
+from trilith_xval.engines import configure
+from trilith_xval.engines.calibration import reference_dt as reference_step
 
-from compare.measure.threshold_point import ThresholdPoint
-from compare.measure.thresholds import SEARCH, Search, engine_threshold
+from trilith_xval.compare.measure.threshold_point import ThresholdPoint
+from trilith_xval.compare.measure.thresholds import SEARCH, Search, engine_threshold
 
 __all__ = ["StepCheck", "finer_steps", "passes", "reference_step", "rule_out_step",
            "LADDER"]

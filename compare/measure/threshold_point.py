@@ -10,7 +10,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from compare.measure.trajectories import Provenance
+from trilith_xval.compare.measure.trajectories import Provenance
 
 __all__ = ["Probe", "ThresholdPoint"]
 

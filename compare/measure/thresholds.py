@@ -41,10 +41,10 @@ import math
 import time
 from dataclasses import dataclass
 
-from analytic.pulses import pulse_of
+from trilith_xval.analytic.pulses import pulse_of
 
-from compare.measure.threshold_point import Probe, ThresholdPoint
-from compare.measure.trajectories import settings_provenance
+from trilith_xval.compare.measure.threshold_point import Probe, ThresholdPoint
+from trilith_xval.compare.measure.trajectories import settings_provenance
 
 __all__ = ["Probe", "ThresholdPoint", "Search", "SEARCH", "PERTURBATIONS", "engine_threshold",
            "overturns", "overturns_under"]
@@ -87,8 +87,8 @@ def overturns_under(backend: str, scene, motion, settings=None,
     With ``verdict_only`` (default) the run stops as soon as the verdict is
     certain; without it an overturn counts only once the columns have fallen.
     """
-    from engines import configure
-    from compare.run import runs
+    from trilith_xval.engines import configure
+    from trilith_xval.compare.run import runs
     settings = configure(backend, settings, verdict_only=verdict_only)
     hits = runs.STATS["hits"]
     traj = runs.simulate(backend, scene, motion, settings)
@@ -140,7 +140,7 @@ class _Runs:
         settings = self.settings
         if perturbation == "tilt":
             if self._tilted is None:
-                from engines import configure
+                from trilith_xval.engines import configure
                 self._tilted = configure(self.backend, self.settings, theta0=TILT)
             settings = self._tilted
         c0 = time.process_time()

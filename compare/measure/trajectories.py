@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from analytic.sampled_events import events_of
-from analytic.trajectory import Trajectory
+from trilith_xval.analytic.sampled_events import events_of
+from trilith_xval.analytic.trajectory import Trajectory
 
-from compare.run.jsonable import plain
-from compare.run.keys import backend_version
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.compare.run.keys import backend_version
 
 __all__ = ["Provenance", "TrajectoryComparison", "provenance_of",
            "settings_provenance", "compare_trajectories", "common_grid_values"]

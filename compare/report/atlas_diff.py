@@ -1,7 +1,7 @@
 """What changed between two atlases of the same points: per engine and step, how many
 rows changed cause and from what to what, and the CPU of the engine jobs.
 
-``python -m compare.report.atlas_diff OLD.json NEW.json [ENGINE ...]`` prints a
+``python -m trilith_xval.compare.report.atlas_diff OLD.json NEW.json [ENGINE ...]`` prints a
 Markdown table (docs/atlas.md quotes it with this command).
 """
 from __future__ import annotations
@@ -57,6 +57,6 @@ def markdown(rows: list[dict]) -> str:
 
 
 if __name__ == "__main__":
-    from scenes.safe_read import read_json
+    from trilith_xval.scenes.safe_read import read_json
     old_doc, new_doc = (read_json(p, p) for p in sys.argv[1:3])
     print(markdown(cause_changes(old_doc, new_doc, sys.argv[3:] or None)))

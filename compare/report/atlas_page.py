@@ -18,8 +18,8 @@ import io
 import math
 from pathlib import Path
 
-from compare.report.cells import unbroken
-from compare.report.trust import label
+from trilith_xval.compare.report.cells import unbroken
+from trilith_xval.compare.report.trust import label
 
 __all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line",
            "cost_rows", "heat_map_png", "atlas_html", "write_page"]
@@ -321,7 +321,7 @@ def page_html(doc: dict) -> str:
 
 def write_page(doc: dict, path) -> Path:
     """:func:`page_html`, written atomically."""
-    from compare.run import atomic
+    from trilith_xval.compare.run import atomic
     atomic.write_text(path, page_html(doc))
     return Path(path)
 
@@ -333,7 +333,7 @@ def stored_atlas_section(path=None) -> str:
     """The report's atlas section from the stored atlas (``docs/validation/atlas.json``,
     measured by ``trilith atlas``, not by the report's own campaign); a line saying
     it is missing when there is none."""
-    from compare.campaign.atlas_check import read_atlas
+    from trilith_xval.compare.campaign.atlas_check import read_atlas
     p = Path(path) if path is not None else STORED
     if not p.is_file():
         return ("<h2 id='atlas'>Trust atlas</h2><p>No stored atlas "

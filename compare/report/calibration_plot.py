@@ -43,7 +43,7 @@ def pareto_plot(cal, path=None, ax=None):
         matplotlib.use("Agg")  # a file only: no display needed
     import matplotlib.pyplot as plt
 
-    from compare.run import atomic
+    from trilith_xval.compare.run import atomic
 
     pts = [e for e in cal.evaluations if math.isfinite(e.worst_error) and e.engine_cpu_s > 0]
     front = [e for e in cal.front if e in pts]

@@ -53,7 +53,7 @@ def _drawing_code() -> str:
 
 def figure_key(name: str, data: dict, options: dict) -> str:
     """The store key of figure ``name`` drawing ``data`` under ``options``."""
-    from compare.run.keys import digest
+    from trilith_xval.compare.run.keys import digest
 
     return digest({"kind": KIND, "figure": name, "data": _fingerprint(data),
                    "options": options, "code": _drawing_code()})
@@ -65,7 +65,7 @@ def png_base64(name: str, data: dict, options: dict, draw) -> str:
     ``draw`` must draw ``data`` under ``options`` and nothing else: the key
     (:func:`figure_key`) is all that tells two figures apart.
     """
-    from compare.run import runs
+    from trilith_xval.compare.run import runs
 
     store = runs.active()
     if store is None:
@@ -76,7 +76,7 @@ def png_base64(name: str, data: dict, options: dict, draw) -> str:
         return base64.b64encode(stored["png"].tobytes()).decode("ascii")
     t0 = time.process_time()
     png = draw()
-    from compare.run.keys import code_version
+    from trilith_xval.compare.run.keys import code_version
 
     store.put(key, {"png": np.frombuffer(png, dtype=np.uint8)}, kind=KIND, label=name,
               cost=time.process_time() - t0, code=code_version(runs.ALL_CODE))

@@ -35,18 +35,18 @@ from pathlib import Path
 
 import numpy as np
 
-from analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
-from analytic.threshold_validity import invalid_spans, spectrum_validity
-from compare.run import atomic
-from compare.run.jsonable import plain
-from scenes import load_scene
+from trilith_xval.analytic.spectrum import Spectrum, SpectrumSettings, overturning_spectrum
+from trilith_xval.analytic.threshold_validity import invalid_spans, spectrum_validity
+from trilith_xval.compare.run import atomic
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.scenes import load_scene
 
 __all__ = ["FigureSettings", "Panel", "FigureSpec", "FIGURES", "compute_spectra", "output_names",
            "plot_figure", "make_figures", "omega_grid", "quick_settings", "figure_size",
            "check_output_options", "plain_text", "QUICK_MARK", "shade_validity",
            "FORMATS", "DEFAULT_DPI"]
 
-from compare.report.figure_options import DEFAULT_DPI, FORMATS, check_output_options  # noqa: F401
+from trilith_xval.compare.report.figure_options import DEFAULT_DPI, FORMATS, check_output_options  # noqa: F401
 SINGLE_COLUMN, DOUBLE_COLUMN = 3.5, 7.0  # in: one and two journal columns
 
 

@@ -23,23 +23,23 @@ import html
 import json
 from pathlib import Path
 
-from compare.run import atomic
-from compare.report import plots
-from compare.report import tables
-from compare.report import threshold_table
-from compare.report import units
-from compare.report.cells import unbroken
-from compare.report.recommend import recommendations
-from scenes import POINTS
+from trilith_xval.compare.run import atomic
+from trilith_xval.compare.report import plots
+from trilith_xval.compare.report import tables
+from trilith_xval.compare.report import threshold_table
+from trilith_xval.compare.report import units
+from trilith_xval.compare.report.cells import unbroken
+from trilith_xval.compare.report.recommend import recommendations
+from trilith_xval.scenes import POINTS
 
-from compare.run.jsonable import plain
-from compare.report.trust import AGREEMENT_RULE, trust_table
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.compare.report.trust import AGREEMENT_RULE, trust_table
 
 __all__ = ["write_report", "render_html", "render_markdown", "summary_dict", "add_model_validity",
            "SCHEMA_VERSION"]
 
 # The schema (and its version) lives in one place, compare/campaign/summary.py.
-from compare.campaign.summary import SCHEMA_VERSION  # noqa: E402
+from trilith_xval.compare.campaign.summary import SCHEMA_VERSION  # noqa: E402
 
 
 def summary_dict(result, provenance: dict | None = None) -> dict:
@@ -191,11 +191,11 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              tables.table(tables.HEADERS["restitution"], tables.restitution_rows(doc)),
              "<h2>Run times</h2>", tables.table(tables.HEADERS["timings"], tables.timing_rows(doc))]
     if doc.get("records"):  # trilith report --record
-        from compare.report.record_section import record_section_html
+        from trilith_xval.compare.report.record_section import record_section_html
         body += record_section_html(doc["records"])
     if doc["errors"]:
         body += ["<h2>Runs that raised</h2>", tables.table(tables.HEADERS["errors"], tables.error_rows(doc))]
-    from compare.report.atlas_page import stored_atlas_section
+    from trilith_xval.compare.report.atlas_page import stored_atlas_section
     body.append(stored_atlas_section())
     s_head, s_rows = tables.settings_rows(doc)
     body += ["<h2>Engine settings</h2>", tables.table(s_head, s_rows),
@@ -214,9 +214,9 @@ def add_model_validity(doc: dict, scene, workers: int = 1) -> dict:
     reference spectrum into ``doc["spectra"][case]["model_validity"]`` (aligned with
     ``omega``; :func:`analytic.threshold_validity.point_validity`), unless the
     summary already carries it.  The campaign's pulses are one-sine (Eq. 22)."""
-    from analytic.threshold_validity import curve_validity
-    from compare.run import runs
-    from compare.run.keys import scene_dict
+    from trilith_xval.analytic.threshold_validity import curve_validity
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import scene_dict
 
     scenes = {"pendulum": scene, "no_pendulum": scene.without_pendulum()}
     for case, spec in doc.get("spectra", {}).items():
@@ -241,7 +241,7 @@ def write_report(result, out_dir, provenance: dict | None = None,
     ``extra``: more top-level keys of the summary (``records``: the section of
     :mod:`compare.report.record_section`).
     """
-    from compare.run.provenance import collect
+    from trilith_xval.compare.run.provenance import collect
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

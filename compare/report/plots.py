@@ -31,10 +31,10 @@ import math
 
 import numpy as np
 
-from analytic.threshold_validity import invalid_spans
-from compare.report import figure_cache
-from compare.report.trust import label
-from compare.report.units import g_hz_axes
+from trilith_xval.analytic.threshold_validity import invalid_spans
+from trilith_xval.compare.report import figure_cache
+from trilith_xval.compare.report.trust import label
+from trilith_xval.compare.report.units import g_hz_axes
 
 __all__ = ["spectra_figures", "convergence_figure", "convergence_axes", "history_figures",
            "restitution_figures", "shade_invalid", "color", "marker", "DPI", "WIDTH"]
@@ -51,7 +51,7 @@ def marker(name: str) -> str:
 
 
 def _style(name: str, attr: str, default):
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     try:
         return getattr(get_backend(name), attr)
     except ValueError:
@@ -259,7 +259,7 @@ def _draw_convergence(d: dict):
 
 
 def _error_vs_time(ref, traj, alpha: float) -> tuple[np.ndarray, np.ndarray]:
-    from compare.measure.trajectories import GRID_DT, common_grid_values
+    from trilith_xval.compare.measure.trajectories import GRID_DT, common_grid_values
 
     t_end = min(float(ref.t[-1]), float(traj.t[-1]))
     t0 = max(float(ref.t[0]), float(traj.t[0]))

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import re
 
-from compare.report.cells import cause_phrase
-from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
+from trilith_xval.compare.report.cells import cause_phrase
+from trilith_xval.compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
 
 __all__ = ["recommendations"]
 

@@ -29,10 +29,10 @@ TOL = 0.02  # agreement tolerance on the intensity, as the pulse thresholds'
 
 def record_section(scene, suite, engines_: tuple, st, workers: int = 1) -> dict:
     """The section's data: ``ida`` settings, ``rows`` (one per record and engine)."""
-    from analytic.bounds import check_model
-    from analytic.ida import scale_to
-    from compare.cli.fragility import ida_job, robust_job
-    from compare.run.runs import run_many
+    from trilith_xval.analytic.bounds import check_model
+    from trilith_xval.analytic.ida import scale_to
+    from trilith_xval.compare.cli.fragility import ida_job, robust_job
+    from trilith_xval.compare.run.runs import run_many
 
     model = list(run_many(ida_job, [("analytic", scene, r, st) for r in suite],
                           workers=workers))

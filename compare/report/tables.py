@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import math
 
-from compare.report import units
-from compare.report.cells import _cell, cause_phrase, csv_text, table
-from compare.report.threshold_table import (  # noqa: F401  (in __all__)
+from trilith_xval.compare.report import units
+from trilith_xval.compare.report.cells import _cell, cause_phrase, csv_text, table
+from trilith_xval.compare.report.threshold_table import (  # noqa: F401  (in __all__)
     threshold_csv, threshold_points, threshold_rows)
-from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
-from compare.report.units import TWO_PI
+from trilith_xval.compare.report.trust import fmt_pct, fmt_sci, fmt_seconds, label
+from trilith_xval.compare.report.units import TWO_PI
 
 __all__ = ["HEADERS", "table", "csv_text", "error_rows", "history_rows", "jump_rows",
            "provenance_rows", "restitution_rows", "threshold_rows", "threshold_points",

@@ -5,10 +5,10 @@ point (SI numbers, g and Hz beside; the model's validity there), exported as CSV
 """
 from __future__ import annotations
 
-from compare.report import units
-from compare.report.cells import _cell, cause_phrase
-from compare.report.trust import fmt_seconds, fmt_sci, label
-from compare.report.units import TWO_PI
+from trilith_xval.compare.report import units
+from trilith_xval.compare.report.cells import _cell, cause_phrase
+from trilith_xval.compare.report.trust import fmt_seconds, fmt_sci, label
+from trilith_xval.compare.report.units import TWO_PI
 
 __all__ = ["threshold_points", "threshold_csv", "threshold_rows"]
 
@@ -42,7 +42,7 @@ def threshold_points(doc: dict) -> list[dict]:
     """Every engine threshold point as a flat record (SI numbers, g and Hz
     beside), for the CSV export and the table; read through the typed summary
     (:class:`compare.campaign.summary.Summary`)."""
-    from compare.campaign.summary import Summary
+    from trilith_xval.compare.campaign.summary import Summary
 
     summary = Summary.from_dict(doc)
     tol = summary.threshold_tolerance

@@ -24,7 +24,7 @@ _NOT_SETTINGS = {"criterion", "t_max", "theta0", "psi0", "monitor", "engine_vers
 def label(name: str) -> str:
     """Human name of a backend: its class's ``label`` (the name itself if it is
     not registered, e.g. an engine from a package no longer installed)."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     try:
         return get_backend(name).label
     except ValueError:
@@ -75,7 +75,7 @@ def threshold_agreement(points: list[dict], tolerance: float) -> dict:
     (every disagreeing point with its causes), ``isolated`` (points with
     isolated overturns) and ``rule``.
     """
-    from compare.campaign.summary import ThresholdResult
+    from trilith_xval.compare.campaign.summary import ThresholdResult
     pts = sorted((ThresholdResult.from_dict(p) for p in points),
                  key=lambda p: p.a_reference if p.a_reference is not None else math.inf)
 
@@ -128,7 +128,7 @@ def engine_cost(doc: dict, engine: str) -> dict:
     curves); ``points_from_store`` says how many points the run store served
     (they cost nothing now).  None where the summary holds no CPU time (a
     schema-2 summary held wall time only)."""
-    from compare.campaign.summary import ThresholdResult
+    from trilith_xval.compare.campaign.summary import ThresholdResult
     runs = [_num(c.get("test", {}).get("cpu_time")) for c in doc.get("comparisons", [])
             if c.get("backend") == engine]
     pts = [ThresholdResult.from_dict(p) for p in _points(doc, engine)]

@@ -6,8 +6,8 @@ from __future__ import annotations
 import html
 import math
 
-from compare.report.cells import _cell, cause_phrase, csv_text, table
-from compare.report.trust import fmt_pct, fmt_sci, fmt_seconds
+from trilith_xval.compare.report.cells import _cell, cause_phrase, csv_text, table
+from trilith_xval.compare.report.trust import fmt_pct, fmt_sci, fmt_seconds
 
 __all__ = ["trust_rows", "trust_html", "trust_csv", "point_rows", "spectrum_figures"]
 
@@ -113,7 +113,7 @@ def spectrum_figures(doc: dict) -> list[str]:
     """Per curve: the model's first-overturning spectrum (invalid frequencies
     hatched) with each engine's points and their error against the tolerance
     band, as the validation report draws them (base64 PNGs)."""
-    from compare.report import plots
+    from trilith_xval.compare.report import plots
     out = []
     for case, rows in doc["band"]["curves"].items():
         engines = []
@@ -140,7 +140,7 @@ def trust_csv(doc: dict) -> str:
 
 
 def trust_html(doc: dict) -> str:
-    from compare.report.html import _CSS
+    from trilith_xval.compare.report.html import _CSS
     esc = html.escape
     sc = doc["scene"]
     band = doc["band"]

@@ -36,6 +36,10 @@ __all__ = ["encode", "decode", "ForeignValue", "MAGIC"]
 
 MAGIC = b"trilith-store-v1\n"
 _PACKAGES = ("analytic", "engines", "compare", "scenes")
+# A class is stored by its name inside the project ("compare.run.store:RunStore"),
+# not by the import name it is installed under, so a store reads the same whatever
+# that name is.
+_ROOT = "trilith_xval."
 _NUMERIC_KINDS = "biufc"
 _NONFINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
 
@@ -77,10 +81,11 @@ def encode(value) -> bytes:
             return {"~": "dict", "v": [[enc(k), enc(x)] for k, x in v.items()]}
         if dataclasses.is_dataclass(v) and not isinstance(v, type):
             cls = type(v)
-            if cls.__module__.split(".")[0] not in _PACKAGES:
+            module = cls.__module__.removeprefix(_ROOT)
+            if module == cls.__module__ or module.split(".")[0] not in _PACKAGES:
                 raise TypeError(f"store: {cls.__module__}.{cls.__qualname__} is not a "
                                 "dataclass of this project")
-            return {"~": "class", "cls": f"{cls.__module__}:{cls.__qualname__}",
+            return {"~": "class", "cls": f"{module}:{cls.__qualname__}",
                     "v": {f.name: enc(getattr(v, f.name)) for f in dataclasses.fields(v)}}
         raise TypeError(f"store: cannot store a {type(v).__name__}")
 
@@ -148,7 +153,7 @@ def _instance(node, raw):
     module, _, qualname = str(node["cls"]).partition(":")
     if module.split(".")[0] not in _PACKAGES or not qualname:
         raise ForeignValue(f"class {node['cls']!r} is not of this project")
-    cls = importlib.import_module(module)
+    cls = importlib.import_module(_ROOT + module)
     for part in qualname.split("."):
         cls = getattr(cls, part)
     if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):

@@ -87,7 +87,7 @@ def _code_packages(backend: str) -> tuple[str, ...]:
 def backend_version(name: str) -> str:
     """The version string of registered backend ``name`` (its ``version()``), the
     one every key, result and report carries."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     return str(get_backend(name).version())
 
 

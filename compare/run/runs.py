@@ -24,9 +24,9 @@ import time
 from collections import Counter
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from compare.run.keys import (CODE_SETS, code_version, digest, project_version, run_code, run_key,
+from trilith_xval.compare.run.keys import (CODE_SETS, code_version, digest, project_version, run_code, run_key,
                               source_digest)
-from compare.run.store import RunStore
+from trilith_xval.compare.run.store import RunStore
 
 __all__ = ["simulate", "memo", "lookup", "memo_key", "run_many", "activate", "active", "using", "set_scheduler",
            "check_scheduler", "STATS", "stats_line"]
@@ -87,7 +87,7 @@ def simulate(name: str, scene, excitation, settings=None):
     """``engines.get_backend(name).simulate(scene, excitation, settings)``, through
     the active store: a stored run is returned as stored (bit-identical, with the
     wall time it cost then), a new one is stored."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
 
     backend = get_backend(name)
     store = _ACTIVE
@@ -258,7 +258,7 @@ def _ordered(futures, result_of, on_done, poll):
 
 
 def _run_local(payloads, workers: int, on_done):
-    from analytic._workers import fork_pool
+    from trilith_xval.analytic._workers import fork_pool
 
     with fork_pool(workers) as ex:
         futures = [ex.submit(_call, p) for p in payloads]

@@ -56,12 +56,12 @@ class RunSpec:
             A value the backend's ``Settings`` refuses, naming the field and the
             layer it came from (e.g. ``dt ... (from --settings FILE)``).
         """
-        import engines
-        from analytic.bounds import required_friction
-        from engines.base import FRICTION_MARGIN
+        from trilith_xval import engines
+        from trilith_xval.analytic.bounds import required_friction
+        from trilith_xval.engines.base import FRICTION_MARGIN
         layers, note = [], ""
         if calibrated and backend in engines.engine_names():
-            from engines.calibration import threshold_choice
+            from trilith_xval.engines.calibration import threshold_choice
             choice = threshold_choice(backend, scene)
             layers.append((f"the calibration of {backend}", choice.options))
             note = choice.note
@@ -90,7 +90,7 @@ class RunSpec:
 
     def key(self) -> dict:
         """What the run's result depends on: its store key."""
-        from compare.run.keys import (backend_version, excitation_dict, scene_dict,
+        from trilith_xval.compare.run.keys import (backend_version, excitation_dict, scene_dict,
                                       settings_dict)
         return {"backend": self.backend, "version": backend_version(self.backend),
                 "scene": scene_dict(self.scene), "excitation": excitation_dict(self.excitation),

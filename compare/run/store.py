@@ -44,10 +44,10 @@ import sys
 import time
 from pathlib import Path
 
-from compare.run import store_db
-from compare.run.store_db import default_cache_dir, default_cache_source
-from compare.run.codec import MAGIC, ForeignValue, decode, encode
-from compare.run.store_figures import StoreFigures
+from trilith_xval.compare.run import store_db
+from trilith_xval.compare.run.store_db import default_cache_dir, default_cache_source
+from trilith_xval.compare.run.codec import MAGIC, ForeignValue, decode, encode
+from trilith_xval.compare.run.store_figures import StoreFigures
 
 __all__ = ["RunStore", "default_cache_dir", "default_cache_source", "DB_NAME"]
 

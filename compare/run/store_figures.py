@@ -4,8 +4,8 @@ verify``).  Mixed into :class:`compare.run.store.RunStore`, whose ``_query``,
 ``_connect`` and ``_legacy`` they use."""
 from __future__ import annotations
 
-from compare.run import store_db
-from compare.run.codec import MAGIC, decode
+from trilith_xval.compare.run import store_db
+from trilith_xval.compare.run.codec import MAGIC, decode
 
 __all__ = ["StoreFigures"]
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analytic.parameters import Scene
+from trilith_xval.analytic.parameters import Scene
 
 __all__ = ["TrilithShape", "trilith_shape", "view_limits", "TrilithArtist", "draw_trilith",
            "COLORS"]

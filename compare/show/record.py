@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analytic.parameters import Scene
-from analytic.trajectory import Trajectory
-from engines import engine_names
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.trajectory import Trajectory
+from trilith_xval.engines import engine_names
 
 __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
            "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
@@ -135,7 +135,7 @@ def check_output(path: str | Path) -> Path:
 def resolve_engines(engine: str) -> tuple[str, ...]:
     """``'all'`` -> :data:`ALL_ENGINES`; ``'a,b'`` -> ``('a', 'b')`` (registered
     backends, each once, panels in that order); else ValueError."""
-    from engines import backend_names
+    from trilith_xval.engines import backend_names
 
     if engine.strip() == "all":
         return ALL_ENGINES
@@ -151,7 +151,7 @@ def resolve_engines(engine: str) -> tuple[str, ...]:
 
 def load_backend(name: str):
     """The backend module (:func:`engines.get_backend`; ValueError if unknown)."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
     return get_backend(name)
 
 
@@ -163,7 +163,7 @@ def backend_settings(name: str, duration: float, options: dict | None = None):
     while the pendulum still swings; every backend runs to ``t_max`` (or until it
     overturns).
     """
-    from engines import configure
+    from trilith_xval.engines import configure
     return configure(name, **(options or {}), t_max=duration, early_stop=False)
 
 
@@ -212,7 +212,7 @@ class Panels:
 
     def __init__(self, scene: Scene, excitation, times: np.ndarray,
                  trajectories: dict[str, Trajectory], figure) -> None:
-        from compare.show.draw import TrilithArtist, view_limits
+        from trilith_xval.compare.show.draw import TrilithArtist, view_limits
 
         self.times = np.asarray(times, dtype=float)
         self.trajectories = trajectories
@@ -289,7 +289,7 @@ def write_gif(frames: list[np.ndarray], path: Path, fps: float) -> None:
     palette = gif_palette(frames)
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
               for f in frames]
-    from compare.run.atomic import atomic_path
+    from trilith_xval.compare.run.atomic import atomic_path
     with atomic_path(path, Path(path).suffix) as tmp:  # whole file or none
         images[0].save(tmp, save_all=True, append_images=images[1:], loop=0,
                        duration=int(round(1000.0 / fps)), optimize=False)
@@ -322,7 +322,7 @@ def write_mp4(frames: list[np.ndarray], path: Path, fps: float) -> None:
            "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
            # Pad to even sizes (yuv420p) and use the most widely playable pixel format.
            "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", str(path)]
-    from compare.run.atomic import atomic_path
+    from trilith_xval.compare.run.atomic import atomic_path
     with atomic_path(path, Path(path).suffix) as tmp:  # whole file or none
         cmd[-1] = str(tmp)
         proc = subprocess.run(cmd, input=b"".join(np.ascontiguousarray(f).tobytes()

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from analytic.parameters import Scene
+from trilith_xval.analytic.parameters import Scene
 
 __all__ = ["display_problem", "view", "NON_INTERACTIVE_BACKENDS"]
 
@@ -64,8 +64,8 @@ def _own_gui(name: str, scene: Scene, excitation, duration: float,
              options: dict | None = None) -> bool:
     """Run engine ``name`` in its own GUI window if it declares the ``'gui'``
     capability; return whether it did."""
-    from engines import supports
-    from compare.show.record import backend_settings, load_backend
+    from trilith_xval.engines import supports
+    from trilith_xval.compare.show.record import backend_settings, load_backend
 
     if not supports(name, "gui"):
         return False
@@ -86,7 +86,7 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     to quote in it, by default ``scene.name``); ``engine_options`` as
     :class:`compare.show.record.RecordSettings`'s.
     """
-    from compare.show.record import (RecordSettings, Panels, default_duration, frame_times,
+    from trilith_xval.compare.show.record import (RecordSettings, Panels, default_duration, frame_times,
                                load_backend, resolve_engines, run_backend, shown_duration)
 
     settings = RecordSettings(fps=fps, duration=duration,  # validates fps/duration

@@ -4,10 +4,10 @@ Run: .venv/bin/python docs/examples/engine_vs_model.py [ENGINE]   (default pymun
 """
 import sys
 
-import engines
-from compare.measure.trajectories import compare_trajectories
-from compare.measure.restitution import measure_restitution
-from scenes import load_scene, point_pulse
+from trilith_xval import engines
+from trilith_xval.compare.measure.trajectories import compare_trajectories
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.scenes import load_scene, point_pulse
 
 engine = sys.argv[1] if len(sys.argv) > 1 else "pymunk"
 scene = load_scene("fig5")

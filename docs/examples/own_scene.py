@@ -2,8 +2,8 @@
 
 Run: .venv/bin/python docs/examples/own_scene.py
 """
-from analytic import Pulse, Scene
-import engines
+from trilith_xval.analytic import Pulse, Scene
+from trilith_xval import engines
 
 # Columns 0.4 m wide, lam = h/b = 4, lintel mass ratio 1.5, pendulum mass ratio 0.2 of a column.
 scene = Scene(b=0.4, lam=4.0, mu=1.5, gamma=0.2, name="my_frame")

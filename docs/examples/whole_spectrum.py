@@ -6,9 +6,9 @@ import sys
 
 import numpy as np
 
-from analytic.spectrum import overturning_spectrum
-from compare.measure.engine_spectrum import engine_spectrum
-from scenes import load_scene
+from trilith_xval.analytic.spectrum import overturning_spectrum
+from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
+from trilith_xval.scenes import load_scene
 
 lo, hi = (float(sys.argv[1]), float(sys.argv[2])) if len(sys.argv) > 2 else (3.0, 30.0)
 scene = load_scene("fig5")

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import dartpy as dart
 
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, joint_plane_state
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, joint_plane_state
 
 from .world import COLLISION_DETECTORS, DartWorld
 

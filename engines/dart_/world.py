@@ -25,7 +25,7 @@ from __future__ import annotations
 import dartpy as dart
 import numpy as np
 
-from engines import geometry
+from trilith_xval.engines import geometry
 
 __all__ = ["DartWorld", "COLLISION_DETECTORS", "NEGLIGIBLE_INERTIA_FRACTION"]
 

@@ -23,10 +23,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from analytic.options import check_real
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, joint_plane_state
-from engines.monitor import MonitorSettings
+from trilith_xval.analytic.options import check_real
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, joint_plane_state
+from trilith_xval.engines.monitor import MonitorSettings
 
 from .world import CONTACT_MODELS, SOLVERS, DrakeWorld
 

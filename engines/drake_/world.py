@@ -39,7 +39,7 @@ from pydrake.multibody.tree import (FixedOffsetFrame, PlanarJoint, RevoluteJoint
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from engines import geometry
+from trilith_xval.engines import geometry
 
 __all__ = ["DrakeWorld", "CONTACT_MODELS", "SOLVERS", "NEGLIGIBLE_INERTIA_FRACTION"]
 

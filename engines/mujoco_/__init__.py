@@ -37,11 +37,11 @@ from dataclasses import dataclass, field
 
 import mujoco
 
-from analytic.options import check_real
-from engines import geometry
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, Pose
-from engines.monitor import MonitorSettings
+from trilith_xval.analytic.options import check_real
+from trilith_xval.engines import geometry
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines.monitor import MonitorSettings
 
 from .world import BAD_WARNINGS, mjcf
 
@@ -200,8 +200,8 @@ class MujocoEngine(Engine):
 
     Examples
     --------
-    >>> from analytic.excitation import Pulse
-    >>> from scenes import load_scene
+    >>> from trilith_xval.analytic.excitation import Pulse
+    >>> from trilith_xval.scenes import load_scene
     >>> tr = MujocoEngine.simulate(load_scene("fig5"), Pulse(4.0, 9.0), Settings(t_max=0.1))
     >>> tr.backend, tr.verdict.status, tr.settings["friction_used"]
     ('mujoco', 'survived', 10.0)

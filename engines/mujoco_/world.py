@@ -30,7 +30,7 @@ import logging
 
 import mujoco
 
-from engines import geometry
+from trilith_xval.engines import geometry
 
 # MuJoCo appends its warnings to MUJOCO_LOG.TXT in the working directory; the
 # World reads the same warnings from its counters (d.warning) and reports them,

@@ -39,11 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analytic.options import check_real
-from analytic.excitation import Still
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, Pose
-from engines._quiet_pybullet import pybullet as pb
+from trilith_xval.analytic.options import check_real
+from trilith_xval.analytic.excitation import Still
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
 from . import world
 from .bodies import build_scene

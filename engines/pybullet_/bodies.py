@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from engines import geometry
-from engines._quiet_pybullet import pybullet as pb
+from trilith_xval.engines import geometry
+from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
 __all__ = ["Bodies", "build_scene", "initial_poses", "NEGLIGIBLE_MASS_FRACTION",
            "GROUND_MASS_FACTOR"]

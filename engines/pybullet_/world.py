@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 
-from engines._quiet_pybullet import pybullet as pb
+from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
 from .bodies import Bodies
 

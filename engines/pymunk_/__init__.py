@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import pymunk
 
-from analytic.options import check_real
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, Pose
+from trilith_xval.analytic.options import check_real
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, Pose
 
 from .world import build_space, state_reader
 

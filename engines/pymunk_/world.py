@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import pymunk
 
-from engines import geometry
+from trilith_xval.engines import geometry
 
 __all__ = ["Space", "build_space", "state_reader"]
 

@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from analytic.clearance import bob_clearance, check_clearance
-from analytic.parameters import Scene
+from trilith_xval.analytic.clearance import bob_clearance, check_clearance
+from trilith_xval.analytic.parameters import Scene
 
 FIG8 = Scene(b=0.6, lam=3.0, gamma=0.1)  # d = h = 1.8 m, l = 2h/3 = 1.2 m
 
@@ -36,8 +36,8 @@ def test_tilted_faces_by_hand():
 
 
 def test_check_on_a_model_run():
-    from analytic.excitation import Pulse
-    from analytic.simulate import simulate
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.analytic.simulate import simulate
     tr = simulate(FIG8, Pulse(2.0, 15.0))  # below uplift: the bob barely moves
     out = check_clearance(FIG8, tr)
     assert out["valid"] and out["min_clearance"] == pytest.approx(0.9, abs=0.05)

@@ -17,10 +17,10 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 
 from tests.support.closed_forms import makris_vassiliou
-from analytic import equations as eq
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from analytic.simulate import Settings, simulate
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.simulate import Settings, simulate
 
 
 # --- uplift --------------------------------------------------------------------------

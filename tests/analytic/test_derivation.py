@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from analytic import equations as eq
+from trilith_xval.analytic import equations as eq
 
 from tests.support import derivation as D
 

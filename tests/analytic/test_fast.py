@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from scipy.special import ellipk
 
-from analytic import _fast_kernels as kern
-from analytic import fast
-from analytic import simulate as accurate
-from analytic.events import free_pendulum_period
-from analytic.excitation import Pulse, SampledRecord
-from analytic.trajectory import OverturnCriterion
-from engines import get_backend
+from trilith_xval.analytic import _fast_kernels as kern
+from trilith_xval.analytic import fast
+from trilith_xval.analytic import simulate as accurate
+from trilith_xval.analytic.events import free_pendulum_period
+from trilith_xval.analytic.excitation import Pulse, SampledRecord
+from trilith_xval.analytic.trajectory import OverturnCriterion
+from trilith_xval.engines import get_backend
 
 # The paper's labelled points of Fig. 5 (A_s [m/s^2], Omega [rad/s]) and a few more
 # cases: overturning with and without impact, survival with impacts, low frequency.
@@ -210,7 +210,7 @@ def test_contract_and_validation(fig5):
 def test_stale_numba_cache_is_dropped(tmp_path):
     """numba does not notice an edit of equations.py inside a cached kernel: the
     fast path drops its cache when the source digest changes."""
-    from analytic import _numba_cache
+    from trilith_xval.analytic import _numba_cache
     kept = tmp_path / "other.func-1.py311.nbi"
     stale = [tmp_path / "_fast_kernels.run-9.py311.nbi", tmp_path / "equations.energy-3.py311.1.nbc"]
     for p in stale + [kept]:
@@ -227,9 +227,9 @@ def test_cosine_pulse_exactly_at_uplift_is_decided():
     rest and be decided, not loop uplift/rest at t = 0 until the step budget runs
     out (which the spectrum scan start used to hit: 21 'undecided' runs per
     one-cosine spectrum)."""
-    from analytic import Pulse
-    from analytic.fast import simulate as fast_simulate, verdict_for
-    from scenes import load_scene
+    from trilith_xval.analytic import Pulse
+    from trilith_xval.analytic.fast import simulate as fast_simulate, verdict_for
+    from trilith_xval.scenes import load_scene
 
     scene = load_scene("fig9_lam5_b0.4").without_pendulum()
     for omega in (3.5, 7.0, 8.0):
@@ -269,7 +269,7 @@ def test_energy_out_of_the_pulse_without_pendulum(fig5, run_analytic):
     the pulse, max(potential at the pulse end, r^2 E), must be at least the recorded
     run's energy just after that impact, and equal it where that term dominates;
     the verdict must be the accurate path's."""
-    from analytic.equations import energy
+    from trilith_xval.analytic.equations import energy
     scene = fig5.without_pendulum()
     b, h, mu, gamma, j, l, g = scene.model_args()
     rng = np.random.default_rng(20)

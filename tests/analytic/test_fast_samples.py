@@ -9,10 +9,10 @@ import sys
 import numpy as np
 import pytest
 
-from analytic import _fast_steps, fast, reactions
-from analytic.excitation import Pulse
-from analytic.simulate import simulate
-from scenes import load_scene
+from trilith_xval.analytic import _fast_steps, fast, reactions
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.simulate import simulate
+from trilith_xval.scenes import load_scene
 
 
 def _samples(scene, pulse):
@@ -53,6 +53,6 @@ def test_validity_is_the_same_with_and_without_the_compiled_path(monkeypatch):
     fast.warm_up(record=False)  # what a spectrum does first
     assert reactions._compiled_accelerations() is not None
     with_kernels = reactions.validity_diagnostics(*call)
-    monkeypatch.delitem(sys.modules, "analytic._fast_kernels")  # a process without them
+    monkeypatch.delitem(sys.modules, "trilith_xval.analytic._fast_kernels")  # a process without them
     assert reactions._compiled_accelerations() is None
     assert reactions.validity_diagnostics(*call) == with_kernels

@@ -55,7 +55,7 @@ def test_point_d_leans_past_alpha_at_the_pulse_end(fig5, run_analytic):
     """Why the energy-barrier rule needs ``|theta| < alpha``: at D the trilith is
     past alpha when the pulse ends with an energy *below* the barrier (the
     potential drops past alpha), yet it topples."""
-    from analytic import equations as eq
+    from trilith_xval.analytic import equations as eq
     tr = run_analytic(fig5, 25.0, 11.0)
     period = tr.excitation.period
     i = int(abs(tr.t - period).argmin())

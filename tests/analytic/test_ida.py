@@ -7,10 +7,10 @@ import math
 
 import pytest
 
-from analytic.excitation import Pulse, SampledRecord
-from analytic.first_overturn import SpectrumSettings, first_overturn_amplitude, search_run_settings
-from analytic.ida import IDASettings, first_overturn_intensity, model_verdict
-from scenes import load_scene
+from trilith_xval.analytic.excitation import Pulse, SampledRecord
+from trilith_xval.analytic.first_overturn import SpectrumSettings, first_overturn_amplitude, search_run_settings
+from trilith_xval.analytic.ida import IDASettings, first_overturn_intensity, model_verdict
+from trilith_xval.scenes import load_scene
 
 
 def windows(*intervals):

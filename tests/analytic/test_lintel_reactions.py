@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from analytic import equations as eq
-from analytic.excitation import Pulse
-from analytic.bounds import check_model
-from analytic.reactions import lintel_force, lintel_history
-from analytic.simulate import Settings, simulate
-from analytic.trajectory import OverturnCriterion
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.bounds import check_model
+from trilith_xval.analytic.reactions import lintel_force, lintel_history
+from trilith_xval.analytic.simulate import Settings, simulate
+from trilith_xval.analytic.trajectory import OverturnCriterion
 from tests.support.finite_differences import central_difference_force
 
 

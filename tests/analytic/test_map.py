@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from analytic import fast
-from analytic.excitation import Pulse
-from analytic.overturn_map import analytic_map, verdict_label, verdict_map
-from compare.cli.main import main as cli_main
+from trilith_xval.analytic import fast
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.overturn_map import analytic_map, verdict_label, verdict_map
+from trilith_xval.compare.cli.main import main as cli_main
 
 OMEGAS = np.array([7.0, 11.0, 18.0])
 AMPS = np.arange(1.0, 45.0, 1.5)

@@ -20,9 +20,9 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from analytic import equations as eq
-from analytic.excitation import Pulse
-from analytic.parameters import LENGTH_RANGE, Scene
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import LENGTH_RANGE, Scene
 
 # Common hypothesis profile: deterministic, no deadline; example counts per test.
 CHEAP = settings(max_examples=300, deadline=None, derandomize=True,
@@ -202,7 +202,7 @@ def scene_and_pulse(draw):
 
 
 def _simulate(scene, pulse, **kw):
-    from analytic.simulate import Settings, simulate
+    from trilith_xval.analytic.simulate import Settings, simulate
     # A 3 s window after the pulse keeps every example bounded in cost.
     return simulate(scene, pulse, Settings(t_max=pulse.end_time + 3.0, **kw))
 

@@ -12,11 +12,11 @@ import pytest
 from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
 
-from analytic import equations as eq
-from analytic.excitation import Pulse
-from analytic.pulses import MavroeidisPapageorgiou, Ricker
-from analytic.simulate import Settings, simulate
-from scenes import load_scene
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.pulses import MavroeidisPapageorgiou, Ricker
+from trilith_xval.analytic.simulate import Settings, simulate
+from trilith_xval.scenes import load_scene
 
 PULSES = [Ricker(3.0, 0.4), Ricker(-2.0, 1.1, "antisymmetric"),
           MavroeidisPapageorgiou(0.4, 1.5, 2.0, 0.0),

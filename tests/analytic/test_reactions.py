@@ -10,13 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from analytic import equations as eq
-from analytic.excitation import Pulse
-from analytic.reactions import ground_reaction, reaction_history, system_mass
-from analytic.simulate import Settings, simulate
-from analytic.trajectory import OverturnCriterion
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.reactions import ground_reaction, reaction_history, system_mass
+from trilith_xval.analytic.simulate import Settings, simulate
+from trilith_xval.analytic.trajectory import OverturnCriterion
 from tests.support.finite_differences import central_difference_force
-from compare.run.jsonable import plain
+from trilith_xval.compare.run.jsonable import plain
 
 G = 9.81
 
@@ -118,8 +118,8 @@ FIG5 = {"A": (19.0, 15.0), "B": (4.0, 9.0), "C": (10.0, 9.0), "D": (25.0, 11.0)}
 @pytest.mark.parametrize("point", sorted(FIG5))
 @pytest.mark.parametrize("criterion", ["topple", "alpha"])
 def test_fig5_points_are_valid(fig5, run_analytic, point, criterion):
-    from analytic.bounds import required_friction
-    from engines import ENGINES, get_backend
+    from trilith_xval.analytic.bounds import required_friction
+    from trilith_xval.engines import ENGINES, get_backend
     amplitude, omega = FIG5[point]
     tr = run_analytic(fig5, amplitude, omega, criterion=criterion)
     d = tr.diagnostics
@@ -157,8 +157,8 @@ def test_toppling_columns_would_lose_contact_during_the_fall(fig5, run_analytic)
 def test_extreme_pulse_is_flagged_invalid(fig5, monkeypatch):
     """lam = 1.5, b = 0.6 m, mu = 1, no pendulum, 50 g at 100 rad/s: the model's
     columns would have to be pulled down (they would hop)."""
-    from analytic import fast
-    from analytic import simulate as simulate_module
+    from trilith_xval.analytic import fast
+    from trilith_xval.analytic import simulate as simulate_module
     scene = fig5.replace(lam=1.5, b=0.6, mu=1.0, gamma=0.0)
     pulse = Pulse(50.0 * G, 100.0)
     tr = simulate(scene, pulse)
@@ -187,7 +187,7 @@ def test_extreme_pulse_is_flagged_invalid(fig5, monkeypatch):
 
 
 def test_cli_warns_when_the_model_is_invalid(capsys):
-    from compare.cli.main import main
+    from trilith_xval.compare.cli.main import main
     code = main(["simulate", "--set", "lam=1.5", "--set", "b=0.6", "--set", "mu=1",
                  "--no-pendulum", "-A", "490.5", "-w", "100"])
     out = capsys.readouterr().out

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from analytic.sampled_events import EventRule, read_events
+from trilith_xval.analytic.sampled_events import EventRule, read_events
 
 ALPHA = 0.2
 
@@ -105,9 +105,9 @@ def test_bad_samples_raise():
 @pytest.mark.slow
 @pytest.mark.parametrize("point", ["A", "D"])
 def test_model_and_pymunk_read_by_the_same_rule_agree(point):
-    import engines
-    from scenes import load_scene
-    from scenes.points import point_pulse
+    from trilith_xval import engines
+    from trilith_xval.scenes import load_scene
+    from trilith_xval.scenes.points import point_pulse
 
     scene = load_scene("fig5")
     model = engines.simulate("analytic", scene, point_pulse(point)).sampled_events()

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from analytic.events import Settings
-from analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
-from analytic.pulses import PulseShape, pulse_of
-from analytic.shape_threshold import first_overturn_pga
-from analytic.simulate import simulate
-from scenes import load_scene
+from trilith_xval.analytic.events import Settings
+from trilith_xval.analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
+from trilith_xval.analytic.pulses import PulseShape, pulse_of
+from trilith_xval.analytic.shape_threshold import first_overturn_pga
+from trilith_xval.analytic.simulate import simulate
+from trilith_xval.scenes import load_scene
 
 
 def test_agrees_with_the_compiled_search_on_a_sine_pulse():

@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from analytic import equations as eq
-from analytic.excitation import Pulse, SampledRecord
-from analytic.simulate import NAME, Settings, simulate, version
-from analytic.trajectory import OverturnCriterion
-from compare.run.jsonable import plain
-from engines import get_backend
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse, SampledRecord
+from trilith_xval.analytic.simulate import NAME, Settings, simulate, version
+from trilith_xval.analytic.trajectory import OverturnCriterion
+from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.engines import get_backend
 
 FREE = Pulse(0.0, 1e4)  # zero-amplitude pulse over 0.6 ms: free motion from the initial state
 
@@ -135,7 +135,7 @@ def test_rest_period_rule_and_its_long_run_check(fig5):
     assert tr.events == ()
     # The period used matches the elliptic-integral period: the run ends one
     # period after the pulse, within the bisection-free event timing (exact).
-    from analytic.events import free_pendulum_period
+    from trilith_xval.analytic.events import free_pendulum_period
     assert tr.t[-1] == pytest.approx(FREE.period + free_pendulum_period(1.0, 0.0, l, g), abs=1e-12)
     # Independent check of the rule's claim over ten periods.
     long = simulate(fig5, FREE, Settings(psi0=1.0, t_max=35.0))
@@ -144,7 +144,7 @@ def test_rest_period_rule_and_its_long_run_check(fig5):
 
 def test_free_pendulum_period_against_direct_integration():
     from scipy.integrate import solve_ivp
-    from analytic.events import free_pendulum_period
+    from trilith_xval.analytic.events import free_pendulum_period
     l, g = 2.0, 9.81
     for psi0, pd0 in [(0.3, 0.0), (2.5, 0.0), (0.0, 5.0)]:  # libration, large, rotation
         period = free_pendulum_period(psi0, pd0, l, g)
@@ -218,7 +218,7 @@ def test_determinism(fig5):
 
 # --- CLI --------------------------------------------------------------------------------------
 def test_cli_json_csv_plot(tmp_path, capsys):
-    from compare.cli.main import main
+    from trilith_xval.compare.cli.main import main
     csv, png = tmp_path / "run.csv", tmp_path / "run.png"
     code = main(["simulate", "-A", "19", "-w", "15", "--no-pendulum", "--criterion", "alpha",
                  "--json", "--csv", str(csv), "--plot", str(png)])
@@ -232,7 +232,7 @@ def test_cli_json_csv_plot(tmp_path, capsys):
 
 
 def test_cli_human_summary_and_t_max(capsys):
-    from compare.cli.main import main
+    from trilith_xval.compare.cli.main import main
     assert main(["simulate", "-A", "4", "-w", "9", "--t-max", "3", "--pulse", "cosine"]) == 0
     out = capsys.readouterr().out
     assert "verdict: survived" in out and "cosine pulse" in out and "t_end = 3.000 s" in out

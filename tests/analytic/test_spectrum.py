@@ -9,15 +9,15 @@ import math
 import numpy as np
 import pytest
 
-from analytic import _workers
-from analytic import equations as eq
-from analytic import fast
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from analytic.spectrum import (Spectrum, SpectrumSettings, first_overturn_amplitude,
+from trilith_xval.analytic import _workers
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic import fast
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.spectrum import (Spectrum, SpectrumSettings, first_overturn_amplitude,
                                overturning_spectrum)
-from compare.cli.main import main as cli_main
-from compare.cli.options import parse_omega_range
+from trilith_xval.compare.cli.main import main as cli_main
+from trilith_xval.compare.cli.options import parse_omega_range
 
 from tests.support.paths import ROOT
 

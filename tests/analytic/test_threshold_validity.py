@@ -7,10 +7,10 @@ import math
 
 import pytest
 
-from analytic import _workers
-from analytic.threshold_validity import (VALIDITY_FIELDS, curve_validity, invalid_spans,
+from trilith_xval.analytic import _workers
+from trilith_xval.analytic.threshold_validity import (VALIDITY_FIELDS, curve_validity, invalid_spans,
                                          point_validity)
-from scenes import load_scene
+from trilith_xval.scenes import load_scene
 
 
 @pytest.fixture(scope="module")

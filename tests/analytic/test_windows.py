@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from analytic import fast
-from analytic.excitation import Pulse
-from analytic.spectrum import SpectrumSettings, first_overturn_amplitude
+from trilith_xval.analytic import fast
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.spectrum import SpectrumSettings, first_overturn_amplitude
 
 OMEGAS = np.round(np.linspace(5.7, 7.6, 20), 3)
 BRUTE_STEP = 0.005  # half the bisection tol: a window of width tol holds a grid point
@@ -81,7 +81,7 @@ def test_window_among_many_impacts():
     hit.  Quiet intervals need the same impact count at both ends, which keeps this
     one in the window scan (an energy margin of 0.2 alone stepped over it and
     reported 3.6755)."""
-    from scenes import load_scene
+    from trilith_xval.scenes import load_scene
     scene = load_scene("fig9_lam3_b0.2").without_pendulum()
     tol = SpectrumSettings().tol
     a, safe = first_overturn_amplitude(scene, 3.75, SpectrumSettings())[:2]
@@ -99,8 +99,8 @@ def test_quiet_intervals_hide_no_window(name, pulse):
     (energy_margin = 1), at frequencies across Fig. 5's range (3.75: the window
     among ~100 impacts on lam 3).  Measured the same on all 28 shipped scenes at
     109 frequencies each (docs/overturn-maps.md)."""
-    from analytic.spectrum import overturning_spectrum
-    from scenes import load_scene
+    from trilith_xval.analytic.spectrum import overturning_spectrum
+    from trilith_xval.scenes import load_scene
     scene, omegas = load_scene(name), [3.75, 5.0, 7.0, 9.0, 12.0, 16.0, 22.0, 30.0]
     ref = overturning_spectrum(scene, omegas, SpectrumSettings(pulse=pulse, energy_margin=1.0),
                                workers=2)

@@ -7,8 +7,8 @@ import os
 
 import pytest
 
-from analytic import _workers
-from analytic._workers import PAYOFF, POOL_START_CPU_S, map_measured, pool_size
+from trilith_xval.analytic import _workers
+from trilith_xval.analytic._workers import PAYOFF, POOL_START_CPU_S, map_measured, pool_size
 
 
 def test_pool_size_counts_workers_the_work_pays_for():

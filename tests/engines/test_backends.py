@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-import engines
-from engines.testing import backend_checks, makris_vassiliou
+from trilith_xval import engines
+from trilith_xval.engines.testing import backend_checks, makris_vassiliou
 from tests.support.closed_forms import makris_vassiliou as derived_here
 
 

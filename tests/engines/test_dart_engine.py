@@ -14,12 +14,12 @@ import math
 import numpy as np
 import pytest
 
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from compare.measure.restitution import measure_restitution
-from engines.dart_ import DartEngine, Settings
-from engines.testing import RESTITUTION_TOL
-from scenes import point_pulse
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.engines.dart_ import DartEngine, Settings
+from trilith_xval.engines.testing import RESTITUTION_TOL
+from trilith_xval.scenes import point_pulse
 
 # Restitution: the engine contract's acceptance bound (engines.testing, 0.5 %).
 # Measured at the defaults, first four impacts from alpha/2 (2026-11-26): Eq. 20

@@ -15,12 +15,12 @@ import math
 import numpy as np
 import pytest
 
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from compare.measure.restitution import measure_restitution
-from engines.drake_ import DrakeEngine, Settings
-from engines.testing import RESTITUTION_TOL
-from scenes import load_scene
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.engines.drake_ import DrakeEngine, Settings
+from trilith_xval.engines.testing import RESTITUTION_TOL
+from trilith_xval.scenes import load_scene
 
 # Restitution: the engine contract's acceptance bound (engines.testing, 0.5 %);
 # the measured worst at the defaults is in docs/drake.md.
@@ -81,8 +81,8 @@ def test_pendulum_on_a_resting_trilith_follows_eq1(fig5):
     here 'stayed down' is the monitor's uplift angle, 1e-4 rad."""
     from scipy.integrate import solve_ivp
 
-    from analytic import equations as eq
-    from analytic.excitation import Still
+    from trilith_xval.analytic import equations as eq
+    from trilith_xval.analytic.excitation import Still
 
     s = Settings(psi0=0.1, t_max=1.0, early_stop=False)
     tr = DrakeEngine.simulate(fig5, Still(), s)
@@ -99,7 +99,7 @@ def test_static_sink_is_the_calibrated_one(fig5):
     four base spheres by ``sink_fraction b`` (the penetration read from the
     poses, the same for every engine), within 10 % (the lintel's share is split
     between the columns only on average)."""
-    from analytic.excitation import Still
+    from trilith_xval.analytic.excitation import Still
 
     s = Settings(t_max=0.3, early_stop=False)
     tr = DrakeEngine.simulate(fig5, Still(), s)

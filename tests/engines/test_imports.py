@@ -11,6 +11,7 @@ import pytest
 
 from tests.support.paths import ROOT
 LAYERS = ("analytic", "scenes", "engines", "compare", "benchmarks")
+ROOT_NAME = "trilith_xval."  # the installed import name: graph nodes are named without it
 
 
 def _module_name(path: Path) -> str:
@@ -34,14 +35,15 @@ def _imports(name: str, path: Path) -> set[str]:
     found = set()
     for node in ast.walk(ast.parse(path.read_text(), str(path))):
         if isinstance(node, ast.Import):
-            targets = [a.name for a in node.names]
+            targets = [a.name.removeprefix(ROOT_NAME) for a in node.names]
         elif isinstance(node, ast.ImportFrom):
             base = node.module or ""
             if node.level:
                 up = package.split(".")[:len(package.split(".")) - node.level + 1]
                 base = ".".join(up + ([base] if base else []))
-            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in MODULES else base
-                       for a in node.names]
+            base = "" if base == ROOT_NAME[:-1] else base.removeprefix(ROOT_NAME)
+            targets = [f"{base}.{a.name}".lstrip(".") if f"{base}.{a.name}".lstrip(".") in MODULES
+                       else base for a in node.names]
         else:
             continue
         for target in targets:

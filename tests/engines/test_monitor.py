@@ -1,9 +1,9 @@
 """The engines' run monitor (engines/_common.py) on synthetic samples."""
 from __future__ import annotations
 
-from analytic import OverturnCriterion, Pulse, Scene
-from engines.monitor import RunMonitor
-from engines.base import EngineSettings
+from trilith_xval.analytic import OverturnCriterion, Pulse, Scene
+from trilith_xval.engines.monitor import RunMonitor
+from trilith_xval.engines.base import EngineSettings
 
 
 def test_columns_out_of_step_is_a_collapse():
@@ -39,7 +39,7 @@ def test_overturn_certain_rules_after_the_pulse():
     """Without a pendulum, past alpha after the pulse and moving outwards is a
     certain fall; moving back inwards with energy above the barrier is not (it can
     cross alpha again).  With a pendulum only the energy rule applies."""
-    from analytic import equations as eq
+    from trilith_xval.analytic import equations as eq
 
     bare = Scene(gamma=0.0)
     a = bare.alpha

@@ -15,13 +15,13 @@ import pytest
 
 import pybullet
 
-from analytic.excitation import Pulse, Still
-from analytic.parameters import Scene
-from engines.pybullet_ import PyBulletEngine, Settings
-from engines.pybullet_ import bodies as pbb
-from engines.pybullet_ import world as ps
-from compare.measure.restitution import measure_restitution
-from scenes import load_scene
+from trilith_xval.analytic.excitation import Pulse, Still
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.engines.pybullet_ import PyBulletEngine, Settings
+from trilith_xval.engines.pybullet_ import bodies as pbb
+from trilith_xval.engines.pybullet_ import world as ps
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.scenes import load_scene
 
 # Restitution tolerance: 0.5 %.  The measured errors are
 # ~0.03 % (median); the margin covers the engine's impact spread over 1-2 steps,
@@ -176,8 +176,8 @@ def test_uplift_time_at_point_a_matches_eq9():
     landing's friction impulse set them rocking 3.9 ms early (theta RMS before
     the first impact 8.5e-3 alpha).  Measured after the fix: -0.17 ms, 2.6e-4 alpha.
     """
-    from compare.measure.trajectories import compare_trajectories
-    from analytic.simulate import Settings as AnalyticSettings, simulate as analytic_simulate
+    from trilith_xval.compare.measure.trajectories import compare_trajectories
+    from trilith_xval.analytic.simulate import Settings as AnalyticSettings, simulate as analytic_simulate
 
     scene, pulse = load_scene("fig5"), Pulse(19.0, 15.0)
     t_max = 0.15  # past the first impact of both runs (~0.11 s)
@@ -236,8 +236,8 @@ def test_monitor_parting_before_certainty_is_collapse_after_it_is_the_fall():
     frame the model describes no longer exists, 'collapsed' (never 'overturned').
     Once the fall is certain (after the pulse, past alpha with the energy below
     the barrier) the columns may part: the fallen column decides the verdict."""
-    from engines.monitor import RunMonitor
-    from engines.base import EngineSettings
+    from trilith_xval.engines.monitor import RunMonitor
+    from trilith_xval.engines.base import EngineSettings
 
     scene = load_scene("no_pendulum")
     a = scene.alpha
@@ -270,8 +270,8 @@ def test_a_tilted_start_under_a_pulse_does_not_slide():
     for ~4.5 ms while the ground accelerated and a pivot slid 21 mm here.  The
     upright start slides ~4e-8 m; 1e-6 m is 25x that and 6000x below the
     monitor's collapse limit (1 % of b = 6 mm)."""
-    from compare.measure.engine_spectrum import pulse_settings
-    from compare.run import runs
+    from trilith_xval.compare.measure.engine_spectrum import pulse_settings
+    from trilith_xval.compare.run import runs
 
     scene = load_scene("fig5")
     settings = pulse_settings("pybullet", scene, 2.2 * 47.0, 20.0)

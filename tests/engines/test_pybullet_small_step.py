@@ -15,11 +15,11 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-import engines
-from analytic.excitation import Pulse
-from compare.measure.restitution import measure_restitution
-from engines.pybullet_ import world as ps
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.compare.measure.restitution import measure_restitution
+from trilith_xval.engines.pybullet_ import world as ps
+from trilith_xval.scenes import load_scene
 
 SMALL_DT = 2.5e-5
 

@@ -13,13 +13,13 @@ import numpy as np
 import pymunk
 import pytest
 
-from analytic import equations as eq
-from analytic.excitation import Pulse, Still
-from analytic.parameters import Scene
-from analytic.bounds import required_friction
-from engines.pymunk_ import PymunkEngine, Settings
-from engines.pymunk_ import world as pw
-from compare.measure.restitution import measure_restitution
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.excitation import Pulse, Still
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.bounds import required_friction
+from trilith_xval.engines.pymunk_ import PymunkEngine, Settings
+from trilith_xval.engines.pymunk_ import world as pw
+from trilith_xval.compare.measure.restitution import measure_restitution
 
 # ---------------------------------------------------------------- restitution
 # The acceptance bound of the engine contract.  Measured at the defaults, first

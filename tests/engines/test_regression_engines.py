@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import pytest
 
-from compare.campaign.validation import CampaignConfig, Tolerances, backend_settings
-from compare.measure.reference_spectra import first_overturning_amplitude, monotone_above
-from compare.measure.thresholds import engine_threshold
-from engines import ENGINES
-from scenes import load_scene
+from trilith_xval.compare.campaign.validation import CampaignConfig, Tolerances, backend_settings
+from trilith_xval.compare.measure.reference_spectra import first_overturning_amplitude, monotone_above
+from trilith_xval.compare.measure.thresholds import engine_threshold
+from trilith_xval.engines import ENGINES
+from trilith_xval.scenes import load_scene
 
 TOL = Tolerances()
 CONFIG = CampaignConfig()  # calibrated engine settings, theta0 = alpha/2, 4 impacts

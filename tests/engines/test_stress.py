@@ -18,13 +18,13 @@ import math
 import numpy as np
 import pytest
 
-from analytic import equations as eq
-from analytic import fast
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from analytic.simulate import Settings as AccurateSettings
-from analytic.simulate import simulate as simulate_accurate
-from analytic.trajectory import STATUSES
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic import fast
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.simulate import Settings as AccurateSettings
+from trilith_xval.analytic.simulate import simulate as simulate_accurate
+from trilith_xval.analytic.trajectory import STATUSES
 
 G = 9.81
 
@@ -287,7 +287,7 @@ ENGINE_GRID = (  # (lam, mu, gamma, l/h, A/g, Omega, dt): corners of the brief's
 def _engine_settings(name, scene, pulse, **changes):
     """Engine defaults with ``changes`` (their default friction follows the pulse,
     ``engines.base.FRICTION_MARGIN``), 1 sample per step at coarse steps."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
 
     backend = get_backend(name)
     base = backend.Settings()

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import engines
-from analytic.excitation import Pulse
-from engines.testing import check_backend
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.engines.testing import check_backend
 from tests.support.paths import ROOT
 from tests.support.toy_engine import ToyEngine
 
@@ -34,8 +34,8 @@ def test_the_toy_engine_is_one_small_folder():
 def test_registered_by_one_line_it_is_everywhere(registered):
     assert engines.get_backend("toy") is ToyEngine
     assert "toy" in engines.engine_names() and "toy" in engines.engine_list("all")
-    from compare.report.plots import color, marker
-    from compare.report.trust import label
+    from trilith_xval.compare.report.plots import color, marker
+    from trilith_xval.compare.report.trust import label
     assert (label("toy"), color("toy"), marker("toy")) == ("Toy (Pymunk)", "tab:gray", "D")
 
 

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from scenes.safe_read import check_schema, read_bytes, read_json, read_text
+from trilith_xval.scenes.safe_read import check_schema, read_bytes, read_json, read_text
 
 
 def test_special_files_are_refused_without_blocking(tmp_path):

@@ -7,9 +7,9 @@ import re
 
 import pytest
 
-from analytic import equations as eq
-from compare.cli.main import main
-from scenes import SCENE_DIR, load_scene, scene_names
+from trilith_xval.analytic import equations as eq
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import SCENE_DIR, load_scene, scene_names
 
 FIG8 = [f"fig8_lam{lam}_gamma{gamma}" for lam in (3, 5, 7) for gamma in (0.1, 0.2, 0.3)]
 FIG9 = [f"fig9_lam{lam}_b{b}" for lam in (3, 5, 7) for b in (0.2, 0.4, 0.6, 0.8)]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 __all__ = ["snapshot", "refused", "tree_digest", "read_only", "make_decoy", "decoy"]
 

@@ -15,11 +15,11 @@ import functools
 
 import numpy as np
 
-from analytic.excitation import Pulse
-from compare.measure import trajectories as metrics
-from compare.campaign.validation import POINTS, CampaignConfig, CampaignResult
-from compare.campaign.verdicts import build_verdicts
-from scenes import load_scene
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.compare.measure import trajectories as metrics
+from trilith_xval.compare.campaign.validation import POINTS, CampaignConfig, CampaignResult
+from trilith_xval.compare.campaign.verdicts import build_verdicts
+from trilith_xval.scenes import load_scene
 
 ENGINES = ("pybullet", "pymunk")
 SHIFT = {"pybullet": 0.004, "pymunk": -0.0002}  # s: the fake engines' time offsets
@@ -60,7 +60,7 @@ def _spectrum(scale: float, jump_at: float) -> dict:
 @functools.lru_cache(maxsize=1)
 def synthetic_result() -> CampaignResult:
     """The small campaign result (cached: treat as read-only)."""
-    from engines import get_backend
+    from trilith_xval.engines import get_backend
 
     config = CampaignConfig(engines=ENGINES, points=("A", "B"), workers=1)
     scene = load_scene("fig5")

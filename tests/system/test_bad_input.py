@@ -10,11 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from analytic.excitation import Pulse
-from analytic.parameters import Scene
-from analytic.simulate import Settings, simulate
-from analytic.trajectory import OverturnCriterion
-from compare.cli.main import main
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.simulate import Settings, simulate
+from trilith_xval.analytic.trajectory import OverturnCriterion
+from trilith_xval.compare.cli.main import main
 
 from tests.support.paths import ROOT
 
@@ -108,7 +108,7 @@ def test_cli_argparse_errors_exit_2(capsys):
 
 def test_cli_subprocess_one_line_error():
     exe = shutil.which("trilith", path=str(Path(sys.executable).parent))
-    cmd = [exe] if exe else [sys.executable, "-m", "compare.cli.main"]
+    cmd = [exe] if exe else [sys.executable, "-m", "trilith_xval.compare.cli.main"]
     proc = subprocess.run(cmd + ["simulate", "-A", "5", "-w", "0"], capture_output=True,
                           text=True, cwd=ROOT, timeout=120)
     assert proc.returncode == 2
@@ -119,13 +119,13 @@ def test_cli_subprocess_one_line_error():
 
 @pytest.mark.parametrize("omega", [float("nan"), -5.0, 0, 0.0, 1e6])
 def test_first_overturn_amplitude_refuses_a_frequency_outside_the_pulse_range(omega):
-    from analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
-    from scenes import load_scene
+    from trilith_xval.analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
+    from trilith_xval.scenes import load_scene
     with pytest.raises(ValueError, match=r"omega must be in \[0.1, 10000\] rad/s"):
         first_overturn_amplitude(load_scene("fig5"), omega, SpectrumSettings())
 
 
 def test_a_size_beyond_the_float_range_is_a_value_error():
-    from analytic import Scene
+    from trilith_xval.analytic import Scene
     with pytest.raises(ValueError, match="b must be finite, got an integer of 401 digits"):
         Scene(b=10 ** 400)

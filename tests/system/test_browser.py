@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from compare.run.provenance import collect
-from compare.report.html import write_report
+from trilith_xval.compare.run.provenance import collect
+from trilith_xval.compare.report.html import write_report
 
 BROWSER = next((shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome")
                 if shutil.which(n)), None)
@@ -170,7 +170,7 @@ def test_real_quick_report_in_the_browser(tmp_path):
     banner, the trust table for each engine, and the same browser checks.  The
     page's layout does not depend on which engines fill it; DART and Drake would
     multiply the cost (their runs take 5-15x Pymunk's CPU)."""
-    from compare.cli.main import main
+    from trilith_xval.compare.cli.main import main
 
     out = tmp_path / "report"
     assert main(["report", "--quick", "--engine", "pymunk,mujoco", "--out", str(out)]) == 0

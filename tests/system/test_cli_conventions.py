@@ -13,9 +13,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from compare.cli.main import main
-from compare.cli.options import SCHEMA_VERSION, resolve_workers
-from scenes import load_record, load_scene, scene_names
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.cli.options import SCHEMA_VERSION, resolve_workers
+from trilith_xval.scenes import load_record, load_scene, scene_names
 
 from tests.support.paths import ROOT
 SAMPLE_CSV = ROOT / "scenes" / "records" / "sample.csv"
@@ -24,7 +24,7 @@ SAMPLE_AT2 = ROOT / "scenes" / "records" / "sample.AT2"
 
 def _cli(*args, **kwargs) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.Popen([sys.executable, "-m", "compare.cli.main", *args], cwd=ROOT, env=env,
+    return subprocess.Popen([sys.executable, "-m", "trilith_xval.compare.cli.main", *args], cwd=ROOT, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
 
@@ -95,9 +95,9 @@ def test_simulate_json_inputs(capsys):
 def test_engine_all_names_every_registered_engine(command, capsys):
     import argparse
 
-    from compare.cli.main import build_parser
-    from compare.cli.options import parse_engine_list
-    from engines import engine_names
+    from trilith_xval.compare.cli.main import build_parser
+    from trilith_xval.compare.cli.options import parse_engine_list
+    from trilith_xval.engines import engine_names
     parser, _ = build_parser()
     args = parser.parse_args([command, "--engine", "all"] +
                              (["--records", "sample"] if command == "fragility" else []))
@@ -112,7 +112,7 @@ def _point(family, error, time, default=False):
 @pytest.mark.parametrize("strict", [False, True])
 def test_bench_strict(monkeypatch, capsys, strict):
     import benchmarks.bench_workprecision as real
-    import compare.cli.bench as bench_cmd
+    import trilith_xval.compare.cli.bench as bench_cmd
     # The default (error 1e-3 in 1 s) is dominated by 1e-4 in 0.5 s.
     points = [_point("pymunk dt", 1e-3, 1.0, default=True), _point("pymunk dt", 1e-4, 0.5)]
     fake = SimpleNamespace(run=lambda **kw: {"points": points}, _dominates=real._dominates)
@@ -124,8 +124,9 @@ def test_bench_strict(monkeypatch, capsys, strict):
 
 @pytest.mark.parametrize("strict", [False, True])
 def test_report_strict_and_formatted_fail_lines(monkeypatch, capsys, tmp_path, strict):
-    import compare.campaign.validation
-    import compare.report.html
+    import trilith_xval.compare.campaign.validation
+    import trilith_xval.compare.report.html
+    from trilith_xval import compare
     verdicts = [{"metric": "restitution vs Eq. 20", "backend": "pymunk",
                  "value": 0.012007074700878338, "tolerance": 0.005, "passed": False,
                  "unit": "relative"},
@@ -148,7 +149,7 @@ def test_a_piped_report_says_how_far_it_is(tmp_path, capsys):
     and the elapsed time; -q keeps it silent."""
     import re
 
-    from compare.campaign.validation import CampaignConfig, run_campaign
+    from trilith_xval.compare.campaign.validation import CampaignConfig, run_campaign
     config = CampaignConfig.quick(engines=("pymunk",), n_frequencies=0, points=("A",),
                                   restitution_lams=(5.0,))
     run_campaign(config, progress=True)
@@ -207,7 +208,7 @@ def test_scenes_lists_every_scene_with_its_values(capsys):
 
 
 def test_sample_record_both_formats_agree_and_regenerate():
-    from scenes.records.make_sample import synthetic_record
+    from trilith_xval.scenes.records.make_sample import synthetic_record
 
     csv, at2 = load_record(SAMPLE_CSV), load_record(SAMPLE_AT2)
     assert len(csv.times) == len(at2.times) == 1001 and csv.end_time == at2.end_time == 10.0
@@ -237,7 +238,7 @@ def test_stored_spectrum_needs_no_numba(tmp_path):
     and the output is the first run's.  (One worker: the first run computes in
     this process, so it must import numba.)"""
     argv = ["spectrum", "--omega", "9:11:1", "--workers", "1", "--cache", str(tmp_path), "--json"]
-    code = (f"import sys; from compare.cli.main import main; main({argv!r}); "
+    code = (f"import sys; from trilith_xval.compare.cli.main import main; main({argv!r}); "
             "print('numba' in sys.modules, file=sys.stderr)")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     first, again = (subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env,

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from analytic.excitation import Pulse, SampledRecord
-from analytic.parameters import Scene
-from compare.cli.main import main
-from scenes import load_record, load_scene
+from trilith_xval.analytic.excitation import Pulse, SampledRecord
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import load_record, load_scene
 
 from tests.support.paths import ROOT
 SAMPLE_CSV = ROOT / "scenes" / "records" / "sample.csv"
@@ -234,8 +234,8 @@ CORNERS = [dict(b=1e-3, lam=1.0), dict(b=1e-3, lam=100.0), dict(b=100.0, lam=1.0
 def test_range_corners_give_a_verdict(engine):
     import dataclasses
 
-    from analytic.trajectory import STATUSES
-    from engines import get_backend
+    from trilith_xval.analytic.trajectory import STATUSES
+    from trilith_xval.engines import get_backend
 
     backend = get_backend(engine)
     settings = dataclasses.replace(backend.Settings(), t_max=1.0)

@@ -22,7 +22,7 @@ DOCTEST_MODULES = ("analytic.options", "analytic.parameters", "analytic.excitati
 
 @pytest.mark.parametrize("module", DOCTEST_MODULES)
 def test_docstring_examples_run(module):
-    result = doctest.testmod(importlib.import_module(module), optionflags=doctest.ELLIPSIS)
+    result = doctest.testmod(importlib.import_module(f"trilith_xval.{module}"), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0, f"{module} has no Examples"
     assert result.failed == 0
 

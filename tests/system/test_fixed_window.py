@@ -5,11 +5,11 @@ import json
 
 import pytest
 
-import engines
-from analytic.excitation import Pulse
-from compare.cli.main import main
-from compare.cli.simulate import _settings
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.cli.simulate import _settings
+from trilith_xval.scenes import load_scene
 
 
 @pytest.mark.slow

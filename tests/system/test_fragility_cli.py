@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 # Short records (1.5 s at 100 Hz) of two half-sines, so runs are cheap; the
 # coarse grid and the no-pendulum scene keep the command to a few seconds.

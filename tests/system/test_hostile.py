@@ -20,13 +20,13 @@ from pathlib import Path
 
 import pytest
 
-from compare.cli.main import main
-from compare.run import atomic, runs
-from compare.run.store import DB_NAME, RunStore
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.run import atomic, runs
+from trilith_xval.compare.run.store import DB_NAME, RunStore
 
 from tests.support.hostile import refused, snapshot
 from tests.support.paths import ROOT
-TRILITH = [sys.executable, "-m", "compare.cli.main"]
+TRILITH = [sys.executable, "-m", "trilith_xval.compare.cli.main"]
 
 
 @pytest.fixture
@@ -195,7 +195,7 @@ def test_report_dir_replaces_only_its_own_directories(tmp_path):
 def test_killed_build_is_cleaned_by_the_next(tmp_path):
     """kill -9 inside the build leaves .r.tmp-*; the next build of r removes it, and
     leaves a user's look-alike folder (no marker, not empty) alone."""
-    code = ("import os, sys\nfrom compare.run import atomic\n"
+    code = ("import os, sys\nfrom trilith_xval.compare.run import atomic\n"
             "with atomic.report_dir(sys.argv[1]) as tmp:\n"
             "    (tmp / 'half.txt').write_text('x')\n    os.kill(os.getpid(), 9)\n")
     out = tmp_path / "r"
@@ -374,7 +374,7 @@ def test_cache_info_prune_clear(tmp_path, capsys):
 
 # -------------------------------------------------------------------- signals
 def test_ctrl_c_is_one_line(monkeypatch, capsys, here):
-    import compare.cli.scenes as scenes_cli
+    import trilith_xval.compare.cli.scenes as scenes_cli
 
     def interrupted(args):
         raise KeyboardInterrupt

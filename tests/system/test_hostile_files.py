@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 
-from compare.campaign import summary
-from scenes.safe_read import read_json
-from scenes import load_record, read_toml
+from trilith_xval.compare.campaign import summary
+from trilith_xval.scenes.safe_read import read_json
+from trilith_xval.scenes import load_record, read_toml
 
 from tests.support.hostile import refused, snapshot
 from tests.support.paths import ROOT

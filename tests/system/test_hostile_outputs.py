@@ -11,8 +11,8 @@ import os
 
 import pytest
 
-from compare.cli.main import main
-from compare.run import atomic
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.run import atomic
 
 from tests.support.hostile import decoy, make_decoy, refused, snapshot, tree_digest  # noqa: F401
 from tests.system.test_fragility_cli import ARGS, write_suite

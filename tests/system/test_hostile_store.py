@@ -17,10 +17,10 @@ from pathlib import Path
 
 import pytest
 
-from compare.cli.main import main
-from compare.run import store_db
-from compare.run.codec import encode
-from compare.run.store import DB_NAME, RunStore
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.run import store_db
+from trilith_xval.compare.run.codec import encode
+from trilith_xval.compare.run.store import DB_NAME, RunStore
 
 from tests.support.hostile import decoy, read_only, refused, snapshot  # noqa: F401
 from tests.support.paths import ROOT
@@ -171,7 +171,7 @@ def test_a_store_that_cannot_grow_is_not_called_unusable(tmp_path, capsys):
     def cap():
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega",
+    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", "spectrum", "--omega",
                            "10:30:1", "--cache", str(cache)], cwd=tmp_path, preexec_fn=cap,
                           env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
                           text=True, timeout=300)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from compare.run.store import RunStore
+from trilith_xval.compare.run.store import RunStore
 
 from tests.support.paths import ROOT
 # Liveness bound for anything we wait on (a kill taking effect, an exit after
@@ -45,7 +45,7 @@ def _study(tmp_path: Path, omega: str = "[10.0, 16.0]") -> Path:
 
 
 def _cli(*args: str) -> list[str]:
-    return [sys.executable, "-m", "compare.cli.main", *args]
+    return [sys.executable, "-m", "trilith_xval.compare.cli.main", *args]
 
 
 def _env() -> dict:

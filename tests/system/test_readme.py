@@ -50,7 +50,7 @@ def _params():
 def test_readme_cli_line_runs_as_written(line, tmp_path):
     argv = shlex.split(line, comments=True)
     exe = Path(sys.executable).parent / argv[0].removeprefix(PREFIX)
-    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "compare.cli.main"]
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "trilith_xval.compare.cli.main"]
     for folder in ("scenes", "campaigns", "docs"):  # paths the lines name, from the repo root
         (tmp_path / folder).symlink_to(ROOT / folder)
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from compare.campaign import atlas
-from compare.campaign.atlas import AtlasConfig, atlas_scenes, base_step, run_atlas
-from compare.run import runs
-from compare.run.store import RunStore
+from trilith_xval.compare.campaign import atlas
+from trilith_xval.compare.campaign.atlas import AtlasConfig, atlas_scenes, base_step, run_atlas
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.run.store import RunStore
 
 # Two Fig. 8 scenes of one lam: their no-pendulum frames are one trilith.
 SCENES = (("fig8_lam5_gamma0.1", "sine"), ("fig8_lam5_gamma0.3", "sine"))
@@ -106,7 +106,7 @@ def test_a_time_budget_records_the_jobs_it_did_not_run(store, monkeypatch):
 
     def no_engine(job):
         raise AssertionError("an engine ran after the budget")
-    monkeypatch.setattr("compare.campaign.study.run_threshold", no_engine)
+    monkeypatch.setattr("trilith_xval.compare.campaign.study.run_threshold", no_engine)
     doc = run_atlas(config, budget_s=0.0)
     (pt,) = doc["points"]
     assert pt["engines"]["pymunk"] == []
@@ -150,7 +150,7 @@ def test_no_engine_runs_where_the_model_is_invalid(store, monkeypatch):
 
     def no_engine(job):
         raise AssertionError("an engine ran where the model is invalid")
-    monkeypatch.setattr("compare.campaign.study.run_threshold", no_engine)
+    monkeypatch.setattr("trilith_xval.compare.campaign.study.run_threshold", no_engine)
     doc = run_atlas(config)
     (pt,) = doc["points"]
     assert pt["valid"] is False and pt["model_reason"] == "lintel lifts"
@@ -179,7 +179,7 @@ def _synthetic() -> dict:
 
 
 def test_trusted_region_counts_only_valid_points():
-    from compare.report.atlas_page import trusted_rows
+    from trilith_xval.compare.report.atlas_page import trusted_rows
     rows = trusted_rows(_synthetic())
     assert rows[0][:5] == ["pymunk", "0.002", "1 / 2", "50 %", "5 %"]
     assert "fig9_c 10: unknown" in rows[0][5]
@@ -188,7 +188,7 @@ def test_trusted_region_counts_only_valid_points():
 
 
 def test_the_share_counts_the_points_a_budget_reached():
-    from compare.report.atlas_page import trusted_rows
+    from trilith_xval.compare.report.atlas_page import trusted_rows
     doc = _synthetic()
     doc["points"][2]["engines"]["pymunk"] = []  # fig9_c: left by the budget at 2e-3 s
     doc["not_run"] = {"pymunk": {repr(2e-3): 1}}
@@ -200,7 +200,7 @@ def test_the_share_counts_the_points_a_budget_reached():
 
 
 def test_page_shows_maps_tables_and_what_was_not_run(tmp_path):
-    from compare.report.atlas_page import write_page
+    from trilith_xval.compare.report.atlas_page import write_page
     path = write_page(_synthetic(), tmp_path / "atlas.html")
     text = path.read_text()
     assert "not run: pybullet" in text and "Trusted region per engine and step" in text
@@ -210,7 +210,7 @@ def test_page_shows_maps_tables_and_what_was_not_run(tmp_path):
 
 
 def test_the_report_section_reads_the_stored_atlas(tmp_path):
-    from compare.report.atlas_page import stored_atlas_section
+    from trilith_xval.compare.report.atlas_page import stored_atlas_section
     assert "No stored atlas" in stored_atlas_section(tmp_path / "missing.json")
     path = tmp_path / "atlas.json"
     path.write_text(json.dumps(_synthetic()))
@@ -221,7 +221,7 @@ def test_the_report_section_reads_the_stored_atlas(tmp_path):
 def test_a_point_left_by_the_budget_is_marked_not_measured():
     # A valid point with no engine row was never measured: a dash, never read as
     # an agreeing cell (blank white is the colour of a 0 % error).
-    from compare.report.atlas_page import _grid
+    from trilith_xval.compare.report.atlas_page import _grid
     doc = _synthetic()
     doc["points"][0]["engines"]["pymunk"] = []
     labels, omegas, err, text, invalid = _grid(doc, "pymunk", "pendulum")
@@ -244,7 +244,7 @@ def test_the_cost_counts_the_workers_cpu():
 
 
 def test_a_part_line_never_calls_the_parents_cpu_the_whole_cost():
-    from compare.report.atlas_page import part_line, parts_of
+    from trilith_xval.compare.report.atlas_page import part_line, parts_of
     doc = _synthetic()
     doc.update(workers=2, parent_cpu_s=14.0, wall_s=600.0, load_average=[0.1, 1.9])
     (part,) = parts_of(doc)

@@ -8,9 +8,9 @@ import shlex
 
 import pytest
 
-from compare.campaign import atlas
-from compare.campaign.atlas_merge import merge_atlases
-from compare.cli.main import main
+from trilith_xval.compare.campaign import atlas
+from trilith_xval.compare.campaign.atlas_merge import merge_atlases
+from trilith_xval.compare.cli.main import main
 
 
 def _part(engine: str, error: float, load: float) -> dict:
@@ -93,8 +93,8 @@ def test_cli_joins_files_and_refuses_a_bad_one(tmp_path, capsys):
 def test_a_legacy_verbosity_in_a_recorded_command_becomes_its_switch():
     import shlex
 
-    from compare.campaign.atlas_merge import runnable_command
-    from compare.cli.main import build_parser
+    from trilith_xval.compare.campaign.atlas_merge import runnable_command
+    from trilith_xval.compare.cli.main import build_parser
 
     parser, _ = build_parser()
     for legacy, expect in (("--verbosity 0", 0), ("--verbosity -1", -1), ("--verbosity 1", 1)):
@@ -113,7 +113,7 @@ def test_select_engines_keeps_their_rows_and_rejoins_whole():
     import json
     from pathlib import Path
 
-    from compare.campaign.atlas_merge import merge_atlases, select_engines
+    from trilith_xval.compare.campaign.atlas_merge import merge_atlases, select_engines
     stored = json.loads((Path(__file__).parents[3] / "docs/validation/atlas.json").read_text())
     engines = list(stored["steps"])
     a, b = select_engines(stored, engines[:2]), select_engines(stored, engines[2:])
@@ -132,7 +132,7 @@ def test_atlas_diff_counts_cause_changes_per_engine_and_step():
     import json
     from pathlib import Path
 
-    from compare.report.atlas_diff import cause_changes, markdown
+    from trilith_xval.compare.report.atlas_diff import cause_changes, markdown
     old = json.loads((Path(__file__).parents[3] / "docs/validation/atlas.json").read_text())
     new = copy.deepcopy(old)
     engine = next(iter(new["steps"]))

@@ -3,10 +3,10 @@ import math
 
 import pytest
 
-import engines
-from compare.campaign.calibrate import Evaluation, ValidationSet, calibrate, pareto_front
-from compare.campaign.settings_file import load_settings_file, settings_toml
-from compare.cli.main import main
+from trilith_xval import engines
+from trilith_xval.compare.campaign.calibrate import Evaluation, ValidationSet, calibrate, pareto_front
+from trilith_xval.compare.campaign.settings_file import load_settings_file, settings_toml
+from trilith_xval.compare.cli.main import main
 
 
 def _ev(cpu, err):
@@ -50,7 +50,7 @@ def test_restitution_calibration_prefers_the_step_that_meets_eq20():
     # 1e-4 s, ~1.4 % at 2e-3 s on lam 3 mu 0.5): the 0.5 % tolerance keeps the fine
     # step even though the coarse one is cheaper.
     vs = ValidationSet(releases=((3.0, 0.5),), n_impacts=2)
-    from scenes import load_scene
+    from trilith_xval.scenes import load_scene
     cal = calibrate("pymunk", "restitution", validation=vs, space={"dt": [1e-4, 2e-3]},
                     scene=load_scene("fig5", gamma=0.0))
     by_dt = {e.options["dt"]: e for e in cal.evaluations}
@@ -91,9 +91,9 @@ def test_threshold_calibration_measures_its_cost_per_simulated_second():
 
 
 def test_a_calibration_resumes_from_the_store_with_its_measured_costs(tmp_path, monkeypatch):
-    from compare.campaign import calibrate as module
-    from compare.run import runs
-    from compare.run.store import RunStore
+    from trilith_xval.compare.campaign import calibrate as module
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.store import RunStore
 
     vs = ValidationSet(omegas=(12.0,))
     space = {"dt": [2e-3, 1e-3]}
@@ -167,8 +167,8 @@ def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
     # default among them (so the search can answer "keep the defaults").
     import dataclasses
 
-    import engines
-    from compare.campaign.calibrate import MAX_CANDIDATES, default_space
+    from trilith_xval import engines
+    from trilith_xval.compare.campaign.calibrate import MAX_CANDIDATES, default_space
     space = default_space(engine)
     defaults = engines.configure(engine)
     for name, values in space.items():
@@ -182,8 +182,8 @@ def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
 
 
 def test_the_pareto_plot_keys_its_points_by_the_settings_that_vary(tmp_path):
-    from compare.campaign.calibrate import Calibration
-    from compare.report.calibration_plot import _label, _varied, pareto_plot
+    from trilith_xval.compare.campaign.calibrate import Calibration
+    from trilith_xval.compare.report.calibration_plot import _label, _varied, pareto_plot
 
     def ev(dt, iters, err, cpu):
         return Evaluation({"dt": dt, "iterations": iters, "slop_fraction": 1e-4}, err, (),
@@ -205,8 +205,8 @@ def test_the_pareto_plot_draws_on_the_given_axes(tmp_path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from compare.campaign.calibrate import Calibration
-    from compare.report.calibration_plot import pareto_plot
+    from trilith_xval.compare.campaign.calibrate import Calibration
+    from trilith_xval.compare.report.calibration_plot import pareto_plot
     evs = [Evaluation({"dt": dt}, err, (), cpu, 2.0 * cpu, 1.0, 1)
            for dt, err, cpu in ((1e-4, 0.004, 8.0), (5e-4, 0.009, 2.0))]
     cal = Calibration("pymunk", "test", "thresholds", 0.01, ValidationSet(omegas=(12.0,)), evs)

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from compare.campaign.design import RANGES, design_scenes, domain_table, scene_omegas
-from compare.cli.main import main
-from engines.calibration import Domain, scene_coordinates
+from trilith_xval.compare.campaign.design import RANGES, design_scenes, domain_table, scene_omegas
+from trilith_xval.compare.cli.main import main
+from trilith_xval.engines.calibration import Domain, scene_coordinates
 
 
 def test_the_design_is_seeded_and_inside_its_ranges():
@@ -20,7 +20,7 @@ def test_the_design_is_seeded_and_inside_its_ranges():
         for key, (lo, hi) in RANGES.items():
             # 4-decimal rounding of the sampled sizes: 1e-3 relative slack.
             assert lo * (1 - 1e-3) <= c[key] <= hi * (1 + 1e-3), key
-    from scenes import load_scene
+    from trilith_xval.scenes import load_scene
     assert domain.outside(load_scene("fig5")) is None  # the paper's trilith is inside
     assert "outside" in domain.outside(load_scene("fig5").replace(lam=8.0))
 

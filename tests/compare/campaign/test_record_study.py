@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from compare.campaign.study import load_study
-from compare.cli.main import main
+from trilith_xval.compare.campaign.study import load_study
+from trilith_xval.compare.cli.main import main
 
 
 def write_suite(folder):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from compare.campaign.study import load_study, reference_jobs
+from trilith_xval.compare.campaign.study import load_study, reference_jobs
 
 
 def write(tmp_path, pulses: str):

@@ -4,7 +4,7 @@ from pathlib import Path
 
 from tests.support.paths import ROOT
 
-from compare.campaign.summary import Probe, Summary, ThresholdResult, load
+from trilith_xval.compare.campaign.summary import Probe, Summary, ThresholdResult, load
 
 SUMMARY = ROOT / "docs" / "validation" / "summary.json"
 

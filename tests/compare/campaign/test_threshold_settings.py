@@ -8,13 +8,13 @@ import dataclasses
 
 import pytest
 
-import engines as engines_pkg
-from compare.campaign.settings_file import domain_notes, read_settings_file, threshold_options
-from compare.campaign.study import job_settings
-from compare.campaign.validation import CampaignConfig, backend_settings, engine_options
-from engines import configure
-from engines.calibration import calibrated, scene_coordinates, threshold_choice
-from scenes import load_scene
+from trilith_xval import engines as engines_pkg
+from trilith_xval.compare.campaign.settings_file import domain_notes, read_settings_file, threshold_options
+from trilith_xval.compare.campaign.study import job_settings
+from trilith_xval.compare.campaign.validation import CampaignConfig, backend_settings, engine_options
+from trilith_xval.engines import configure
+from trilith_xval.engines.calibration import calibrated, scene_coordinates, threshold_choice
+from trilith_xval.scenes import load_scene
 
 ENGINES = engines_pkg.ENGINES
 
@@ -32,7 +32,7 @@ def test_every_engine_ships_its_calibration_as_package_data(engine):
 
 
 def test_a_missing_calibration_is_an_error_not_a_fallback(monkeypatch):
-    import engines.calibration as c
+    import trilith_xval.engines.calibration as c
     calibrated.cache_clear()
 
     class Missing:
@@ -101,7 +101,7 @@ def test_a_settings_file_then_dt_go_over_the_calibrated_step():
 
 
 def test_the_report_names_the_threshold_step():
-    from compare.report.tables import settings_rows
+    from trilith_xval.compare.report.tables import settings_rows
     doc = {"config": {"engines": ["pymunk"]}, "settings": {"pymunk": {"dt": 1e-4}},
            "threshold_settings": {"pymunk": {"dt": 2e-3}}}
     head, rows = settings_rows(doc)
@@ -113,9 +113,9 @@ def test_the_report_names_the_threshold_step():
 def test_a_threshold_job_is_a_value_resolved_once():
     """A job's run is resolved once, layer by layer, and names where a bad value
     came from."""
-    from compare.campaign.study import ThresholdJob
-    from compare.run.spec import RunSpec
-    from analytic.pulses import pulse_of
+    from trilith_xval.compare.campaign.study import ThresholdJob
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.analytic.pulses import pulse_of
 
     job = ThresholdJob("fig5", "pendulum", "sine", 12.0, 10.0, None, "pymunk", 0.0, 0.03,
                        5e-3, (("iterations", 40),))

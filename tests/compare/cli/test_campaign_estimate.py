@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 
 def test_estimate_is_printed_on_stdout(tmp_path, capsys, monkeypatch):

@@ -6,8 +6,8 @@ import shlex
 
 import pytest
 
-from compare.cli.main import build_parser
-from compare.run.provenance import command_line
+from trilith_xval.compare.cli.main import build_parser
+from trilith_xval.compare.run.provenance import command_line
 
 LINES = [
     "atlas -q --engine dart --omega 4:28:2 --time-budget 14 --workers 1 --cache /tmp/s",

@@ -15,7 +15,7 @@ HEAVY = ("numba", "scipy", "matplotlib", "pybullet", "pymunk", "mujoco", "dartpy
 
 
 def test_the_parser_imports_nothing_heavy():
-    code = ("import sys; from compare.cli.main import build_parser; build_parser(); "
+    code = ("import sys; from trilith_xval.compare.cli.main import build_parser; build_parser(); "
             f"print(' '.join(m for m in {HEAVY!r} if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
                          env={**os.environ, "PYTHONPATH": str(ROOT)}, check=True, timeout=120)

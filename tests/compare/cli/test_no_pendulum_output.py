@@ -11,7 +11,7 @@ from types import SimpleNamespace as NS
 import matplotlib
 import pytest
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 matplotlib.use("Agg")
 # Fig. 5 without the pendulum: a mode jump between 15 and 18 rad/s and the model
@@ -75,7 +75,7 @@ def _labels(fig) -> list[str]:
 
 
 def test_spectrum_plot_has_no_gain_panel_without_pendulum(no_pendulum, monkeypatch, tmp_path):
-    import compare.run.atomic as atomic
+    import trilith_xval.compare.run.atomic as atomic
     figures = _captured(monkeypatch, atomic)
     assert main(["spectrum", *GRID, *_flags(no_pendulum), "--plot",
                  str(tmp_path / "s.png")]) == 0
@@ -91,7 +91,7 @@ def test_engine_spectrum_plot_draws_one_model_curve_without_pendulum(no_pendulum
                                                                      tmp_path):
     from matplotlib.figure import Figure
 
-    from compare.measure import engine_spectrum_files as files
+    from trilith_xval.compare.measure import engine_spectrum_files as files
     figures = []
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: figures.append(fig))
     point = NS(omega=10.0, a_engine=5.6, a_reference=5.5, rel_error=0.018, cause="agrees")
@@ -106,9 +106,9 @@ def test_engine_spectrum_plot_draws_one_model_curve_without_pendulum(no_pendulum
 
 
 def test_validity_of_a_spectrum_has_its_curves_only(no_pendulum):
-    from analytic import Scene
-    from analytic.spectrum import overturning_spectrum
-    from analytic.threshold_validity import spectrum_validity
+    from trilith_xval.analytic import Scene
+    from trilith_xval.analytic.spectrum import overturning_spectrum
+    from trilith_xval.analytic.threshold_validity import spectrum_validity
     scene = Scene(gamma=0.0 if no_pendulum else 0.3)
     spec = overturning_spectrum(scene, [24.0])
     validity = spectrum_validity(spec)

@@ -13,17 +13,17 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-import engines  # noqa: E402
-from analytic import Pulse  # noqa: E402
-from compare.cli.main import main  # noqa: E402
-from compare.show.history import EVENT_MARKERS, plot_psi, plot_theta  # noqa: E402
-from scenes import load_scene  # noqa: E402
+from trilith_xval import engines  # noqa: E402
+from trilith_xval.analytic import Pulse  # noqa: E402
+from trilith_xval.compare.cli.main import main  # noqa: E402
+from trilith_xval.compare.show.history import EVENT_MARKERS, plot_psi, plot_theta  # noqa: E402
+from trilith_xval.scenes import load_scene  # noqa: E402
 
 
 @pytest.fixture
 def saved(monkeypatch):
     """The figures the CLI saves, kept open for inspection."""
-    import compare.run.atomic as atomic
+    import trilith_xval.compare.run.atomic as atomic
     figures = []
     monkeypatch.setattr(atomic, "savefig", lambda fig, *a, **k: figures.append(fig))
     yield figures
@@ -97,7 +97,7 @@ def test_plot_functions_refuse_bad_input(call, error):
 def test_engine_spectrum_plot_has_g_and_hz_axes(monkeypatch, tmp_path):
     from matplotlib.figure import Figure
 
-    from compare.measure import engine_spectrum_files as files
+    from trilith_xval.compare.measure import engine_spectrum_files as files
     figures = []
     monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: figures.append(fig))
     point = NS(omega=10.0, a_engine=5.6, a_reference=5.5, rel_error=0.018, cause="agrees")

@@ -8,8 +8,8 @@ import math
 
 import pytest
 
-from analytic.pulses import PULSE_FAMILY, MavroeidisPapageorgiou, PulseShape, Ricker, pulse_of
-from compare.cli.main import main
+from trilith_xval.analytic.pulses import PULSE_FAMILY, MavroeidisPapageorgiou, PulseShape, Ricker, pulse_of
+from trilith_xval.compare.cli.main import main
 
 from tests.support.paths import ROOT
 

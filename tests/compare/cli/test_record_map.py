@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 
 @pytest.fixture
@@ -22,10 +22,10 @@ def short_record(tmp_path):
 def test_cells_are_the_model_verdicts(short_record, tmp_path, capsys):
     """Each cell against a direct run of the accurate model: the record scaled to
     the PGA, played k times slower, in the window end + tail."""
-    from analytic.ida import scale_to
-    from analytic.simulate import Settings, simulate
-    from scenes import load_record, load_scene
-    from scenes.ground_motion import time_scaled
+    from trilith_xval.analytic.ida import scale_to
+    from trilith_xval.analytic.simulate import Settings, simulate
+    from trilith_xval.scenes import load_record, load_scene
+    from trilith_xval.scenes.ground_motion import time_scaled
     argv = ["map", "--record", short_record, "--no-pendulum", "--intensity", "6,12,24",
             "--time-scale", "0.8,1.6", "--tail", "1", "--workers", "1", "--json",
             "--cache", str(tmp_path / "cache")]

@@ -8,9 +8,9 @@ import re
 import numpy as np
 import pytest
 
-from analytic.excitation import G_STANDARD
-from compare.cli.main import main
-from scenes import load_record
+from trilith_xval.analytic.excitation import G_STANDARD
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import load_record
 
 # A short record (one sine cycle of 0.5 m/s^2 at 8 rad/s, 1.5 s) and a coarse
 # search keep each IDA to a second.

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from analytic.parameters import GLOSSARY
-from compare.cli import COMMANDS
-from compare.cli.main import main
-from scenes import load_scene, scene_names
+from trilith_xval.analytic.parameters import GLOSSARY
+from trilith_xval.compare.cli import COMMANDS
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import load_scene, scene_names
 
 ROOT = Path(__file__).resolve().parents[3]
 # The words a newcomer must not guess (mu read as friction, b as half-width).

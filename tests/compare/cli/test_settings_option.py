@@ -7,8 +7,8 @@ import json
 
 import pytest
 
-from compare.cli.main import main
-from compare.run import runs
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.run import runs
 
 from tests.support.paths import ROOT
 
@@ -110,9 +110,9 @@ def test_a_changed_setting_is_a_new_store_key(tmp_path, capsys):
 
 
 def test_campaign_jobs_carry_the_file_into_their_keys():
-    from compare.campaign.study import Study, threshold_description, threshold_jobs
-    from compare.campaign.validation import CampaignConfig, _job_description
-    from compare.run.keys import digest
+    from trilith_xval.compare.campaign.study import Study, threshold_description, threshold_jobs
+    from trilith_xval.compare.campaign.validation import CampaignConfig, _job_description
+    from trilith_xval.compare.run.keys import digest
 
     study = Study("s", ("fig5",), ("pymunk",), ("sine",), (12.0,), (0.0,))
     refs = {("fig5", "pendulum", "sine", 12.0): (20.0, "no-impact")}
@@ -130,7 +130,7 @@ def test_campaign_jobs_carry_the_file_into_their_keys():
 
 
 def test_recordings_run_with_the_file_options():
-    from compare.show.record import RecordSettings, backend_settings
+    from trilith_xval.compare.show.record import RecordSettings, backend_settings
     settings = RecordSettings(engine_options=(("pymunk", (("dt", 1e-3),)),))
     assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
     run = backend_settings("pymunk", 2.0, settings.options("pymunk"))

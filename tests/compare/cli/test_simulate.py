@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 import re
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 
 def test_simulate_prints_rule_events_with_resolution(capsys):
@@ -33,8 +33,8 @@ def test_simulate_json_has_rule_times_and_the_verdict_time(capsys):
 def test_overturn_time_is_one_quantity_in_json_python_and_record(capsys, tmp_path):
     """`overturn_time` names the verdict's time in simulate --json, in Python's
     Trajectory and in record's line; the last rise past alpha has its own name."""
-    import engines
-    from scenes import load_scene, point_pulse
+    from trilith_xval import engines
+    from trilith_xval.scenes import load_scene, point_pulse
 
     traj = engines.simulate("analytic", load_scene("fig5"), point_pulse("D"))
     assert main(["simulate", "-A", "25", "-w", "11", "--json"]) == 0

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from compare.cli.main import main
-from engines import configure
-from engines.calibration import threshold_choice
-from scenes import load_scene
+from trilith_xval.compare.cli.main import main
+from trilith_xval.engines import configure
+from trilith_xval.engines.calibration import threshold_choice
+from trilith_xval.scenes import load_scene
 
 
 def _run(capsys, argv):

@@ -5,10 +5,10 @@ import math
 
 import pytest
 
-from compare.cli.main import main
-from compare.cli.units import (acceleration_text, frequency_text, parse_acceleration,
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.cli.units import (acceleration_text, frequency_text, parse_acceleration,
                                parse_frequency, parse_period, parse_velocity)
-from scenes import SCENE_DIR
+from trilith_xval.scenes import SCENE_DIR
 
 SAMPLE = SCENE_DIR.parent / "records" / "sample.csv"
 

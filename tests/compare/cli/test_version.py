@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from compare.cli.main import main
+from trilith_xval.compare.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[3]
 

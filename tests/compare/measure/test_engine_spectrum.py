@@ -7,14 +7,14 @@ import json
 import numpy as np
 import pytest
 
-import engines
-from analytic.excitation import Pulse
-from analytic.spectrum import SpectrumSettings, overturning_spectrum
-from compare.measure import causes
-from compare.measure import engine_spectrum as es
-from compare.campaign.settings_file import threshold_options
-from compare.cli.main import main
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.spectrum import SpectrumSettings, overturning_spectrum
+from trilith_xval.compare.measure import causes
+from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.compare.campaign.settings_file import threshold_options
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import load_scene
 
 
 def _without_costs(obj):
@@ -98,8 +98,8 @@ def test_cli_engine_spectrum_bad_input(capsys):
 
 
 def _point(a_eng, a_surv, a_ref=20.0, omega=12.0, probes=()):
-    from compare.measure.thresholds import ThresholdPoint
-    from compare.measure.trajectories import Provenance
+    from trilith_xval.compare.measure.thresholds import ThresholdPoint
+    from trilith_xval.compare.measure.trajectories import Provenance
     return ThresholdPoint(omega, "sine", a_ref, a_eng, a_surv, None, None, 5, 0, 5e-3,
                           Provenance("pymunk", "", 1e-4, {}, 0.0), tuple(probes))
 
@@ -144,7 +144,7 @@ def test_collapse_where_the_model_holds_is_the_engine(valid_model):
     """The frame collapses below the model's threshold where the model is valid (PyBullet,
     Omega 21 with pendulum: collapse from 49.37 m/s^2, model invalid only at its own 50.89):
     the cause is the collapse, however invalid the model is higher up."""
-    from compare.measure.thresholds import Probe
+    from trilith_xval.compare.measure.thresholds import Probe
     probes = (Probe(49.37, "collapsed", None), Probe(50.0, "collapsed", None))
     p = _point(float("nan"), float("nan"), a_ref=50.89, omega=21.0, probes=probes)
     c = causes.classify("pybullet", load_scene("fig5"), 21.0, p, engines.configure("pybullet"))
@@ -196,12 +196,12 @@ def test_same_point_same_cause_with_any_grid(monkeypatch):
     """Three grids around Omega 12 (no pendulum): the point's causes come
     from the point and the model, never from its neighbours on the grid.  The engine is
     a fake that overturns 3 % low at every frequency (no engine run)."""
-    from compare.measure import thresholds as thr
-    from compare.measure.thresholds import Probe
+    from trilith_xval.compare.measure import thresholds as thr
+    from trilith_xval.compare.measure.thresholds import Probe
     bare = load_scene("fig5").without_pendulum()
 
     def fake(backend, scene, omega, amplitude, settings=None, kind="sine"):
-        from analytic.first_overturn import first_overturn_amplitude
+        from trilith_xval.analytic.first_overturn import first_overturn_amplitude
         a_ref = _REF.setdefault(omega, first_overturn_amplitude(scene, omega,
                                                                 SpectrumSettings())[0])
         over = amplitude >= 0.97 * a_ref

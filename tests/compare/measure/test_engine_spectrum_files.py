@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import json
 
-from compare.measure.engine_spectrum_files import summary_table
+from trilith_xval.compare.measure.engine_spectrum_files import summary_table
 
 
 def _point(omega, a_ref, err, cause, iso=0, cpu=1.0):
@@ -42,7 +42,7 @@ def test_docs_table_is_the_stored_spectra():
 
 
 def test_plot_from_a_stored_document(tmp_path):
-    from compare.measure.engine_spectrum_files import main
+    from trilith_xval.compare.measure.engine_spectrum_files import main
     curves = {"pendulum": [_point(3, 2.5, 0.002, "agrees"), _point(6, 12.0, None, "model")]}
     doc = {"inputs": {"scene": {"lam": 5.0, "b": 0.6, "gamma": 0.3, "mu": 1.0}},
            "analytic": {"omega": [3.0, 6.0], "a_pendulum": [2.5, 12.0],

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from compare.measure.fragility import agreement, empirical_curve, fit_lognormal, fragility
+from trilith_xval.compare.measure.fragility import agreement, empirical_curve, fit_lognormal, fragility
 
 MEDIAN, BETA, N = 3.0, 0.4, 4000
 
@@ -101,8 +101,8 @@ def test_fragility_refuses_bad_settings(kwargs, exc, needle):
 def test_sizes_are_capped_before_any_work():
     import time
 
-    from analytic.spectrum import overturning_spectrum
-    from scenes import load_scene
+    from trilith_xval.analytic.spectrum import overturning_spectrum
+    from trilith_xval.scenes import load_scene
     t0 = time.perf_counter()
     with pytest.raises(ValueError, match="im has 10000000 values, more than 100000"):
         fragility(np.ones(10_000_000), censored_at=10.0)

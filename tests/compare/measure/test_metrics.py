@@ -10,12 +10,12 @@ import math
 import numpy as np
 import pytest
 
-import compare.measure.thresholds as thr
-from compare.measure import jump_shift
-from analytic.parameters import Scene
-from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
-from compare.measure import trajectories as metrics
-from compare.measure.restitution import restitution_from_trajectory
+import trilith_xval.compare.measure.thresholds as thr
+from trilith_xval.compare.measure import jump_shift
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from trilith_xval.compare.measure import trajectories as metrics
+from trilith_xval.compare.measure.restitution import restitution_from_trajectory
 
 ALPHA = 0.2
 
@@ -289,9 +289,9 @@ def test_uplift_timed_at_the_same_angle_in_both_runs():
 def test_tongue_tip_is_where_the_spectrum_mode_changes():
     """The jump located by compare.measure.reference_spectra sits where analytic.spectrum's first
     overturning mode switches (an independent scan + bisection)."""
-    from compare.campaign.validation import CampaignConfig
-    from compare.measure.reference_spectra import first_overturning_amplitude, reference_spectrum
-    from scenes import load_scene
+    from trilith_xval.compare.campaign.validation import CampaignConfig
+    from trilith_xval.compare.measure.reference_spectra import first_overturning_amplitude, reference_spectrum
+    from trilith_xval.scenes import load_scene
 
     scene = load_scene("no_pendulum")
     cfg = CampaignConfig(omega_range=(17.0, 18.5), spectrum_step=0.5)

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from analytic.excitation import SampledRecord
-from analytic.ida import IDASettings, first_overturn_intensity, model_verdict
-from compare.measure.record_threshold import engine_intensity
-from scenes import load_scene
+from trilith_xval.analytic.excitation import SampledRecord
+from trilith_xval.analytic.ida import IDASettings, first_overturn_intensity, model_verdict
+from trilith_xval.compare.measure.record_threshold import engine_intensity
+from trilith_xval.scenes import load_scene
 
 
 def half_sine_record(omega: float = 9.0) -> SampledRecord:
@@ -42,8 +42,8 @@ def test_a_censored_model_centres_the_search_on_im_hi(monkeypatch):
     """No model overturn up to im_hi: the engine's search starts there, and an
     engine that survives everything is censored, not given a number (fake
     engine: no run)."""
-    from compare.measure import thresholds as thr
-    from compare.measure.thresholds import Probe
+    from trilith_xval.compare.measure import thresholds as thr
+    from trilith_xval.compare.measure.thresholds import Probe
     seen = []
 
     def survives(backend, scene, motion, settings=None, value=math.nan, verdict_only=True):

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from analytic import equations as eq
-from analytic.parameters import Scene
-from analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
-from compare.cli.main import main
-from engines import BACKENDS
-from compare.measure.restitution import analytic_impact_times, measure_restitution
+from trilith_xval.analytic import equations as eq
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.trajectory import Event, OverturnCriterion, Trajectory, Verdict
+from trilith_xval.compare.cli.main import main
+from trilith_xval.engines import BACKENDS
+from trilith_xval.compare.measure.restitution import analytic_impact_times, measure_restitution
 
 
 # ------------------------------------------------------ analytic run length
@@ -60,7 +60,7 @@ def _fake_backend(monkeypatch, impacts, tilt=True):
     """Register a backend 'fake' (what the registry reads: name, capabilities, a
     RunOptions Settings, simulate, version) that records the settings it receives and returns
     ``impacts`` (a list of Events) as its measured impacts."""
-    from analytic.options import RunOptions
+    from trilith_xval.analytic.options import RunOptions
     settings_cls = dataclasses.make_dataclass("Settings", [], bases=(RunOptions,), frozen=True)
     module = types.ModuleType("fake_backend")
     module.NAME = "fake"

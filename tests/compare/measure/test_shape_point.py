@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
-from compare.measure.engine_spectrum import DEFAULT_TOL, measure_point
-from scenes import load_scene
+from trilith_xval.analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
+from trilith_xval.compare.measure.engine_spectrum import DEFAULT_TOL, measure_point
+from trilith_xval.scenes import load_scene
 
 
 @pytest.mark.slow

@@ -7,12 +7,12 @@ import math
 
 import pytest
 
-from analytic.parameters import Scene
-from analytic.spectrum import overturning_spectrum
-from compare.measure.engine_spectrum import measure_point
-from compare.measure.step_rule import finer_steps, passes, rule_out_step
-from compare.measure.thresholds import SEARCH, engine_threshold
-from engines import configure
+from trilith_xval.analytic.parameters import Scene
+from trilith_xval.analytic.spectrum import overturning_spectrum
+from trilith_xval.compare.measure.engine_spectrum import measure_point
+from trilith_xval.compare.measure.step_rule import finer_steps, passes, rule_out_step
+from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
+from trilith_xval.engines import configure
 
 SMALL_SLENDER = Scene(b=0.15, lam=7.0, mu=0.5, gamma=0.45, l=0.3, name="small_slender")
 OMEGA = 16.0  # rad/s; at Pymunk's Fig. 5 step (5e-4 s) the threshold is ~10 % high here

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import pytest
 
-import engines
-from analytic.excitation import Pulse
-from analytic.first_overturn import first_overturn_amplitude
-from analytic.spectrum import SpectrumSettings
-from compare.measure.engine_spectrum import pulse_settings
-from scenes import load_scene
+from trilith_xval import engines
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.first_overturn import first_overturn_amplitude
+from trilith_xval.analytic.spectrum import SpectrumSettings
+from trilith_xval.compare.measure.engine_spectrum import pulse_settings
+from trilith_xval.scenes import load_scene
 
 # (case, Omega [rad/s]) inside every engine's trusted region on both curves of Fig. 5
 # (docs/engine-trust.md), away from the model's jumps and windows.

@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from compare.report.atlas_findings import ATLAS_BEGIN, ATLAS_END, render_atlas
+from trilith_xval.compare.report.atlas_findings import ATLAS_BEGIN, ATLAS_END, render_atlas
 
 from tests.support.paths import ROOT
 ATLAS = ROOT / "docs" / "validation" / "atlas.json"

@@ -7,7 +7,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from compare.report import plots  # noqa: E402
+from trilith_xval.compare.report import plots  # noqa: E402
 
 ROWS = [{"kind": "dt", "dt": 1e-4, "iterations": 50, "rel_error": 0.03},
         {"kind": "dt", "dt": 5e-5, "iterations": 50, "rel_error": 0.01},

@@ -9,9 +9,9 @@ import base64
 import numpy as np
 import pytest
 
-from compare.report import figure_cache, plots
-from compare.run import runs
-from compare.run.store import RunStore
+from trilith_xval.compare.report import figure_cache, plots
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.run.store import RunStore
 
 PNG = b"\x89PNG\r\n\x1a\n fake image bytes"
 
@@ -71,9 +71,9 @@ def test_without_a_store_every_figure_is_drawn():
 def test_a_rebuilt_report_draws_no_figure(store, tmp_path, monkeypatch):
     from tests.support.synthetic_report import synthetic_result
 
-    from compare.report.html import write_report
+    from trilith_xval.compare.report.html import write_report
 
-    from analytic import threshold_validity
+    from trilith_xval.analytic import threshold_validity
 
     drawn, checked = [], []
     real_png, real_check = plots._png, threshold_validity.curve_validity

@@ -8,11 +8,11 @@ import math
 
 import pytest
 
-from analytic.spectrum import overturning_spectrum
-from compare.cli.main import main as cli_main
-from compare.report.figures import (FIGURES, FigureSettings, compute_spectra, figure_size, omega_grid,
+from trilith_xval.analytic.spectrum import overturning_spectrum
+from trilith_xval.compare.cli.main import main as cli_main
+from trilith_xval.compare.report.figures import (FIGURES, FigureSettings, compute_spectra, figure_size, omega_grid,
                              plot_figure, quick_settings)
-from scenes import load_scene
+from trilith_xval.scenes import load_scene
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 EXPECTED = {"fig5": 1, "fig8": 9, "fig9": 12, "fig10": 3, "fig11": 4}  # panels per caption
@@ -186,7 +186,7 @@ def test_settings_validation():
 
 
 def test_quick_output_is_marked_quick(quick_run):
-    from compare.report.figures import QUICK_MARK
+    from trilith_xval.compare.report.figures import QUICK_MARK
 
     _, _, doc = quick_run
     assert doc["quick"] is True and doc["settings"]["quick"] is True

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from compare.campaign.summary import SCHEMA_VERSION
-from compare.report.findings import BEGIN, END, TRUST_BEGIN, TRUST_END, render, render_trust
-from compare.report.trust import trust_table
-from compare.campaign.verdicts import VERDICT_IDS
+from trilith_xval.compare.campaign.summary import SCHEMA_VERSION
+from trilith_xval.compare.report.findings import BEGIN, END, TRUST_BEGIN, TRUST_END, render, render_trust
+from trilith_xval.compare.report.trust import trust_table
+from trilith_xval.compare.campaign.verdicts import VERDICT_IDS
 
 from tests.support.paths import ROOT
 README = ROOT / "README.md"
@@ -30,7 +30,7 @@ def test_readme_block_is_generated_from_the_summary(doc):
     assert text.count(BEGIN) == 1 and text.count(END) == 1
     block = text.split(BEGIN, 1)[1].split(END, 1)[0].strip("\n")
     assert block == render(doc), ("README findings differ from docs/validation/summary.json; "
-                                  "run: python -m compare.report.findings docs/validation/summary.json "
+                                  "run: python -m trilith_xval.compare.report.findings docs/validation/summary.json "
                                   "README.md")
 
 

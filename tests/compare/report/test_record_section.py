@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from analytic.ida import IDASettings
-from compare.cli.main import main
-from compare.report.record_section import _row, record_section, record_section_html
-from scenes import load_scene
+from trilith_xval.analytic.ida import IDASettings
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.report.record_section import _row, record_section, record_section_html
+from trilith_xval.scenes import load_scene
 from tests.compare.measure.test_record_threshold import half_sine_record
 
 ST = IDASettings(im="pga", im_lo=2.0, im_hi=40.0, rel_step=0.5, rtol=0.01, tail=1.0)
@@ -17,8 +17,8 @@ ST = IDASettings(im="pga", im_lo=2.0, im_hi=40.0, rel_step=0.5, rtol=0.01, tail=
 def test_pymunk_agrees_on_a_one_sine_record(tmp_path):
     """The case of compare/measure/test_record_threshold.py (Pymunk within 2 %
     of the model): the section calls it 'agrees', and the page shows the row."""
-    from compare.run import runs
-    from compare.run.store import RunStore
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.store import RunStore
     with runs.using(RunStore(tmp_path / "store")):
         sec = record_section(load_scene("fig5").without_pendulum(), [half_sine_record()],
                              ("pymunk",), ST)

@@ -13,11 +13,11 @@ import json
 
 import pytest
 
-from compare.campaign.summary import SCHEMA_VERSION
-from compare.campaign.validation import CampaignConfig, run_campaign
-from compare.cli.main import main
-from compare.report.html import write_report
-from compare.campaign.verdicts import VERDICT_IDS
+from trilith_xval.compare.campaign.summary import SCHEMA_VERSION
+from trilith_xval.compare.campaign.validation import CampaignConfig, run_campaign
+from trilith_xval.compare.cli.main import main
+from trilith_xval.compare.report.html import write_report
+from trilith_xval.compare.campaign.verdicts import VERDICT_IDS
 
 # Narrow window 6-8 rad/s: far from the Fig. 5 mode jump without the pendulum
 # (17.5-18 rad/s), so the one threshold point is away from jumps.
@@ -55,8 +55,8 @@ def test_report_files_and_keys(tiny_report):
     thr = summary["spectra"]["no_pendulum"]["engines"]["pymunk"][0]
     # Threshold searches run at the calibrated threshold step; restitution and
     # histories at the engine's default.
-    from compare.campaign.settings_file import threshold_options
-    from scenes import load_scene
+    from trilith_xval.compare.campaign.settings_file import threshold_options
+    from trilith_xval.scenes import load_scene
     step = threshold_options("pymunk", load_scene("fig5"))["dt"]
     assert thr["provenance"]["dt"] == pytest.approx(step)
     assert summary["threshold_settings"]["pymunk"]["dt"] == step
@@ -107,7 +107,7 @@ def test_cli_bad_input_exits_2(argv, needle, capsys, tmp_path):
 
 
 def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
-    import compare.campaign.validation as campaign
+    import trilith_xval.compare.campaign.validation as campaign
 
     def broken(name, scene, config=None):
         raise RuntimeError("engine exploded")
@@ -127,7 +127,7 @@ def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
 def synthetic(tmp_path_factory):
     from tests.support.synthetic_report import synthetic_result
 
-    from compare.run.provenance import collect
+    from trilith_xval.compare.run.provenance import collect
 
     result = synthetic_result()
     out = tmp_path_factory.mktemp("synthetic")
@@ -167,13 +167,13 @@ def test_conclusions_follow_the_numbers(synthetic):
 
 
 def test_missing_cause_reads_not_measured():
-    from compare.report.trust import threshold_agreement
+    from trilith_xval.compare.report.trust import threshold_agreement
 
     pts = [{"omega": 10.0, "a_reference": 20.0, "a_engine": 21.0, "rel_error": 0.05,
             "bracketed": True}]
     out = threshold_agreement(pts, 0.02)
     assert out["agree_up_to"] is None and out["failing"][0]["cause"] is None
-    from compare.report.trust import conclusion
+    from trilith_xval.compare.report.trust import conclusion
     row = {"version": "v", "settings": {}, "thresholds": out,
            "cost": {"run_cpu_s": None, "threshold_point_cpu_s": None, "spectrum_cpu_s": None}}
     assert "cause: not measured" in conclusion("pymunk", row)
@@ -207,14 +207,14 @@ def test_html_first_screen_provenance_and_layout(synthetic):
 def test_command_line_is_recorded(tmp_path, monkeypatch):
     import argparse
 
-    from compare.run.provenance import command_line
+    from trilith_xval.compare.run.provenance import command_line
 
     args = argparse.Namespace(command="report", scene="fig5", quick=True, out="x y", dt=None)
     assert command_line(args) == "trilith report --scene fig5 --quick --out 'x y'"
 
 
 def test_errors_print_at_the_bracket_resolution():
-    from compare.report import units
+    from trilith_xval.compare.report import units
 
     # Both thresholds are ends of 0.2 % brackets: a difference inside one is no number.
     assert units.rel_error(-1.12e-14, 0.002) == "|e| ≤ 0.2 %"
@@ -226,7 +226,7 @@ def test_errors_print_at_the_bracket_resolution():
 
 
 def test_recommendation_names_the_excluded_engine_with_its_number(synthetic):
-    from compare.report.recommend import recommendations
+    from trilith_xval.compare.report.recommend import recommendations
 
     _, doc, out = synthetic
     lines = recommendations(doc)
@@ -244,7 +244,7 @@ def test_recommendation_names_the_excluded_engine_with_its_number(synthetic):
 def test_csv_exports_match_the_tables(synthetic):
     import csv
 
-    from compare.report import tables
+    from trilith_xval.compare.report import tables
 
     _, doc, out = synthetic
     rows = list(csv.DictReader((out / "thresholds.csv").open()))
@@ -265,7 +265,7 @@ def test_csv_exports_match_the_tables(synthetic):
 def test_an_engine_is_not_blamed_where_the_model_is_invalid(synthetic):
     import copy
 
-    from compare.report import tables
+    from trilith_xval.compare.report import tables
 
     _, doc, _ = synthetic
     doc = copy.deepcopy(doc)

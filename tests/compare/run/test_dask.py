@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from compare.run import runs
-from compare.campaign.validation import CampaignConfig, _run_one
-from compare.run.store import RunStore
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.campaign.validation import CampaignConfig, _run_one
+from trilith_xval.compare.run.store import RunStore
 from tests.support.trajectories import assert_same_trajectory
 
 distributed = pytest.importorskip("distributed")
@@ -63,7 +63,7 @@ def test_dask_workers_fill_the_callers_store(cluster, fig5, tmp_path):
 
 def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
     def spectrum(*extra):
-        proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega",
+        proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", "spectrum", "--omega",
                                "8:14:2", "--json", "--no-cache", *extra], cwd=ROOT,
                               env=os.environ, capture_output=True, text=True, timeout=600)
         assert proc.returncode == 0, proc.stderr
@@ -74,7 +74,7 @@ def test_spectrum_cli_on_the_cluster(cluster, tmp_path):
 
 
 def test_the_atlas_on_the_cluster_equals_the_local_one(cluster):
-    from compare.campaign.atlas import AtlasConfig, run_atlas
+    from trilith_xval.compare.campaign.atlas import AtlasConfig, run_atlas
     config = AtlasConfig(engines=("pymunk",), scenes=(("fig8_lam5_gamma0.1", "sine"),),
                          omegas=(12.0, 18.0), factors=(1.0, 2.0), cases=("no_pendulum",))
 
@@ -98,7 +98,7 @@ def test_the_atlas_on_the_cluster_equals_the_local_one(cluster):
 
 
 def test_unreachable_scheduler_is_a_usage_error():
-    proc = subprocess.run([sys.executable, "-m", "compare.cli.main", "spectrum", "--omega", "10",
+    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", "spectrum", "--omega", "10",
                            "--no-cache", "--scheduler", "tcp://127.0.0.1:9"], cwd=ROOT,
                           env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
                           text=True, timeout=120)

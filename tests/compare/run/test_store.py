@@ -12,12 +12,12 @@ import struct
 import numpy as np
 import pytest
 
-from analytic.excitation import Pulse, SampledRecord, Still
-from compare.run import atomic
-from compare.run import runs
-from compare.run.keys import run_key
-from compare.run.store import RunStore, default_cache_dir
-from engines import get_backend
+from trilith_xval.analytic.excitation import Pulse, SampledRecord, Still
+from trilith_xval.compare.run import atomic
+from trilith_xval.compare.run import runs
+from trilith_xval.compare.run.keys import run_key
+from trilith_xval.compare.run.store import RunStore, default_cache_dir
+from trilith_xval.engines import get_backend
 from tests.support.trajectories import TIMINGS, assert_same_trajectory, same
 
 # Short pymunk run (0.3 s of simulated time at 5e-4 s steps): milliseconds.
@@ -201,7 +201,7 @@ def test_run_many_lookup_sends_only_missing_items(store):
 def test_every_trajectory_field_round_trips_through_the_format(fig5):
     """A record-driven pymunk run (events, verdict, settings, diagnostics, scene and a
     SampledRecord excitation) comes back field for field, bit for bit."""
-    from compare.run.codec import decode, encode
+    from trilith_xval.compare.run.codec import decode, encode
 
     rec = SampledRecord(tuple(np.linspace(0.0, 1.0, 11)), (0.0, 30.0, -30.0, 30.0, -1e-300,
                                                            -0.0, 5e-324, 2.0, 1.0, 0.5, 0.0))
@@ -213,9 +213,9 @@ def test_every_trajectory_field_round_trips_through_the_format(fig5):
 
 
 def test_format_keeps_types_and_special_floats():
-    from compare.measure.thresholds import ThresholdPoint
-    from compare.measure.trajectories import Provenance
-    from compare.run.codec import decode, encode
+    from trilith_xval.compare.measure.thresholds import ThresholdPoint
+    from trilith_xval.compare.measure.trajectories import Provenance
+    from trilith_xval.compare.run.codec import decode, encode
 
     prov_fields = {f.name: 0.5 if f.type in ("float", float) else None
                    for f in dataclasses.fields(Provenance)}
@@ -235,7 +235,7 @@ def test_format_keeps_types_and_special_floats():
 @pytest.mark.parametrize("value", [object(), {1, 2}, np.array(["a"], dtype=object),
                                    b"bytes"])
 def test_format_refuses_what_is_not_data(value):
-    from compare.run.codec import encode
+    from trilith_xval.compare.run.codec import encode
     with pytest.raises(TypeError, match="store"):
         encode(value)
 
@@ -246,7 +246,7 @@ def test_format_reads_nothing_foreign():
     import json
     import struct
 
-    from compare.run.codec import MAGIC, ForeignValue, decode, encode
+    from trilith_xval.compare.run.codec import MAGIC, ForeignValue, decode, encode
 
     def blob(tree) -> bytes:
         header = json.dumps(tree).encode()

@@ -5,8 +5,8 @@ import sqlite3
 
 import pytest
 
-from compare.run import store_db
-from compare.run.store import DB_NAME, RunStore
+from trilith_xval.compare.run import store_db
+from trilith_xval.compare.run.store import DB_NAME, RunStore
 
 
 def test_a_new_store_carries_the_marker_and_no_temporary(tmp_path):

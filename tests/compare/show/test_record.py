@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-import compare.show.record as rec
-from analytic.excitation import Pulse
-from analytic.trajectory import OverturnCriterion, Trajectory, Verdict
-from compare.cli.main import main
-from scenes import load_scene
-from compare.show.draw import bob_radius, trilith_shape, view_limits
-from compare.show.view import display_problem
+import trilith_xval.compare.show.record as rec
+from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.analytic.trajectory import OverturnCriterion, Trajectory, Verdict
+from trilith_xval.compare.cli.main import main
+from trilith_xval.scenes import load_scene
+from trilith_xval.compare.show.draw import bob_radius, trilith_shape, view_limits
+from trilith_xval.compare.show.view import display_problem
 
 README = ROOT / "README.md"
 FIG5 = load_scene("fig5")
@@ -247,7 +247,7 @@ def test_bad_outputs_fail_before_simulating(tmp_path, monkeypatch):
 
 
 def test_missing_backend_is_a_clear_error(tmp_path, monkeypatch):
-    import engines
+    from trilith_xval import engines
 
     monkeypatch.setitem(engines.BACKENDS, "ghost", "engines.ghost_engine")
     with pytest.raises(ValueError, match="'ghost' is not available"):
@@ -348,7 +348,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
     animation steps (the same Panels as recordings)."""
     import matplotlib.pyplot as plt
 
-    import compare.show.view as view_mod
+    import trilith_xval.compare.show.view as view_mod
 
     shown = {}
 
@@ -370,7 +370,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
 
 
 def test_view_pybullet_uses_its_own_gui(monkeypatch):
-    import compare.show.view as view_mod
+    import trilith_xval.compare.show.view as view_mod
 
     calls = []
 

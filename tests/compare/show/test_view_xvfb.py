@@ -87,7 +87,7 @@ def test_view_opens_a_window_that_moves(xvfb, tmp_path):
     env = {**os.environ, "DISPLAY": xvfb, "MPLBACKEND": "TkAgg",
            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     env.pop("WAYLAND_DISPLAY", None)
-    cmd = [sys.executable, "-m", "compare.cli.main", "view", "--scene", "fig5", "--engine", "all",
+    cmd = [sys.executable, "-m", "trilith_xval.compare.cli.main", "view", "--scene", "fig5", "--engine", "all",
            "--amplitude", "25", "--omega", "11", "--duration", "3", "--fps", "20"]
     proc = subprocess.Popen(cmd, env=env, cwd=tmp_path, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import pymunk
 
-from engines.base import Engine, EngineSettings
-from engines.diagnostics import PlaneState, Pose
-from engines.pymunk_.world import build_space, state_reader
+from trilith_xval.engines.base import Engine, EngineSettings
+from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines.pymunk_.world import build_space, state_reader
 
 __all__ = ["ToyEngine", "Settings"]
 
