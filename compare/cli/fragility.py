@@ -19,12 +19,12 @@ import time
 
 from trilith_xval.analytic.excitation import G_STANDARD
 from trilith_xval.analytic.ida import IM_UNITS, IDASettings
+from trilith_xval.compare.report.fragility_plot import IM_TEXT, plot_fragility
 from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
                                  add_workers_arg, check_output_path, file_options, info,
                                  parse_engine_list, resolve_workers, scene_from_args,
                                  settings_from_args, use_store)
 
-IM_TEXT = {"pga": "PGA", "pgv": "PGV", "scale": "scale factor"}
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -190,8 +190,6 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
 
 
 def _write(out, doc: dict, st: IDASettings) -> None:
-    import json
-
     from trilith_xval.compare.run.atomic import report_dir
     with report_dir(out) as tmp:
         _write_files(tmp, doc, st)
@@ -215,56 +213,7 @@ def _write_files(out, doc: dict, st: IDASettings) -> None:
                 r["censored"], islands, r["n_runs"],
                 "" if b == "analytic" else r["bracketed"], len(r.get("isolated", ())))))
     write_text(out / "fragility.csv", "\n".join(rows) + "\n")
-    _plot(out / "fragility.png", doc, st)
-
-
-def _plot(path, doc: dict, st: IDASettings) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-    from scipy import stats
-
-    from trilith_xval.compare.run.atomic import savefig
-    from trilith_xval.compare.measure.fragility import empirical_curve
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    from trilith_xval.compare.report.plots import color
-    colours = {b: "k" if b == "analytic" else color(b) for b in doc["backends"]}
-    for b, body in doc["backends"].items():
-        fit, c = body["fit"], colours.get(b, None)
-        if fit is None:  # no record with a robust bracket: nothing to draw
-            continue
-        ims = np.array([math.inf if v is None else v for v in fit["im"]])
-        x, f = empirical_curve(ims)
-        if x.size:
-            ax.step(np.concatenate([[x[0] / 2], x]), np.concatenate([[0.0], f]), where="post",
-                    color=c, alpha=0.6, lw=1.0)
-        grid = np.array(fit["band"]["im"])
-        if fit["median"] is not None:
-            curve = stats.norm.cdf(np.log(grid / fit["median"]) / fit["beta"])
-            ax.plot(grid, curve, color=c, lw=1.8,
-                    label=f"{b}: median {fit['median']:.3g}, beta {fit['beta']:.2f}")
-            lo = np.array([np.nan if v is None else v for v in fit["band"]["lower"]])
-            hi = np.array([np.nan if v is None else v for v in fit["band"]["upper"]])
-            ax.fill_between(grid, lo, hi, color=c, alpha=0.12, lw=0)
-    ax.set_xscale("log")
-    unit = IM_UNITS[st.im]
-    ax.set_xlabel(f"{IM_TEXT[st.im]}" + (f" [{unit}]" if unit else ""))
-    if st.im == "pga":
-        sec = ax.secondary_xaxis("top", functions=(lambda a: a / G_STANDARD,
-                                                   lambda g: g * G_STANDARD))
-        sec.set_xlabel("PGA [g]")
-    ax.set_ylabel("P(overturn | IM)")
-    ax.set_ylim(0.0, 1.0)
-    if ax.get_legend_handles_labels()[1]:  # no fit (fewer than 2 overturns): no line
-        ax.legend(fontsize=8, loc="upper left")
-    pendulum = "" if doc["scene"].get("gamma", 0.0) > 0.0 else " without pendulum"
-    ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records "
-                 "(steps: empirical; lines: lognormal fit, 90 % band)",
-                 fontsize=9)
-    fig.tight_layout()
-    savefig(fig, path, dpi=120)
-    plt.close(fig)
+    plot_fragility(out / "fragility.png", doc, st)
 
 
 def _print(doc: dict, st: IDASettings) -> None:

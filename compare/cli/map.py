@@ -12,7 +12,8 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
-from trilith_xval.compare.cli.map_plot import plot_maps, print_map_summary, subsample
+from trilith_xval.compare.cli.map_text import print_map_summary, subsample
+from trilith_xval.compare.report.map_plot import plot_maps
 from trilith_xval.compare.measure.map_thresholds import LEAST_RUNS
 from trilith_xval.compare.run.jsonable import plain
 

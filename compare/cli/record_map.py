@@ -91,7 +91,8 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
     import numpy as np
 
     from trilith_xval.analytic.overturn_map import verdict_map
-    from trilith_xval.compare.cli.map_plot import plot_maps, print_map_summary, subsample
+    from trilith_xval.compare.cli.map_text import print_map_summary, subsample
+    from trilith_xval.compare.report.map_plot import plot_maps
     from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
                                      use_store)
     from trilith_xval.compare.run.jsonable import plain

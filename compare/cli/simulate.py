@@ -62,35 +62,6 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
     return configure(name, **options)
 
 
-def _plot(runs: list, scene, path: str) -> None:
-    """theta(t)/alpha of ``runs`` (the model's first, when the run is an engine's)
-    with each run's events, and psi(t) below when the scene has a pendulum."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from trilith_xval.compare.show.history import plot_psi, plot_theta
-
-    rows = 2 if scene.has_pendulum else 1
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.8 * rows + 0.4),
-                             squeeze=False)
-    plot_theta(runs, scene.alpha, ax=axes[0, 0])
-    titles = []
-    for traj in runs:
-        v = traj.verdict
-        titles.append(f"{traj.backend}: {v.status}" + (
-            f" ({v.mode}, overturn_time = {traj.overturn_time:.3f} s)" if v.overturned else ""))
-    axes[0, 0].set_title("\n".join(titles), fontsize=9)
-    if scene.has_pendulum:
-        plot_psi(runs, ax=axes[1, 0], legend=False)  # named once, above
-    for ax in axes[:-1, 0]:
-        ax.set_xlabel("")
-    fig.tight_layout()
-    from trilith_xval.compare.run.atomic import savefig
-    savefig(fig, path, dpi=120)
-    plt.close(fig)
-
-
 def _describe_excitation(excitation) -> str:
     d = excitation.describe()
     if d["type"] == "pulse":
@@ -135,7 +106,8 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         model = [get_backend("analytic").simulate(scene, excitation, model_settings)
                  ] if overlay else []
-        _plot(model + [traj], scene, args.plot)
+        from trilith_xval.compare.show.history import plot_runs  # matplotlib: only when asked
+        plot_runs(model + [traj], scene, args.plot)
     if args.json:
         summary = traj.summary()
         timings = summary.pop("timings")

@@ -15,7 +15,7 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  file_options, info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
                                  settings_line, use_store)
-from trilith_xval.compare.cli.spectrum_plot import plot_spectrum
+from trilith_xval.compare.report.spectrum_plot import plot_spectrum
 from trilith_xval.compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:1"  # the range of the paper's Fig. 5

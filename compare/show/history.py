@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_theta", "plot_psi", "EVENT_MARKERS"]
+__all__ = ["plot_theta", "plot_psi", "plot_runs", "EVENT_MARKERS"]
 
 # One marker per kind of event, the same for every run (the colour is the run's).
 EVENT_MARKERS = {"uplift": ("^", "uplift"), "impact": ("o", "impact"),
@@ -141,3 +141,32 @@ def plot_psi(trajectories, ax=None, labels=None, legend: bool = True):
     if legend and len(runs) > 1:
         ax.legend(fontsize=7)
     return ax
+
+
+def plot_runs(runs: list, scene, path) -> None:
+    """The figure of ``trilith simulate --plot``: theta(t)/alpha of ``runs`` (the
+    model's first, when the run is an engine's) with each run's events and each
+    verdict in the title, and psi(t) below when the scene has a pendulum; written
+    atomically to ``path``."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = 2 if scene.has_pendulum else 1
+    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(7, 2.8 * rows + 0.4),
+                             squeeze=False)
+    plot_theta(runs, scene.alpha, ax=axes[0, 0])
+    titles = []
+    for traj in runs:
+        v = traj.verdict
+        titles.append(f"{traj.backend}: {v.status}" + (
+            f" ({v.mode}, overturn_time = {traj.overturn_time:.3f} s)" if v.overturned else ""))
+    axes[0, 0].set_title("\n".join(titles), fontsize=9)
+    if scene.has_pendulum:
+        plot_psi(runs, ax=axes[1, 0], legend=False)  # named once, above
+    for ax in axes[:-1, 0]:
+        ax.set_xlabel("")
+    fig.tight_layout()
+    from trilith_xval.compare.run.atomic import savefig
+    savefig(fig, path, dpi=120)
+    plt.close(fig)

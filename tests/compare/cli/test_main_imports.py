@@ -20,3 +20,17 @@ def test_the_parser_imports_nothing_heavy():
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True,
                          env={**os.environ, "PYTHONPATH": str(ROOT)}, check=True, timeout=120)
     assert out.stdout.split() == []
+
+
+def test_no_command_draws_a_figure_itself():
+    """compare/cli parses, resolves, calls and prints: every figure a command writes
+    is drawn in compare/report or compare/show, where the API reaches it too."""
+    import ast
+    drawing = []
+    for path in sorted((ROOT / "compare" / "cli").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            if any(n.split(".")[0] == "matplotlib" for n in names):
+                drawing.append(path.name)
+    assert drawing == [], f"figures drawn in compare/cli: {drawing}"

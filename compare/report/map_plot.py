@@ -3,25 +3,7 @@ records), the model's first-overturning curve on each, the frequencies where the
 model is invalid hatched, an engine's robust threshold brackets on its panel."""
 from __future__ import annotations
 
-__all__ = ["plot_maps", "print_map_summary", "subsample"]
-
-
-def print_map_summary(m, what: str) -> None:
-    """One map's headline (``what``: its grid), its cost in CPU seconds (wall beside)
-    and the number of cells per verdict."""
-    print(f"{m.backend}: {what} in {m.cpu_s:.2f} CPU s ({m.wall_time:.2f} s wall)")
-    for lab, n in m.counts().items():
-        if n:
-            print(f"  {lab:>26}: {n}")
-
-
-def subsample(values, n: int):
-    """At most ``n`` of ``values``, evenly spread, the ends kept (an engine grid on the
-    model's)."""
-    import numpy as np
-    if values.size <= n:
-        return values
-    return values[np.unique(np.round(np.linspace(0, values.size - 1, n)).astype(int))]
+__all__ = ["plot_maps"]
 
 
 def _hatch_invalid(ax, first, validity) -> None:
