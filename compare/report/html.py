@@ -69,6 +69,11 @@ def render_markdown(doc: dict) -> str:
     parts = [f"# Validation report: scene `{doc['config']['scene']}`"]
     if doc.get("quick"):
         parts.append(f"**{_QUICK}**")
+    if doc.get("rendered_from"):
+        prov = doc.get("provenance") or {}
+        parts.append(f"**Rendered from the stored run `{doc['rendered_from']['file']}` "
+                     f"(measured {prov.get('date', 'on an unknown date')}, commit "
+                     f"{str(prov.get('commit', 'unknown'))[:12]}): nothing was recomputed.**")
     parts += [f"{_headline(doc)}.", "## Recommendation",
               "\n".join(f"- {r}" for r in recommendations(doc)),
               "## Which engine to trust", tables.table(header, rows, md=True),
@@ -140,6 +145,13 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
     if doc.get("quick"):
         body.append(f"<p class='banner'>{esc(_QUICK)}</p>")
     prov = doc.get("provenance") or {}
+    if doc.get("rendered_from"):  # trilith report --from: a stored run, not this code's
+        src = doc["rendered_from"]
+        body.append(f"<p class='banner'>Rendered from the stored run <code>{esc(src['file'])}"
+                    f"</code> (sha256 {esc(src['sha256'][:12])}), measured "
+                    f"{esc(prov.get('date', 'on an unknown date'))} at commit "
+                    f"<code>{esc(str(prov.get('commit', 'unknown'))[:12])}</code>: nothing was "
+                    "recomputed; time-history plots are not stored.</p>")
     body += [f"<p class='headline'><b>{esc(_headline(doc))}.</b> Reference: the analytic "
              "model (accurate path for time histories, compiled path for spectra).</p>",
              "<div class='reco'><b>Recommendation</b><ul>",
@@ -258,4 +270,23 @@ def write_report(result, out_dir, provenance: dict | None = None,
     atomic.write_text(paths["trust_csv"], tables.csv_text(*tables.trust_rows(doc)))
     atomic.write_text(paths["thresholds_csv"], threshold_table.threshold_csv(doc))
     atomic.write_text(paths["html"], render_html(doc, result.histories, alphas))
+    return paths
+
+
+def write_stored_report(doc: dict, out_dir, source: dict) -> dict[str, Path]:
+    """The report of a stored run (``trilith report --from FILE``): the files of
+    :func:`write_report` rendered from its ``summary.json`` document ``doc``, without
+    the time-history plots (a summary stores their errors, not the trajectories)
+    and with a banner naming ``source`` (``{"file", "sha256"}``), the run's date
+    and commit: nothing is recomputed."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {**doc, "rendered_from": dict(source)}
+    paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md",
+             "trust_csv": out / "trust.csv", "thresholds_csv": out / "thresholds.csv"}
+    atomic.write_text(paths["json"], json.dumps(doc, indent=1, allow_nan=False))
+    atomic.write_text(paths["md"], render_markdown(doc))
+    atomic.write_text(paths["trust_csv"], tables.csv_text(*tables.trust_rows(doc)))
+    atomic.write_text(paths["thresholds_csv"], threshold_table.threshold_csv(doc))
+    atomic.write_text(paths["html"], render_html(doc))
     return paths
