@@ -189,6 +189,10 @@ class Engine:
     # second or less per threshold point at its threshold step.
     affordable: ClassVar[bool] = True
     calibration_space: ClassVar[Mapping[str, Sequence]] = {}
+    # (scene, Omega [rad/s]) of the engine's regression threshold against the model
+    # (tests/engines/test_regression_engines.py): on one of Fig. 5's well-posed
+    # branches, away from mode jumps and overturning windows.
+    regression_point: ClassVar[tuple[str, float]] = ("fig5", 13.0)
     default_friction: ClassVar[float]
     Settings: ClassVar[type[EngineSettings]]
 

@@ -72,6 +72,7 @@ class DartEngine(Engine):
     name = "dart"
     label = "DART"
     color = "tab:cyan"
+    regression_point = ("no_pendulum", 12.5)
     marker = "v"
     affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})

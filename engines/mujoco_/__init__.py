@@ -210,6 +210,7 @@ class MujocoEngine(Engine):
     name = "mujoco"
     label = "MuJoCo"
     color = "tab:purple"
+    regression_point = ("fig5", 12.5)
     marker = "^"
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})

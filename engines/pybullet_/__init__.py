@@ -154,6 +154,7 @@ class PyBulletEngine(Engine):
     name = "pybullet"
     label = "PyBullet"
     color = "tab:blue"
+    regression_point = ("no_pendulum", 12.5)
     marker = "o"
     capabilities = frozenset({"time_step", "solver_iterations", "render", "gui",
                               "moving_ground", "initial_tilt", "trajectory"})

@@ -18,26 +18,25 @@ import pytest
 from trilith_xval.compare.campaign.validation import CampaignConfig, Tolerances, backend_settings
 from trilith_xval.compare.measure.reference_spectra import first_overturning_amplitude, monotone_above
 from trilith_xval.compare.measure.thresholds import engine_threshold
-from trilith_xval.engines import ENGINES
+from trilith_xval.engines import engine_names, get_backend
 from trilith_xval.scenes import load_scene
 
 TOL = Tolerances()
 CONFIG = CampaignConfig()  # calibrated engine settings, theta0 = alpha/2, 4 impacts
 
 
-# One point per engine, on both branches of the Fig. 5 spectrum: with the pendulum
-# at 13 rad/s (no-impact branch, 2.75 rad/s above its mode jump at 10-10.5) and
-# without it at 12.5 rad/s (after-impact branch, 5 rad/s below its jump at
-# 17.5-18).  Below ~10 rad/s the pendulum curve has narrow overturning windows
-# (see analytic/spectrum.py), where "the" threshold is ill-posed for a bisection.
-CASES = {"pybullet": ("no_pendulum", 12.5), "pymunk": ("fig5", 13.0), "mujoco": ("fig5", 12.5),
-         "dart": ("no_pendulum", 12.5), "drake": ("fig5", 13.0)}
+# One point per engine (its class's ``regression_point``), on both branches of the
+# Fig. 5 spectrum: with the pendulum at 12.5-13 rad/s (no-impact branch, above its
+# mode jump at 10-10.5) and without it at 12.5 rad/s (after-impact branch, 5 rad/s
+# below its jump at 17.5-18).  Below ~10 rad/s the pendulum curve has narrow
+# overturning windows (see analytic/spectrum.py), where "the" threshold is
+# ill-posed for a bisection; the test checks the point is well posed.
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("engine", engine_names())
 def test_overturning_threshold_within_2_percent(engine):
-    scene_name, omega = CASES[engine]
+    scene_name, omega = get_backend(engine).regression_point
     scene = load_scene(scene_name)
     a_ref, mode_ref = first_overturning_amplitude(scene, omega)
     # The point is well posed: the model overturns throughout the bracket above it,

@@ -160,7 +160,7 @@ def test_a_scene_glob_that_matches_nothing_is_refused(capsys):
     assert len(err) == 1 and "--scene: 'fig99_*' matches no scene" in err[0]
 
 
-@pytest.mark.parametrize("engine", ["pybullet", "pymunk", "mujoco", "dart", "drake"])
+@pytest.mark.parametrize("engine", engines.engine_names())
 def test_declared_search_ranges_are_valid_settings_around_the_defaults(engine):
     # calibrate's default space: the step times 1, 2, 5, 10 and the engine's own
     # declared ranges; each value must be one its Settings accept, the calibrated
