@@ -124,11 +124,8 @@ def _validity(job: tuple) -> dict:
 
 
 def _bar(total: int, desc: str):
-    import sys
-
-    from tqdm import tqdm
-    return tqdm(total=total, desc=desc, unit="pt", disable=not sys.stderr.isatty(),
-                leave=False)
+    from trilith_xval.compare.run.progress import bar
+    return bar(total, desc, "points")
 
 
 def _many(fn, jobs: list, workers: int, chunk: int, desc: str,

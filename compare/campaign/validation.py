@@ -154,28 +154,12 @@ class _JobError:
     message: str
 
 
-class _Lines:
-    """Progress for a reader who is not at a terminal (piped, logged): a stderr line
-    at each tenth of the jobs, with the count and the elapsed wall time."""
-
-    def __init__(self, total: int):
-        self.total, self.done, self.t0, self.next = total, 0, time.perf_counter(), 1
-
-    def update(self, n: int = 1) -> None:
-        self.done += n
-        if self.done * 10 >= self.next * self.total:
-            self.next = self.done * 10 // max(self.total, 1) + 1
-            print(f"report: {self.done}/{self.total} jobs, "
-                  f"{time.perf_counter() - self.t0:.0f} s", file=sys.stderr, flush=True)
-
-    def close(self) -> None:
-        pass
-
-
 def _progress(total: int, lines: bool = False):
-    """tqdm at a terminal; with ``lines`` and no terminal, :class:`_Lines`."""
+    """tqdm at a terminal; with ``lines`` and no terminal, a line at each tenth
+    (:class:`compare.run.progress.Lines`)."""
     if lines and not sys.stderr.isatty():
-        return _Lines(total)
+        from trilith_xval.compare.run.progress import Lines
+        return Lines(total, "report", "jobs")
     try:
         from tqdm import tqdm
     except ImportError:  # pragma: no cover - tqdm is a dependency

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 
 from trilith_xval.analytic.options import MAX_ENGINE_DT
 
@@ -181,10 +180,9 @@ def run(args: argparse.Namespace) -> int:
     if loaded is not None:
         info(settings_line(loaded, engine) + " (every candidate starts from them)")
     bar = None
-    if sys.stderr.isatty() and _common.VERBOSITY >= 0:
-        from tqdm import tqdm
-        bar = tqdm(total=math.prod(len(v) for v in space.values()), unit="candidate",
-                   file=sys.stderr)
+    if _common.VERBOSITY >= 0:
+        from trilith_xval.compare.run.progress import bar as progress_bar
+        bar = progress_bar(math.prod(len(v) for v in space.values()), "calibrate", "candidates")
 
     def progress(done, total, ev):
         if bar is not None:

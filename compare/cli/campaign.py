@@ -190,12 +190,11 @@ def _duration(seconds: float) -> str:
 
 
 def _bar(total: float):
-    from tqdm import tqdm
+    from trilith_xval.compare.run.progress import bar
     # Units are seconds of estimated work: tqdm's rate is then the measured speed
     # against the measured costs, and its ETA the remaining estimated work at it.
-    return tqdm(total=round(total, 1), unit="s", unit_scale=False, desc="campaign",
-                disable=not sys.stderr.isatty(), leave=False,
-                bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} s of work [{elapsed}<{remaining}]")
+    return bar(round(total, 1), "campaign", "s of estimated work", unit_scale=False,
+               bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} s of work [{elapsed}<{remaining}]")
 
 
 def _versions(study) -> dict:

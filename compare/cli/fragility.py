@@ -153,13 +153,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_all(items, workers: int, scheduler, job=None):
-    import sys
-
-    from tqdm import tqdm
-
+    from trilith_xval.compare.run.progress import bar as progress_bar
     from trilith_xval.compare.run.runs import run_many
-    bar = tqdm(total=len(items), unit="record", desc="fragility",
-               disable=not sys.stderr.isatty())
+    bar = progress_bar(len(items), "fragility", "records")
     try:
         return list(run_many(job or ida_job, items, workers=workers, scheduler=scheduler,
                              on_done=lambda i, r: bar.update(1)))

@@ -204,6 +204,8 @@ def _main(argv: list[str] | None) -> int:
         return 2
     from trilith_xval.compare.cli import options as _common
     _common.VERBOSITY = args.verbosity
+    from trilith_xval.compare.run import progress
+    progress.PIPED_LINES = args.verbosity >= 0  # a pipe or a log gets progress lines
     try:
         code = int(modules[args.command].run(args) or 0)
         sys.stdout.flush()  # a closed pipe fails here, inside the handler below
@@ -232,7 +234,8 @@ def _main(argv: list[str] | None) -> int:
         return 130
     finally:
         # A command's run store and scheduler end with it (main() is also called
-        # in-process, by tests and scripts).
+        # in-process, by tests and scripts), and so do its progress lines.
+        progress.PIPED_LINES = False
         if "trilith_xval.compare.run.runs" in sys.modules:
             store = sys.modules["trilith_xval.compare.run.runs"].activate(None)
             if store is not None:

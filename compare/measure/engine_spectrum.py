@@ -256,7 +256,7 @@ def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", worker
             jobs.append((engine, sc, curve, w, float(a), m, kind, options, tol, rel_tol,
                          convergence))
             keys.append(curve)
-    results = _map(_point_job, jobs, workers)
+    results = _map(_point_job, jobs, workers, f"spectrum {engine}")
     out = EngineSpectrum(engine, get_backend(engine).version(), settings.describe(), kind, tol,
                          rel_tol)
     for key, point in zip(keys, results):
@@ -274,12 +274,19 @@ def engine_points(engine: str, scene, omegas, a_references, modes, *, case: str 
     configure(engine, **options)  # validates the options up front
     jobs = [(engine, scene, case, float(w), float(a), m, kind, options, tol, rel_tol,
              convergence) for w, a, m in zip(omegas, a_references, modes) if math.isfinite(a)]
-    return _map(_point_job, jobs, workers)
+    return _map(_point_job, jobs, workers, f"{engine} {case}".strip())
 
 
-def _map(fn, items: list, workers: int) -> list:
+def _map(fn, items: list, workers: int, desc: str = "points") -> list:
     """``[fn(x) for x in items]``, in order, through :func:`compare.run.runs.run_many`:
     local workers that die with their parent and stop at Ctrl-C, or the Dask
-    cluster of ``--scheduler``; each engine run inside goes through the run store."""
+    cluster of ``--scheduler``; each engine run inside goes through the run store.
+    Progress: :func:`compare.run.progress.bar` named ``desc``."""
+    from trilith_xval.compare.run.progress import bar
     from trilith_xval.compare.run.runs import run_many
-    return list(run_many(fn, items, workers=max(1, workers)))
+    progress = bar(len(items), desc, "points")
+    try:
+        return list(run_many(fn, items, workers=max(1, workers),
+                             on_done=lambda i, r: progress.update(1)))
+    finally:
+        progress.close()

@@ -16,7 +16,7 @@ EXAMPLES = ROOT / "docs" / "examples"
 # Public entry points whose numpydoc Examples must run as written.
 DOCTEST_MODULES = ("analytic.options", "analytic.parameters", "analytic.excitation",
                    "analytic.bounds", "analytic.contact_forces", "engines",
-                   "compare.measure.restitution", "compare.run.jsonable", "scenes.points",
+                   "compare.measure.restitution", "compare.run.jsonable", "compare.run.progress", "scenes.points",
                    "scenes.ground_motion", "engines.mujoco_")
 
 
