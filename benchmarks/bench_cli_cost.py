@@ -41,11 +41,14 @@ HEAVY = ("numba", "scipy", "matplotlib", "pybullet", "pymunk", "mujoco", "dartpy
 
 def _cpu_of(argv: list[str], root: Path) -> tuple[float, float, str]:
     """CPU seconds (user + system, the process and its children), wall seconds
-    and stdout of ``python -m trilith_xval.compare.cli.main *argv`` run from ``root``."""
+    and stdout of ``python -m trilith_xval.compare.cli.main *argv`` run from ``root``
+    (``compare.cli.main`` in a reference tree: older commits predate the one
+    import name and run from their own folders)."""
     import time
+    module = "trilith_xval.compare.cli.main" if root == ROOT else "compare.cli.main"
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", *argv], cwd=root,
+    proc = subprocess.run([sys.executable, "-m", module, *argv], cwd=root,
                           env={**os.environ, "PYTHONPATH": str(root)}, capture_output=True,
                           text=True, check=True)
     wall = time.perf_counter() - t0
