@@ -15,7 +15,7 @@ __all__ = ["add_restitution_arg", "restitution_factor", "restitution_text"]
 def add_restitution_arg(parser: argparse.ArgumentParser) -> None:
     """``--restitution-factor R``; read with :func:`restitution_factor`."""
     parser.add_argument(
-        "--restitution-factor", type=float, default=None, metavar="R",
+        "--restitution-factor", default=None, metavar="R",
         help="measured restitution: the model's impact ratio (Eq. 20 without pendulum, "
              "Eq. 19 with it) times R, in (0, 1] (default 1: the exact impact); engines "
              "run beside the model are compared with this scaled model (docs/model.md)")
@@ -27,12 +27,17 @@ def restitution_factor(args: argparse.Namespace) -> float:
     0 would stop every rocking at its first impact and above 1 an impact would
     create energy: neither is a restitution a block can have.
     """
-    value = getattr(args, "restitution_factor", None)
-    if value is None:
+    text = getattr(args, "restitution_factor", None)
+    if text is None:
         return 1.0
+    try:  # read here, not by argparse: its error would not be the door's one line
+        value = float(text)
+    except (TypeError, ValueError):
+        raise ValueError(f"--restitution-factor must be a number in (0, 1], "
+                         f"got {text!r}") from None
     if not (math.isfinite(value) and 0.0 < value <= 1.0):
         raise ValueError(f"--restitution-factor must be in (0, 1], got {value!r}")
-    return float(value)
+    return value
 
 
 def restitution_text(r: float, pendulum: bool) -> str:
