@@ -189,7 +189,8 @@ def run(args: argparse.Namespace) -> int:
                                               **{**threshold_options(name, scene),
                                                  **_options.file_options(loaded, name)})
     from trilith_xval.analytic.threshold_validity import curve_validity
-    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)
+    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers,
+                              restitution_factor=rf)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
 
     def valid_text(w):
@@ -213,8 +214,14 @@ def run(args: argparse.Namespace) -> int:
                         "thresholds": [p.to_dict() for p in thresholds[m.backend]],
                         "threshold_cost": threshold_cost(thresholds[m.backend])}
                        for m in maps[1:]]
-        print_json(plain({"maps": [first] + engine_maps}))
+        doc = {"maps": [first] + engine_maps}
+        if rf != 1.0:  # absent at 1: the documents of exact-impact maps stay as they were
+            doc["restitution_factor"] = rf
+        print_json(plain(doc))
         return 0
+    if rf != 1.0:
+        from trilith_xval.compare.cli.model_options import restitution_text
+        print(f"model: {restitution_text(rf, scene.has_pendulum)}")
     for m in maps:
         print_map_summary(m, f"scene {scene.name}, {m.pulse} pulse, {m.omega.size} "
                              f"frequencies x {m.amplitude.size} amplitudes")

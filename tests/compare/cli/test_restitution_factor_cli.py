@@ -83,3 +83,15 @@ def test_eq20_of_the_model_is_unscaled():
     b, h, mu, gamma, j, _l, _g = load_scene("single_block").model_args()
     assert eq.restitution_ratio(0.0, 1.0, b, h, mu, gamma, j) == pytest.approx(
         _housner(load_scene("single_block")), rel=1e-12)
+
+
+def test_map_first_overturning_moves_with_the_factor(capsys):
+    base = ["map", "--scene", "single_block", "--omega", "10", "--amplitude", "2:14:2",
+            "--workers", "1", "--json"]
+    exact = _json(base, capsys)
+    scaled = _json(base + ["--restitution-factor", "0.8"], capsys)
+    assert "restitution_factor" not in exact and scaled["restitution_factor"] == 0.8
+    a1 = exact["maps"][0]["first_overturn"][0]
+    a08 = scaled["maps"][0]["first_overturn"][0]
+    # The spectrum's numbers (test above): after-impact ~4.1, no-impact ~12.5 m/s^2.
+    assert a1 == pytest.approx(4.105, rel=0.01) and a08 == pytest.approx(12.48, rel=0.01)
