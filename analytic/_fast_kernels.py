@@ -30,13 +30,16 @@ EV_UPLIFT, EV_IMPACT, EV_REST, EV_OVERTURN, EV_UNSTABLE = 0, 1, 2, 3, 4
 
 @njit(cache=True)
 def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
-        rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit, record, sample_dt):
+        rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit, rf, record,
+        sample_dt):
     """Integrate one run.  ``t_max <= 0`` means exact survival (no fixed horizon);
     ``rest_frac``: largest REST step over the pulse period (after the pulse, over
     the small-swing pendulum period); ``certain_exit``: with exact survival, end
     an overturn as soon as it is certain (:func:`overturn_certain`; status
     overturned, reason ``R_CERTAIN``, time = that instant) instead of
-    integrating the fall to ``thr``.
+    integrating the fall to ``thr``; ``rf``: the restitution factor, which
+    multiplies every impact's rocking ratio (Eq. 19/20,
+    :func:`analytic.equations.impact_velocities`).
 
     Returns ``(status, reason, t_verdict, n_impacts, samples, n_samples, events,
     n_events, n_steps, e_out)`` (``e_out``: how near the run came to the
@@ -128,7 +131,7 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
                 # keeps r^2 of it (Eq. 20): e_out is known now, and so is the
                 # verdict unless it sits exactly on the barrier.  (A recorded run
                 # goes on: its reader wants the motion.)
-                r = _impact(1.0, 0.0, 0.0, float(-phase), b, h, mu, gamma, j, l)[0]
+                r = _impact(1.0, 0.0, 0.0, float(-phase), b, h, mu, gamma, j, l, rf)[0]
                 e_next = r * r * en
                 e_out = max(v_pulse, e_stay, e_next)
                 await_impact = False
@@ -342,7 +345,7 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
             new_side = -phase
             tdm = ytmp[1]
             pdm = ytmp[3]
-            tdp, pdp = _impact(tdm, ytmp[2], pdm, float(new_side), b, h, mu, gamma, j, l)
+            tdp, pdp = _impact(tdm, ytmp[2], pdm, float(new_side), b, h, mu, gamma, j, l, rf)
             n_imp += 1
             if record:  # the instant before the impact; the one after is pushed below
                 row[0] = t
@@ -396,18 +399,18 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
 
 @njit(cache=True)
 def verdict(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
-            rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit):
+            rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit, rf):
     """Verdict only: ``(status, reason, t_verdict, n_impacts)``."""
     st, rs, tv, ni, _s, _ns, _e, _ne, _n, _en = run(amp, b, h, mu, gamma, j, l, g, omega, pkind,
                                               t_end_pulse, thr, rtol, atol, rest_velocity,
                                               t_max, t_cap, max_steps, rest_frac,
-                                              certain_exit, False, 1.0)
+                                              certain_exit, rf, False, 1.0)
     return st, rs, tv, ni
 
 
 @njit(cache=True)
 def verdicts(amps, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, atol,
-             rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit):
+             rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit, rf):
     """:func:`verdict` for every amplitude of ``amps`` in one compiled loop (no
     per-run dispatch): arrays ``(status, reason, t_verdict, n_impacts, e_out)``,
     ``e_out`` how near each run came to the barrier (see :func:`run`)."""
@@ -420,7 +423,7 @@ def verdicts(amps, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rto
     for i in range(n):
         out = run(amps[i], b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol,
                   atol, rest_velocity, t_max, t_cap, max_steps, rest_frac, certain_exit,
-                  False, 1.0)
+                  rf, False, 1.0)
         st[i] = out[0]
         rs[i] = out[1]
         tv[i] = out[2]

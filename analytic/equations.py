@@ -146,7 +146,7 @@ def uplift_acceleration(psi: float, psi_dot: float, side: float, b: float, h: fl
 
 def impact_velocities(theta_dot_minus: float, psi: float, psi_dot_minus: float,
                       new_side: float, b: float, h: float, mu: float, gamma: float,
-                      j: float, l: float) -> tuple[float, float]:
+                      j: float, l: float, rf: float = 1.0) -> tuple[float, float]:
     """Post-impact ``(theta_dot_plus, psi_dot_plus)`` at ``theta = 0`` (Eq. 19, 21
     corrected), for an impact that hands the rocking over to ``new_side``
     (``new_side=+1``: from the right corners to the left ones, ``theta_dot > 0``).
@@ -161,6 +161,16 @@ def impact_velocities(theta_dot_minus: float, psi: float, psi_dot_minus: float,
 
     If the ratio is not positive the trilith cannot re-uplift: it stops
     (``theta_dot+ = 0``) and the pendulum jump follows from the same formula.
+
+    ``rf`` is the restitution factor in (0, 1] (callers validate it): it
+    multiplies the rocking angular-velocity ratio ``theta_dot+ / theta_dot-`` of
+    Eq. 19 (Eq. 20 without pendulum), and nothing else, so that a measured impact
+    can stand in for the plastic one.  The pendulum's ``psi_dot+`` still follows
+    from the second line above with the scaled ``theta_dot+``: that line says
+    the bob's velocity across the rod is the same before and after (the rod,
+    hinged at both ends, passes the impulse along itself only), which holds for
+    any base impulse; at ``rf = 1`` it is Eq. 21.  ``rf = 1`` returns the exact
+    ratio bit for bit (a product by 1.0 is exact).
     """
     sb = new_side * b
     sp = math.sin(psi)
@@ -169,7 +179,7 @@ def impact_velocities(theta_dot_minus: float, psi: float, psi_dot_minus: float,
     dd = sb * cp - h * sp
     num = -4.0 * j + (b * b - h * h) * (1.0 + 2.0 * mu) + 2.0 * gamma * c * dd
     den = 4.0 * j + (b * b + h * h) * (1.0 + 2.0 * mu) + 2.0 * gamma * c * c
-    ratio = -num / den
+    ratio = -num / den * rf
     if ratio <= 0.0:
         ratio = 0.0
     theta_dot_plus = ratio * theta_dot_minus

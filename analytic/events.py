@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ellipk
 
-from .options import RunOptions
+from .options import RunOptions, check_restitution_factor
 from .trajectory import OverturnCriterion  # noqa: F401  (re-exported for callers)
 
 __all__ = ["Settings", "METHODS", "free_pendulum_period", "excitation_window",
@@ -34,7 +34,9 @@ class Settings(RunOptions):
     backend's own.  Every field is validated here (``ValueError`` naming the field
     and its range).  The initial state defaults to the trilith at rest with the
     pendulum hanging; ``theta0 != 0`` (or ``theta0 = 0``, ``theta_dot0 != 0``)
-    starts rocking about the side of its sign.
+    starts rocking about the side of its sign.  ``restitution_factor`` (in (0, 1],
+    default 1) multiplies the rocking angular-velocity ratio of every impact
+    (:func:`analytic.equations.impact_velocities`; docs/model.md).
     """
 
     t_cap: float = 120.0  # s after the excitation: safety net of the exact rules (>> rocking decay)
@@ -47,6 +49,8 @@ class Settings(RunOptions):
     max_events: int = 100_000  # guard against a non-progressing event loop
     theta_dot0: float = 0.0  # rad/s: initial rocking speed
     psi_dot0: float = 0.0  # rad/s: initial pendulum speed
+    # Measured over exact impact ratio (Eq. 19/20), in (0, 1]: docs/model.md.
+    restitution_factor: float = 1.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -63,6 +67,7 @@ class Settings(RunOptions):
             raise ValueError(f"max_events must be an integer >= 1, got {self.max_events!r}")
         for name in ("theta_dot0", "psi_dot0"):
             _check(name, getattr(self, name), -1e3, 1e3, lo_open=False)
+        check_restitution_factor(type(self).__name__, self.restitution_factor)
 
 
 def _check(name: str, value, lo: float, hi: float, lo_open: bool = True) -> None:

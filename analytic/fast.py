@@ -70,13 +70,16 @@ PULSE_CODES = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
 
 def _pack(model_args: tuple, omega: float, kind_code: int, threshold: float, rtol: float,
           atol: float, rest_velocity: float, t_max: float | None, t_cap: float,
-          max_steps: int, rest_step_fraction: float, certain_exit: bool) -> tuple:
+          max_steps: int, rest_step_fraction: float, certain_exit: bool,
+          restitution_factor: float = 1.0) -> tuple:
     """The kernels' arguments after the amplitude, in their order (the one place
-    that knows it); ``t_max`` None or <= 0 = exact survival."""
+    that knows it); ``t_max`` None or <= 0 = exact survival.  The restitution
+    factor comes last: :func:`warm_up` and :func:`simulate` append ``record,
+    sample_dt`` after it."""
     t_max = -1.0 if t_max is None else float(t_max)
     return (*model_args, float(omega), int(kind_code), 2.0 * math.pi / omega,
             float(threshold), rtol, atol, rest_velocity, t_max, t_cap, int(max_steps),
-            rest_step_fraction, bool(certain_exit))
+            rest_step_fraction, bool(certain_exit), float(restitution_factor))
 
 
 def kernel_args(scene: Scene, omega: float, kind: str, settings: Settings,
@@ -88,19 +91,20 @@ def kernel_args(scene: Scene, omega: float, kind: str, settings: Settings,
     return _pack(scene.model_args(), omega, PULSE_CODES[kind],
                  settings.criterion.threshold(scene.alpha), settings.rtol, settings.atol,
                  settings.rest_velocity, settings.t_max, settings.t_cap, settings.max_steps,
-                 settings.rest_step_fraction, certain_exit)
+                 settings.rest_step_fraction, certain_exit, settings.restitution_factor)
 
 
 def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: float,
                      g: float, amplitude: float, omega: float, kind: int, threshold: float,
                      rtol: float = 1e-8, atol: float = 1e-10, rest_velocity: float = 1e-6,
                      t_max: float = -1.0, t_cap: float = 120.0,
-                     max_steps: int = 2_000_000, rest_step_fraction: float = 0.01
-                     ) -> tuple[int, int, float, int]:
+                     max_steps: int = 2_000_000, rest_step_fraction: float = 0.01,
+                     restitution_factor: float = 1.0) -> tuple[int, int, float, int]:
     """Verdict of one pulse, compiled and allocation-free per step (for spectra).
 
     No validation (callers validate once); ``kind`` 0 = sine (Eq. 22), 1 = cosine
-    (Eq. 23); ``t_max <= 0`` = exact survival.  Returns ``(status_code,
+    (Eq. 23); ``t_max <= 0`` = exact survival; ``restitution_factor`` in (0, 1]
+    scales every impact's rocking ratio (Eq. 19/20).  Returns ``(status_code,
     reason_code, time, n_impacts)``; ``STATUS_NAMES[status_code]``, ``REASONS``.
     With a fixed ``t_max`` the exact survival rules still stop the run early (the
     verdict at ``t_max`` follows from them), so ``n_impacts`` then counts the
@@ -109,7 +113,7 @@ def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: f
     """
     return _k.verdict(amplitude, *_pack((b, h, mu, gamma, j, l, g), omega, kind, threshold,
                                         rtol, atol, rest_velocity, t_max, t_cap, max_steps,
-                                        rest_step_fraction, True))
+                                        rest_step_fraction, True, restitution_factor))
 
 
 def verdict_for(scene: Scene, pulse: Pulse, settings: Settings | None = None) -> Verdict:
@@ -153,7 +157,7 @@ def warm_up(record: bool = True) -> float:
     args = kernel_args(Scene(), 10.0, "sine", Settings())
     _k.verdicts(np.array([10.0]), *args)
     if record:
-        _k.run(10.0, *args[:-1], False, True, 1e-2)
+        _k.run(10.0, *args[:-2], False, args[-1], True, 1e-2)
     return time.perf_counter() - t0
 
 
@@ -168,7 +172,8 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     if not isinstance(excitation, Pulse):
         from . import simulate as accurate  # the fallback the docstring promises
         acc_settings = accurate.Settings(criterion=settings.criterion, t_max=settings.t_max,
-                                         rest_velocity=settings.rest_velocity)
+                                         rest_velocity=settings.rest_velocity,
+                                         restitution_factor=settings.restitution_factor)
         traj = accurate.simulate(scene, excitation, acc_settings)
         traj.diagnostics["fast_path_fallback"] = (f"{type(excitation).__name__}: accurate "
                                                   "path used")

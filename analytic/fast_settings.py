@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 from importlib.metadata import version as _dist_version
 
-from .options import RunOptions
+from .options import RunOptions, check_restitution_factor
 
 __all__ = ["Settings", "version"]
 
@@ -22,6 +22,9 @@ class Settings(RunOptions):
     The shared run options are :class:`analytic.options.RunOptions`; the fast
     path starts at rest and decides the verdict exactly, so ``theta0``, ``psi0``
     must be 0 and ``early_stop`` True (use the ``analytic`` backend otherwise).
+    ``restitution_factor`` (in (0, 1], default 1) multiplies the rocking
+    angular-velocity ratio of every impact, as in the accurate path
+    (:func:`analytic.equations.impact_velocities`; docs/model.md).
     """
 
     # Undecided after pulse end + t_cap [s]: far longer than any decaying rocking.
@@ -39,6 +42,8 @@ class Settings(RunOptions):
     # Largest REST step / pulse period (after it: / pendulum period): a dip of the
     # uplift margin shorter than a step could be missed; 1 % costs <= 100 steps.
     rest_step_fraction: float = 0.01
+    # Measured over exact impact ratio (Eq. 19/20), in (0, 1]: docs/model.md.
+    restitution_factor: float = 1.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -54,3 +59,4 @@ class Settings(RunOptions):
                 raise ValueError(f"{name} must be in ({lo:g}, {hi:g}], got {v!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps >= 100):
             raise ValueError(f"max_steps must be an integer >= 100, got {self.max_steps!r}")
+        check_restitution_factor(type(self).__name__, self.restitution_factor)

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 from .trajectory import OverturnCriterion
 
-__all__ = ["RunOptions", "check_real", "MAX_RUN_STEPS", "MAX_ENGINE_DT"]
+__all__ = ["RunOptions", "check_real", "check_restitution_factor", "MAX_RUN_STEPS",
+           "MAX_ENGINE_DT", "KEY_NEUTRAL"]
 
 # Largest run any backend accepts: engine steps (length / dt) or analytic output
 # samples (length / sample_dt).  5e6 steps is about 3 min of PyBullet and 1 min
@@ -25,6 +26,10 @@ MAX_RUN_STEPS = 5_000_000
 # ends such a run with a verdict ('unstable' when it blows up), which the stress
 # grid checks; the calibrated steps are 1e-4 s.
 MAX_ENGINE_DT = 0.1
+# Fields added after runs were stored, with the value that reproduces those runs:
+# describe() leaves a field out at that value, so the settings part of every run
+# key made before the field existed stays the same.
+KEY_NEUTRAL = {"restitution_factor": 1.0}
 
 
 def check_real(owner: str, name: str, value, lo: float, hi: float, lo_open: bool = True,
@@ -42,6 +47,17 @@ def check_real(owner: str, name: str, value, lo: float, hi: float, lo_open: bool
         raise ValueError(f"{owner}: {name} must be finite in {left}{lo:g}, {hi:g}{right}, "
                          f"got {value!r}")
     return v
+
+
+def check_restitution_factor(owner: str, value) -> float:
+    """``value`` as a float if it is a restitution factor in (0, 1], else
+    ``TypeError``/``ValueError`` naming ``owner.restitution_factor`` and the range.
+
+    The factor scales the model's impact ratio (Eq. 19, Eq. 20 without pendulum):
+    1 is the exact impulse-momentum impact, below 1 a measured, lossier one; 0
+    would stop every rocking at its first impact and above 1 would create energy.
+    """
+    return check_real(owner, "restitution_factor", value, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -117,8 +133,13 @@ class RunOptions:
                              f"got {self.theta0!r}")
 
     def describe(self) -> dict:
-        """A plain dict of every field (the criterion as a dict): what a result carries."""
+        """A plain dict of every field (the criterion as a dict): what a result carries
+        and what a run key hashes.  A field of :data:`KEY_NEUTRAL` at its neutral
+        value is left out (runs stored before it existed keep their keys)."""
         from dataclasses import asdict
         out = asdict(self)
         out["criterion"] = self.criterion.describe()
+        for name, neutral in KEY_NEUTRAL.items():
+            if name in out and out[name] == neutral:
+                del out[name]
         return out

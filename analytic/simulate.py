@@ -243,7 +243,8 @@ class _Run(RestPhase):
         b, h, mu, gamma, j, l, g = self.args
         td_minus, pd_minus = self.theta_dot, self.psi_dot
         td_plus, pd_plus = eq.impact_velocities(td_minus, self.psi, pd_minus, -s,
-                                                b, h, mu, gamma, j, l)
+                                                b, h, mu, gamma, j, l,
+                                                self.st.restitution_factor)
         self.n_impacts += 1
         self.events.append(Event("impact", self.t, side=-s, theta_dot_before=td_minus,
                                  theta_dot_after=td_plus, psi=self.psi,

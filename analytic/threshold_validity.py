@@ -39,9 +39,12 @@ VALIDITY_FIELDS = ("model_valid", "ground_min_normal", "lintel_min_normal",
                    "model_reason")
 
 
-def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "sine") -> dict:
+def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "sine",
+                   restitution_factor: float = 1.0) -> dict:
     """The model's contact checks on the run at ``amplitude`` [m/s^2] and
-    ``omega`` [rad/s] of a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse.
+    ``omega`` [rad/s] of a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse, with
+    the impacts scaled by ``restitution_factor`` (Eq. 19/20 times it; 1 = exact)
+    as in the threshold's own search.
 
     Returns
     -------
@@ -60,7 +63,10 @@ def point_validity(scene: Scene, amplitude: float, omega: float, kind: str = "si
     from .pulses import pulse_of
     from .simulate import simulate  # simulate imports the contact checks
 
-    tr = simulate(scene, pulse_of(kind, float(amplitude), float(omega)))
+    from .events import Settings
+    settings = None if restitution_factor == 1.0 else Settings(
+        restitution_factor=restitution_factor)
+    tr = simulate(scene, pulse_of(kind, float(amplitude), float(omega)), settings)
     d = tr.diagnostics
     if "model_valid" not in d:  # non-finite samples: nothing to judge
         return {k: None for k in VALIDITY_FIELDS[:-1]} | {
@@ -92,13 +98,13 @@ def _many_validity(jobs: list[tuple], workers: int) -> list[dict]:
     return out
 
 
-def _jobs(scene: Scene, omegas, amplitudes, kind: str) -> list[tuple]:
+def _jobs(scene: Scene, omegas, amplitudes, kind: str, rf: float = 1.0) -> list[tuple]:
     w = [float(x) for x in np.atleast_1d(omegas)]
     a = [math.nan if x is None else float(x) for x in np.atleast_1d(amplitudes)]
     if len(w) != len(a):
         raise ValueError(f"omegas and amplitudes must have equal lengths, got {len(w)} "
                          f"and {len(a)}")
-    return [(scene, a[i], w[i], kind) for i in range(len(w))]
+    return [(scene, a[i], w[i], kind, rf) for i in range(len(w))]
 
 
 def _check_workers(workers) -> None:
@@ -107,7 +113,7 @@ def _check_workers(workers) -> None:
 
 
 def curve_validity(scene: Scene, omegas, amplitudes, kind: str = "sine",
-                   workers: int = 1) -> list[dict]:
+                   workers: int = 1, restitution_factor: float = 1.0) -> list[dict]:
     """:func:`point_validity` at every ``(amplitudes[i], omegas[i])``, in order.
 
     Parameters
@@ -122,7 +128,7 @@ def curve_validity(scene: Scene, omegas, amplitudes, kind: str = "sine",
         ~0.05-0.5 s): :func:`analytic._workers.map_measured` runs the first
         point here and starts the workers the rest is worth.
     """
-    jobs = _jobs(scene, omegas, amplitudes, kind)
+    jobs = _jobs(scene, omegas, amplitudes, kind, restitution_factor)
     _check_workers(workers)
     return _many_validity(jobs, workers)
 
@@ -135,9 +141,10 @@ def spectrum_validity(spectrum, workers: int = 1) -> dict[str, list[dict]]:
     ``scene.without_pendulum()``); both curves share one set of workers."""
     _check_workers(workers)
     sc, kind = spectrum.scene, spectrum.settings.pulse
-    jobs = _jobs(sc.without_pendulum(), spectrum.omega, spectrum.a_no_pendulum, kind)
+    rf = spectrum.settings.fast.restitution_factor  # the model the thresholds came from
+    jobs = _jobs(sc.without_pendulum(), spectrum.omega, spectrum.a_no_pendulum, kind, rf)
     if sc.gamma != 0.0:
-        jobs += _jobs(sc, spectrum.omega, spectrum.a_pendulum, kind)
+        jobs += _jobs(sc, spectrum.omega, spectrum.a_pendulum, kind, rf)
     checked = _many_validity(jobs, workers)
     n = len(spectrum.omega)
     out = {"no_pendulum": checked[:n]}

@@ -5,7 +5,9 @@ fields (``b``, ``lam``, ``mu``, ``gamma``, ``l``, ...); the column height ``h``
 may be given instead of ``lam`` (``lam = h/b``), not beside it.  ``load_scene`` accepts a
 name (a file in ``scenes/data``) or a path.  Shipped scenes: ``fig5``, the
 paper's Fig. 8, 9 and 11 grids (``fig8_lam5_gamma0.1``, ``fig9_lam3_b0.4``,
-``fig11_mu2``, ...), ``single_block`` (Housner checks) and ``no_pendulum``;
+``fig11_mu2``, ...), ``single_block`` (Housner checks), the rocking block family
+``block_lam1.5``, ``block_lam2``, ``block_lam3``, ``block_lam5``, ``block_lam8``,
+``block_lam10`` (mu = gamma = 0, b = 0.6 m) and ``no_pendulum``;
 each file's header comment says where its numbers come from and how sure
 they are.
 """

@@ -195,7 +195,7 @@ def _candidates(space: dict) -> list[dict]:
 
 
 # ------------------------------------------------------------------ the three metrics
-def _restitution(engine, scene, vs: ValidationSet, options):
+def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
     from trilith_xval.compare.measure.restitution import measure_restitution
     cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
              for lam, mu in vs.releases]
@@ -203,7 +203,8 @@ def _restitution(engine, scene, vs: ValidationSet, options):
         cases.append((f"lam {scene.lam:g} mu {scene.mu:g} gamma {scene.gamma:g}", scene))
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for label, sc in cases:
-        r = measure_restitution(engine, sc, n_impacts=vs.n_impacts, **options)
+        r = measure_restitution(engine, sc, n_impacts=vs.n_impacts, restitution_factor=rf,
+                                **options)
         errors.append((label, r.max_rel_error if r.complete else math.nan))
         engine_cpu += r.diagnostics["cpu_time"]
         simulated += r.diagnostics["steps"] * r.settings["dt"]
@@ -229,7 +230,7 @@ def _thresholds(engine, scene, reference, options, workers):
     return errors, engine_cpu, simulated, runs
 
 
-def _histories(engine, scene, vs: ValidationSet, options):
+def _histories(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
     from trilith_xval import engines
     from trilith_xval.compare.measure.trajectories import compare_trajectories
     from trilith_xval.scenes import point_pulse
@@ -237,7 +238,8 @@ def _histories(engine, scene, vs: ValidationSet, options):
     for sc in (scene, scene.without_pendulum()) if scene.has_pendulum else (scene,):
         for point in vs.points:
             pulse = point_pulse(point)
-            ref = engines.simulate("analytic", sc, pulse)
+            model = {} if rf == 1.0 else {"restitution_factor": rf}
+            ref = engines.simulate("analytic", sc, pulse, **model)
             test = engines.simulate(engine, sc, pulse, **options)
             c = compare_trajectories(ref, test)
             err = c.theta_rms_first if c.verdict_agrees else 1.0
@@ -251,7 +253,8 @@ def _histories(engine, scene, vs: ValidationSet, options):
 
 def calibrate(engine: str, metric: str = "thresholds", *, validation: ValidationSet | None = None,
               space: dict | None = None, tolerance: float | None = None, workers: int = 1,
-              progress=None, scene=None, base: dict | None = None) -> Calibration:
+              progress=None, scene=None, base: dict | None = None,
+              restitution_factor: float = 1.0) -> Calibration:
     """Evaluate every candidate of ``space`` on ``validation`` for ``metric``.
 
     Parameters
@@ -281,6 +284,12 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         Settings every candidate starts from (e.g. a settings file's table for
         ``engine``); a candidate's own values replace them.  Default: none (the
         engine's calibrated defaults).
+    restitution_factor : float
+        In (0, 1]: the model every candidate is measured against has its impact
+        ratio (Eq. 19/20) times this factor (a measured restitution); 1 (default)
+        is the exact impact.  The restitution metric's target is then ``r`` x
+        Eq. 19/20, the thresholds' the scaled model's spectrum, the histories'
+        the scaled model's run.
 
     Returns
     -------
@@ -296,6 +305,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     if isinstance(tolerance, bool) or not (isinstance(tolerance, (int, float))
                                             and 0.0 < tolerance <= 1.0):
         raise ValueError(f"tolerance must be in (0, 1], got {tolerance!r}")
+    from trilith_xval.analytic.options import check_restitution_factor
+    rf = check_restitution_factor("calibrate", restitution_factor)
     vs = validation or ValidationSet()
     names = (vs.scene,) if isinstance(vs.scene, str) else tuple(vs.scene)
     if scene is None:
@@ -316,16 +327,22 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     def one_scene(sc, varied: dict):
         cand = {**base, **varied}
         if metric == "restitution":
-            return _restitution(engine, sc, vs, cand)
+            return _restitution(engine, sc, vs, cand, rf)
         if metric == "thresholds":
             if id(sc) not in reference:
                 from trilith_xval.analytic.spectrum import overturning_spectrum
 
                 from trilith_xval.compare.campaign.design import scene_omegas
+                model = {}
+                if rf != 1.0:  # the target: the model with the measured restitution
+                    from trilith_xval.analytic.spectrum import (SpectrumSettings,
+                                                                search_run_settings)
+                    model = {"settings": SpectrumSettings(
+                        fast=search_run_settings(restitution_factor=rf))}
                 reference[id(sc)] = overturning_spectrum(
-                    sc, list(vs.omegas) if vs.omegas else scene_omegas(sc))
+                    sc, list(vs.omegas) if vs.omegas else scene_omegas(sc), **model)
             return _thresholds(engine, sc, reference[id(sc)], cand, workers)
-        return _histories(engine, sc, vs, cand)
+        return _histories(engine, sc, vs, cand, rf)
 
     def evaluate(cand: dict) -> Evaluation:
         with runs.using(None):  # measured costs: no run inside served from a store
@@ -347,6 +364,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         # calibration resumes at the next one; a served candidate keeps the costs
         # measured when it ran.
         description = _candidate_description(engine, metric, vs, scenes, {**base, **cand})
+        if rf != 1.0:  # absent at 1: candidates stored before the factor keep their keys
+            description["restitution_factor"] = rf
         ev = runs.lookup("calibration-candidate", description, code=runs.ALL_CODE)
         if ev is not None:
             ev = dataclasses.replace(ev, from_store=True)

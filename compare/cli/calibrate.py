@@ -12,6 +12,7 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add
                                  add_store_args, add_workers_arg, check_output_path, envelope,
                                  file_options, info, resolve_workers,
                                  settings_from_args, settings_line, sig, use_store)
+from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.run.jsonable import plain
 
 
@@ -58,6 +59,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=None, metavar="S",
                         help="the design's seed (default 34; the held-out set uses S + 1)")
     add_settings_arg(parser)
+    add_restitution_arg(parser)
     add_workers_arg(parser)
     add_store_args(parser)
     parser.add_argument("--json", metavar="FILE", help="write every evaluation as JSON")
@@ -150,6 +152,7 @@ def run(args: argparse.Namespace) -> int:
     if len(engine) != 1:
         raise ValueError("--engine: calibrate one engine at a time")
     engine = engine[0]
+    rf = restitution_factor(args)
     design = _design(args)
     scenes = design[0] if design else _common.scenes_from_args(args)
     loaded = settings_from_args(args, (engine,))
@@ -189,7 +192,8 @@ def run(args: argparse.Namespace) -> int:
             bar.update(1)
 
     cal = calibrate(engine, args.metric, validation=vs, space=space, tolerance=args.tolerance,
-                    workers=workers, progress=progress, scene=scenes, base=base)
+                    workers=workers, progress=progress, scene=scenes, base=base,
+                    restitution_factor=rf)
     if bar is not None:
         bar.close()
     _print(cal)
@@ -202,6 +206,8 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"engine": engine, "metric": args.metric,
                   "scene": [sc.to_dict() for sc in scenes] if len(scenes) > 1
                   else scenes[0].to_dict()}
+        if rf != 1.0:
+            inputs["restitution_factor"] = rf
         atomic.write_text(args.json, json.dumps(envelope("calibrate", inputs, body, {}),
                                                 indent=1) + "\n")
         info(f"wrote {args.json}")
@@ -245,6 +251,8 @@ def _command(args, engine: str) -> str:
     words += [f"--vary {v}" for v in args.vary]
     if args.step_only:
         words.append("--step-only")
+    if restitution_factor(args) != 1.0:  # these settings match the scaled model only
+        words.append(f"--restitution-factor {restitution_factor(args)!r}")
     return " ".join(words)
 
 
@@ -281,7 +289,7 @@ def _held_out(engine, args, cal, held, vs, base, workers):
     ev = calibrate(engine, "thresholds", validation=ValidationSet(scene=names, omegas=vs.omegas),
                    space={k: [v] for k, v in cal.recommended.options.items()},
                    tolerance=cal.tolerance, workers=workers, scene=held,
-                   base=base).evaluations[0]
+                   base=base, restitution_factor=restitution_factor(args)).evaluations[0]
     worst = max(ev.errors, key=lambda e: e[1]) if ev.errors else ("-", math.nan)
     print(f"held-out ({len(held)} scenes, {len(ev.errors)} points): worst error "
           f"{ev.worst_error:.3g} at {worst[0]} (tolerance {cal.tolerance:g}, "

@@ -14,6 +14,7 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  scene_from_args)
 from trilith_xval.compare.cli.map_text import print_map_summary, subsample
 from trilith_xval.compare.report.map_plot import plot_maps
+from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.measure.map_thresholds import LEAST_RUNS
 from trilith_xval.compare.run.jsonable import plain
 
@@ -45,6 +46,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="fixed window of every engine run [s], no early stop (default: "
                              "each run stops when its verdict is certain)")
     _options.add_settings_arg(parser)
+    add_restitution_arg(parser)
     parser.add_argument("--max-engine-runs", type=int, default=200, metavar="N",
                         help="refuse engine work of more runs than this in all: every grid "
                              f"cell, and at least {LEAST_RUNS} runs per robust threshold "
@@ -145,7 +147,10 @@ def run(args: argparse.Namespace) -> int:
     from trilith_xval.compare.cli.pulse_shape import shape_from_args
     shape = shape_from_args(args)
     engines, eng_grid = (), None
+    rf = restitution_factor(args)
     if args.record is not None:
+        if rf != 1.0:  # the record map runs the exact impact
+            raise ValueError("--restitution-factor is not supported with --record yet")
         from trilith_xval.compare.cli.record_map import record_map
         return record_map(args, scene, workers,
                           parse_engine_list(args.engine) if args.engine is not None else ())
@@ -156,6 +161,9 @@ def run(args: argparse.Namespace) -> int:
     from trilith_xval.analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
     from trilith_xval.analytic.spectrum import SpectrumSettings
     settings = SpectrumSettings(pulse=shape)
+    if rf != 1.0:  # at 1 the settings (and so every stored key) stay the defaults
+        from trilith_xval.analytic.first_overturn import search_run_settings
+        settings = SpectrumSettings(pulse=shape, fast=search_run_settings(restitution_factor=rf))
     top = MAX_CELLS if settings.compiled else MAX_ACCURATE_CELLS
     if omegas.size * amps.size > top:
         why = "" if settings.compiled else (f" for a {shape} pulse (the accurate model, "
@@ -172,7 +180,8 @@ def run(args: argparse.Namespace) -> int:
     if engines:
         from trilith_xval.compare.campaign.settings_file import threshold_options
         from trilith_xval.compare.measure.map_thresholds import map_thresholds, model_thresholds
-        reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers)
+        reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers,
+                                     restitution_factor=rf)
         _options.step_notes(engines, [scene])
         for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
             thresholds[name] = map_thresholds(name, scene, eng_grid[0], settings.pulse,
@@ -181,7 +190,8 @@ def run(args: argparse.Namespace) -> int:
                                               **{**threshold_options(name, scene),
                                                  **_options.file_options(loaded, name)})
     from trilith_xval.analytic.threshold_validity import curve_validity
-    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers)
+    validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers,
+                              restitution_factor=rf)
     valid_at = {round(float(w), 9): v["model_valid"] for w, v in zip(maps[0].omega, validity)}
 
     def valid_text(w):
@@ -205,8 +215,14 @@ def run(args: argparse.Namespace) -> int:
                         "thresholds": [p.to_dict() for p in thresholds[m.backend]],
                         "threshold_cost": threshold_cost(thresholds[m.backend])}
                        for m in maps[1:]]
-        print_json(plain({"maps": [first] + engine_maps}))
+        doc = {"maps": [first] + engine_maps}
+        if rf != 1.0:  # absent at 1: the documents of exact-impact maps stay as they were
+            doc["restitution_factor"] = rf
+        print_json(plain(doc))
         return 0
+    if rf != 1.0:
+        from trilith_xval.compare.cli.model_options import restitution_text
+        print(f"model: {restitution_text(rf, scene.has_pendulum)}")
     for m in maps:
         print_map_summary(m, f"scene {scene.name}, {m.pulse} pulse, {m.omega.size} "
                              f"frequencies x {m.amplitude.size} amplitudes")

@@ -9,6 +9,7 @@ from trilith_xval.engines import engine_names
 from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args, detail,
                                  envelope, file_options, info, print_json, scene_from_args,
                                  settings_from_args, settings_line, sig, use_store)
+from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.run.jsonable import plain
 
 # Half the static overturning angle: large, clean impacts far from toppling.
@@ -34,6 +35,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="initial pendulum angle [rad], in [-pi, pi]")
     parser.add_argument("--n-impacts", type=int, default=None, metavar="N",
                         help="impacts to measure, in [1, 50] (default: 4)")
+    add_restitution_arg(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     add_store_args(parser)
     return parser
@@ -47,10 +49,11 @@ def run(args: argparse.Namespace) -> int:
     n = args.n_impacts if args.n_impacts is not None else DEFAULT_N_IMPACTS
     if not 1 <= n <= MAX_N_IMPACTS:
         raise ValueError(f"--n-impacts must be in [1, {MAX_N_IMPACTS}], got {n}")
+    rf = restitution_factor(args)
     loaded = settings_from_args(args, (args.engine,))
     use_store(args)
     result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0,
-                                 **file_options(loaded, args.engine))
+                                 restitution_factor=rf, **file_options(loaded, args.engine))
     if args.json:
         body = result.to_dict()
         diagnostics = dict(body.get("diagnostics") or {})
@@ -61,10 +64,13 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"scene": scene.to_dict(), "excitation": {"type": "still"},
                   "engine": args.engine, "theta0": theta0, "psi0": args.psi0, "n_impacts": n,
                   "settings_file": None if loaded is None else loaded.describe()}
+        if rf != 1.0:
+            inputs["restitution_factor"] = rf
         body = {"engine": body.pop("engine"), "engine_version": body.pop("version"), **body}
         print_json(plain(envelope("restitution", inputs, body, timings)))
         return 0
     eq_name = "Eq. 19 at measured psi" if scene.has_pendulum else "Eq. 20"
+    eq_name = eq_name if rf == 1.0 else f"{rf:g} x {eq_name}"
     print(f"{result.engine} ({result.version}), scene {scene.name}: lam = {sig(scene.lam)}, "
           f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}, theta0 = {sig(theta0)} rad")
     print(f"{'#':>3} {'t [s]':>8} {'side':>4} {'psi [rad]':>10} {'measured [-]':>12} "

@@ -13,6 +13,8 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add
                                  check_output_path, detail, envelope, file_options, info,
                                  print_json, scene_from_args, settings_from_args, settings_line,
                                  sig)
+from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
+                                                    restitution_text)
 from trilith_xval.compare.run.jsonable import plain
 
 
@@ -32,6 +34,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--criterion", choices=("topple", "alpha"), default=None,
                         help="overturned at |theta| = 1.5 rad (topple) or at alpha "
                              "(default: the backend's, topple)")
+    add_restitution_arg(parser)
     parser.add_argument("--t-max", type=float, default=None, metavar="S",
                         help="fixed run length [s], > 0 (default: until the verdict is "
                              "decided exactly, docs/overturning.md)")
@@ -45,10 +48,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
-def _settings(name: str, criterion: str | None, t_max: float | None, base: dict | None = None):
+def _settings(name: str, criterion: str | None, t_max: float | None, base: dict | None = None,
+              restitution: float = 1.0):
     """Backend ``name``'s calibrated settings with ``base`` (a ``--settings`` table)
     and ``--criterion``/``--t-max`` applied (``--t-max`` fixes the run's window: no
-    early stop, in every backend)."""
+    early stop, in every backend); ``restitution`` (``--restitution-factor``) is
+    the model's, set on the analytic backends only (at 1 their settings stay the
+    defaults)."""
     from trilith_xval.engines import configure
     if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
@@ -59,6 +65,8 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
         options["t_max"] = t_max
         if name != "analytic-fast":  # the compiled model stops only when its verdict is exact
             options["early_stop"] = False
+    if restitution != 1.0 and name.startswith("analytic"):
+        options["restitution_factor"] = restitution
     return configure(name, **options)
 
 
@@ -84,15 +92,21 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     excitation = excitation_from_args(args)
     backend = get_backend(args.engine)
+    r = restitution_factor(args)
+    model_run = args.engine.startswith("analytic") or args.plot is not None
+    if r != 1.0 and not model_run:
+        raise ValueError(f"--restitution-factor scales the model's impacts, and --engine "
+                         f"{args.engine} alone runs no model (add --plot to draw the model "
+                         f"beside it)")
     loaded = settings_from_args(args, (args.engine,))
     settings = _settings(args.engine, args.criterion, args.t_max,
-                         file_options(loaded, args.engine))
+                         file_options(loaded, args.engine), r)
     check_run_budget(args.engine, settings, excitation)
     # An engine's plot shows the model's run beside it (same scene, excitation,
     # criterion and window): what a cross-validation is read from.
     overlay = args.plot is not None and not args.engine.startswith("analytic")
     if overlay:
-        model_settings = _settings("analytic", args.criterion, args.t_max)
+        model_settings = _settings("analytic", args.criterion, args.t_max, restitution=r)
         check_run_budget("analytic", model_settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
@@ -114,12 +128,15 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"scene": scene.to_dict(), "excitation": excitation.describe(),
                   "engine": args.engine, "criterion": args.criterion, "t_max": args.t_max,
                   "settings_file": None if loaded is None else loaded.describe()}
+        if r != 1.0:  # absent at 1: the documents of exact-impact runs stay as they were
+            inputs["restitution_factor"] = r
         body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
         print_json(plain(envelope("simulate", inputs, body, timings)))
         return 0
     v = traj.verdict
     print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
-          f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}")
+          f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}"
+          + (f"; model {restitution_text(r, scene.has_pendulum)}" if r != 1.0 else ""))
     line = f"verdict: {v.status}"
     if v.overturned:  # the name of the time in --json and in Python's Trajectory
         line += f" ({v.mode}), overturn_time = {v.time:.4f} s"

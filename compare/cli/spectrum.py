@@ -15,6 +15,8 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  file_options, info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
                                  settings_line, use_store)
+from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
+                                                    restitution_text)
 from trilith_xval.compare.report.spectrum_plot import plot_spectrum
 from trilith_xval.compare.run.jsonable import plain
 
@@ -47,6 +49,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="overturned at |theta| = 1.5 rad (topple) or at alpha")
     parser.add_argument("--t-max", type=float, default=None, metavar="S",
                         help="fixed run length [s] (default: exact survival rules)")
+    add_restitution_arg(parser)
     parser.add_argument("--engine", default="analytic", metavar="NAME[,NAME...]",
                         help="analytic (the model's spectrum), or engines to bisect on the same "
                              f"grid around it: {', '.join(engine_names())}, or all")
@@ -148,7 +151,8 @@ def _settings(args: argparse.Namespace):
                                            and 1e-4 < args.scan_step <= 100):
         raise ValueError(f"--scan-step must be in (0.0001, 100] m/s^2, got {args.scan_step!r}")
     from trilith_xval.compare.cli.pulse_shape import shape_from_args
-    fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max)
+    fast = search_run_settings(criterion=OverturnCriterion(args.criterion), t_max=args.t_max,
+                               restitution_factor=restitution_factor(args))
     kw = {"pulse": shape_from_args(args), "fast": fast}
     if args.tol is not None:
         kw["tol"] = args.tol
@@ -180,6 +184,9 @@ def run(args: argparse.Namespace) -> int:
 
     scene = scene_from_args(args)
     if args.record is not None:
+        if restitution_factor(args) != 1.0:  # the record search runs the exact model
+            raise ValueError("--restitution-factor is not supported with --record yet "
+                             "(the record's intensity search runs the exact impact)")
         return _record_spectrum(args, scene)
     omegas = parse_omega_range(args.omega, "--omega")
     settings = _settings(args)
@@ -211,13 +218,17 @@ def run(args: argparse.Namespace) -> int:
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": settings.pulse,
                   "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
                   "scan_step": args.scan_step, "engine": ENGINE}
+        if settings.fast.restitution_factor != 1.0:  # absent at 1, as in the run keys
+            inputs["restitution_factor"] = settings.fast.restitution_factor
         body = {"engine": ENGINE, "engine_version": version(), **body}
         print_json(plain(envelope("spectrum", inputs, body, timings)))
         return 0
     print(f"scene {scene.name}: lam = {scene.lam:.4g}, b = {scene.b:.4g} m, mu = {scene.mu:.4g}, "
           f"gamma = {scene.gamma:.4g}; {settings.pulse} pulse; criterion "
           f"{settings.criterion.kind}, t_max = {settings.t_max}, tol = {settings.tol:g} m/s^2, "
-          f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)")
+          f"scan step max({settings.scan_step:g} m/s^2, {100 * settings.scan_rel_step:g} % A)"
+          + (f"; {restitution_text(settings.fast.restitution_factor, scene.has_pendulum)}"
+             if settings.fast.restitution_factor != 1.0 else ""))
     both = len(spec.curves) == 2  # without a pendulum: one curve, no gain
     print(f"{'Omega [rad/s]':>13} {'A_np [m/s^2]':>12} {'mode_np':>13}"
           + (f" {'A_yp [m/s^2]':>12} {'mode_yp':>13} {'Delta [%]':>9}" if both else "")
@@ -357,11 +368,16 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
                   "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
                   "convergence": args.convergence,
                   "settings_file": None if loaded is None else loaded.describe()}
+        if spec.settings.fast.restitution_factor != 1.0:  # the engines' target: the scaled model
+            inputs["restitution_factor"] = spec.settings.fast.restitution_factor
         body = {"engine": list(names),
                 "engine_version": {"analytic": version(), **{r.engine: r.version for r in results}},
                 "analytic": analytic, "engines": {r.engine: r.to_dict() for r in results}}
         print_json(envelope("spectrum", inputs, body, timings))
         return 0
+    rf = spec.settings.fast.restitution_factor
+    if rf != 1.0:  # the engines' target is the scaled model, not the exact impact
+        print(f"A_model: the model with {restitution_text(rf, scene.has_pendulum)}")
     for r in results:
         cost = r.cost()
         if loaded is not None:

@@ -24,16 +24,23 @@ LEAST_RUNS = 7
 def _model_point(args):
     from trilith_xval.analytic.first_overturn import first_overturn_amplitude
     from trilith_xval.analytic.spectrum import SpectrumSettings
-    scene, omega, kind = args
-    a, _, mode, _, _ = first_overturn_amplitude(scene, omega, SpectrumSettings(pulse=kind))
+    scene, omega, kind, rf = args
+    settings = SpectrumSettings(pulse=kind)
+    if rf != 1.0:  # the engines' target: the model with the measured restitution
+        from trilith_xval.analytic.first_overturn import search_run_settings
+        settings = SpectrumSettings(pulse=kind, fast=search_run_settings(restitution_factor=rf))
+    a, _, mode, _, _ = first_overturn_amplitude(scene, omega, settings)
     return float(a), mode
 
 
-def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1):
+def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1,
+                     restitution_factor: float = 1.0):
     """``[(a_reference, mode)]``: the model's first overturning amplitude [m/s^2]
-    and mode at each of ``omegas`` (NaN, None when nothing overturns)."""
+    and mode at each of ``omegas`` (NaN, None when nothing overturns), its impacts
+    scaled by ``restitution_factor`` (Eq. 19/20 times it; 1 = exact)."""
     from trilith_xval.compare.measure.engine_spectrum import _map
-    return _map(_model_point, [(scene, float(w), kind) for w in omegas], workers)
+    return _map(_model_point, [(scene, float(w), kind, float(restitution_factor))
+                               for w in omegas], workers)
 
 
 def map_thresholds(engine: str, scene, omegas, kind: str = "sine", *, workers: int = 1,

@@ -5,7 +5,9 @@ The trilith is released at rest from a tilt ``theta0`` with no base motion
 backend's measured velocity ratio ``theta_dot+ / theta_dot-`` (read away from the
 impact: :mod:`engines.monitor`) is compared with the model: Eq. 20 without the
 pendulum, Eq. 19 at the impact's measured ``psi`` with it (both as corrected in
-:func:`analytic.equations.restitution_ratio`, ``docs/paper-errata.md``).
+:func:`analytic.equations.restitution_ratio`, ``docs/paper-errata.md``), times the
+restitution factor ``r`` when one is given: the target a measured restitution
+sets (``docs/model.md``).
 
 The run length comes from the analytic model itself (:mod:`analytic.simulate`
 released from the same tilt): a backend runs to halfway between impacts ``n`` and
@@ -73,11 +75,14 @@ class RestitutionResult:
     settings: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
     wall_time: float = math.nan
+    restitution_factor: float = 1.0
 
     @property
     def equation(self) -> str:
-        """``'Eq. 19'`` with a pendulum (at the measured psi), else ``'Eq. 20'``."""
-        return "Eq. 19" if self.gamma > 0.0 else "Eq. 20"
+        """``'Eq. 19'`` with a pendulum (at the measured psi), else ``'Eq. 20'``;
+        prefixed by ``'r x '`` when the target is scaled by a restitution factor."""
+        name = "Eq. 19" if self.gamma > 0.0 else "Eq. 20"
+        return name if self.restitution_factor == 1.0 else f"{self.restitution_factor:g} x {name}"
 
     @property
     def n_impacts(self) -> int:
@@ -94,6 +99,10 @@ class RestitutionResult:
         return max((abs(i.rel_error) for i in self.impacts), default=math.nan)
 
     def to_dict(self) -> dict:
+        """Every field; ``restitution_factor`` only when it is not 1 (the exact
+        impact), so that documents of exact-impact runs stay as they were."""
+        extra = {} if self.restitution_factor == 1.0 else {
+            "restitution_factor": self.restitution_factor}
         return {"engine": self.engine, "version": self.version, "lam": self.lam,
                 "mu": self.mu, "gamma": self.gamma, "equation": self.equation,
                 "theta0": self.theta0, "psi0": self.psi0, "n_requested": self.n_requested,
@@ -101,7 +110,7 @@ class RestitutionResult:
                 "impacts": [i.to_dict() for i in self.impacts],
                 "max_rel_error": self.max_rel_error, "status": self.status,
                 "settings": self.settings, "diagnostics": self.diagnostics,
-                "wall_time": self.wall_time}
+                **extra, "wall_time": self.wall_time}
 
 
 def analytic_impact_times(scene, theta0: float, psi0: float, n: int) -> list[float]:
@@ -124,10 +133,12 @@ def analytic_impact_times(scene, theta0: float, psi0: float, n: int) -> list[flo
     return [e.t for e in traj.impacts[:n]]
 
 
-def restitution_from_trajectory(traj: Trajectory, scene=None,
-                                n_impacts: int | None = None) -> tuple[ImpactRestitution, ...]:
+def restitution_from_trajectory(traj: Trajectory, scene=None, n_impacts: int | None = None,
+                                restitution_factor: float = 1.0
+                                ) -> tuple[ImpactRestitution, ...]:
     """Each impact event of ``traj`` against the model (Eq. 20, or Eq. 19 at the
-    impact's measured ``psi`` with a pendulum); the event ``side`` is the side entered."""
+    impact's measured ``psi`` with a pendulum, times ``restitution_factor``); the
+    event ``side`` is the side entered."""
     scene = scene if scene is not None else traj.scene
     if scene is None:
         raise ValueError("scene must be given when the trajectory carries none")
@@ -141,13 +152,14 @@ def restitution_from_trajectory(traj: Trajectory, scene=None,
         side = ev.side if ev.side in (-1, 1) else (1 if ev.theta_dot_after > 0 else -1)
         rows.append(ImpactRestitution(float(ev.t), int(side), float(psi),
                                       float(ev.theta_dot_before), float(ev.velocity_ratio),
-                                      eq.restitution_ratio(psi, side, b, h, mu, gamma, j)))
+                                      restitution_factor
+                                      * eq.restitution_ratio(psi, side, b, h, mu, gamma, j)))
     return tuple(rows)
 
 
 def measure_restitution(backend: str, scene, theta0: float | None = None, settings=None,
                         n_impacts: int = DEFAULT_N_IMPACTS, psi0: float = 0.0,
-                        **options) -> RestitutionResult:
+                        restitution_factor: float = 1.0, **options) -> RestitutionResult:
     """Release ``scene`` from tilt ``theta0`` in ``backend`` and compare each
     impact's velocity ratio with Eq. 19/20.
 
@@ -166,6 +178,11 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
         Impacts to measure, in [1, 50].
     psi0 : float
         Initial pendulum angle [rad], in [-pi, pi].
+    restitution_factor : float
+        In (0, 1]: the target is Eq. 19/20 times it (a measured restitution);
+        the analytic backends also run with it.  The run's length still comes
+        from the exact model, whose impacts are the latest (a lossier rocking
+        swings lower, hence faster), so the run shows at least ``n_impacts``.
 
     Returns
     -------
@@ -201,6 +218,10 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
                          f"got {theta0!r}")
     if not (math.isfinite(psi0) and abs(psi0) <= math.pi):
         raise ValueError(f"psi0 must be in [-pi, pi] rad, got {psi0!r}")
+    from trilith_xval.analytic.options import check_restitution_factor
+    restitution_factor = check_restitution_factor("measure_restitution", restitution_factor)
+    if restitution_factor != 1.0 and backend.startswith("analytic"):
+        options = {**options, "restitution_factor": restitution_factor}
     if isinstance(n_impacts, bool) or not isinstance(n_impacts, int) or not (
             1 <= n_impacts <= MAX_N_IMPACTS):
         raise ValueError(f"n_impacts must be an integer in [1, {MAX_N_IMPACTS}], got {n_impacts!r}")
@@ -217,6 +238,7 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
     return RestitutionResult(
         engine=backend, version=module.version(), lam=scene.lam, mu=scene.mu,
         gamma=scene.gamma, theta0=theta0, psi0=psi0, n_requested=n_impacts,
-        impacts=restitution_from_trajectory(traj, scene, n_impacts),
+        impacts=restitution_from_trajectory(traj, scene, n_impacts, restitution_factor),
         status=traj.verdict.status, settings=dict(traj.settings),
-        diagnostics=dict(traj.diagnostics), wall_time=traj.wall_time)
+        diagnostics=dict(traj.diagnostics), wall_time=traj.wall_time,
+        restitution_factor=restitution_factor)

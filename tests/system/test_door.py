@@ -16,6 +16,8 @@ from pathlib import Path
 import pytest
 
 from trilith_xval.analytic.excitation import Pulse, SampledRecord
+from trilith_xval.analytic.events import Settings as AccurateSettings
+from trilith_xval.analytic.fast_settings import Settings as FastSettings
 from trilith_xval.analytic.parameters import Scene
 from trilith_xval.compare.cli.main import main
 from trilith_xval.scenes import load_record, load_scene
@@ -147,6 +149,28 @@ CLI_CASES = [
     (["record", "--out", "{dir}/x.gif", "--engine", "nope"], "--engine"),
     (["record", "--out", "{dir}/x.gif", "--fps", "0"], "fps"),
     (["view", "--omega", "1e-6"], "omega"),
+    # --- a measured restitution: in (0, 1], on every command that runs the model
+    (S + ["--restitution-factor", "1.5"], "--restitution-factor must be in (0, 1], got 1.5"),
+    (S + ["--restitution-factor", "0"], "--restitution-factor must be in (0, 1], got 0.0"),
+    (S + ["--restitution-factor", "nan"], "--restitution-factor must be in (0, 1], got nan"),
+    (S + ["--restitution-factor", "-0.5", "--engine", "analytic-fast"],
+     "--restitution-factor must be in (0, 1]"),
+    (S + ["--restitution-factor", "high"], "--restitution-factor must be a number in (0, 1]"),
+    (S + ["--restitution-factor", "0.9", "--engine", "pymunk"], "runs no model"),
+    (["simulate", "--record", str(SAMPLE_CSV), "--restitution-factor", "inf"],
+     "--restitution-factor must be in (0, 1], got inf"),
+    (["spectrum", "--omega", "10", "--restitution-factor", "1.01"],
+     "--restitution-factor must be in (0, 1], got 1.01"),
+    (["spectrum", "--omega", "10", "--engine", "pymunk", "--restitution-factor", "-1"],
+     "--restitution-factor must be in (0, 1]"),
+    (["spectrum", "--record", str(SAMPLE_CSV), "--restitution-factor", "0.9"],
+     "not supported with --record"),
+    (["map", "--omega", "10", "--amplitude", "1:2:1", "--restitution-factor", "2"],
+     "--restitution-factor must be in (0, 1], got 2.0"),
+    (["restitution", "--engine", "analytic", "--restitution-factor", "0"],
+     "--restitution-factor must be in (0, 1], got 0.0"),
+    (["calibrate", "--engine", "pymunk", "--restitution-factor", "1.2"],
+     "--restitution-factor must be in (0, 1], got 1.2"),
 ]
 
 
@@ -197,6 +221,10 @@ API_CASES = [
     (lambda: SampledRecord((0.0, 1.0), (0.0, 2e4)), ValueError, "1e4"),
     (lambda: SampledRecord(("a", "b"), (0.0, 0.0)), TypeError, "times"),
     (lambda: load_record(None), TypeError, "path"),
+    (lambda: AccurateSettings(restitution_factor=1.5), ValueError,
+     r"restitution_factor must be finite in \(0, 1\]"),
+    (lambda: FastSettings(restitution_factor=0.0), ValueError, "restitution_factor"),
+    (lambda: FastSettings(restitution_factor="0.9"), TypeError, "restitution_factor"),
 ]
 
 
