@@ -4,9 +4,9 @@ Public API::
 
     from trilith_xval.analytic import Scene, Pulse, simulate, SimulationSettings
 """
-from .excitation import Pulse, SampledRecord, Still
+from .excitation import Excitation, Pulse, SampledRecord, Still, check_excitation
 from .parameters import Scene
 from .trajectory import Event, OverturnCriterion, Trajectory, Verdict
 
-__all__ = ["Scene", "Pulse", "SampledRecord", "Still", "Trajectory", "Event", "Verdict",
-           "OverturnCriterion"]
+__all__ = ["Scene", "Excitation", "check_excitation", "Pulse", "SampledRecord", "Still",
+           "Trajectory", "Event", "Verdict", "OverturnCriterion"]

@@ -12,11 +12,8 @@ from __future__ import annotations
 import math
 import numbers
 
-import numpy as np
-
 from . import equations as eq
 from .contact_forces import violations
-from .excitation import Pulse, SampledRecord
 from .simulate import simulate
 
 __all__ = ["required_friction", "peak_acceleration", "check_model"]
@@ -47,15 +44,9 @@ def required_friction(scene, excitation) -> float:
 
 
 def peak_acceleration(excitation) -> float:
-    """``max |xg_ddot|`` [m/s^2] of an excitation (0 for :class:`Still`)."""
-    if isinstance(excitation, Pulse):
-        return abs(excitation.amplitude)
-    if isinstance(excitation, SampledRecord):  # linear interpolation peaks at a sample
-        return max(abs(a) for a in excitation.accelerations)
-    if excitation.end_time > 0.0:
-        t = np.linspace(0.0, excitation.end_time, 20001)
-        return float(np.max(np.abs(excitation.acceleration_array(t))))
-    return 0.0
+    """``max |xg_ddot|`` [m/s^2] of an excitation (0 for :class:`Still`): its
+    ``acceleration_bound()`` (exact for a pulse and a record, sampled otherwise)."""
+    return excitation.acceleration_bound()
 
 
 def check_model(scene, pulse, friction: float | None = None) -> dict:

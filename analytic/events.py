@@ -112,9 +112,7 @@ def excitation_window(excitation) -> tuple[float, float]:
     Both ends are breakpoints of the integration: the one-cosine pulse jumps at
     ``t = 0`` and at ``T_s`` (Eq. 23), a record may start with a non-zero value.
     """
-    times = getattr(excitation, "times", None)
-    t_on = float(times[0]) if times is not None else 0.0
-    return t_on, float(excitation.end_time)
+    return float(excitation.start_time), float(excitation.end_time)
 
 
 def segment_acceleration(excitation, t_a: float, t_b: float) -> Callable[[float], float]:
@@ -126,9 +124,6 @@ def segment_acceleration(excitation, t_a: float, t_b: float) -> Callable[[float]
     if mid < t_on or mid > t_off:
         return lambda t: 0.0
     lo, hi = max(t_a, t_on), min(t_b, t_off)
-    if not hasattr(excitation, "interpolant"):
-        acc = excitation.acceleration
-        return lambda t: acc(min(max(t, lo), hi))
     return excitation.interpolant(lo, hi)
 
 

@@ -1,9 +1,10 @@
 """Base excitations: one-sine (Eq. 22), one-cosine (Eq. 23) pulses and sampled records.
 
-Every excitation gives the ground acceleration ``xg_ddot(t)`` [m/s^2] and its
-integrals (for the moving-ground option of the engines), and ``end_time``: after
-it the ground is still (``xg_ddot = 0``), which lets a run stop as soon as its
-verdict is decided.
+Every excitation meets the contract of :class:`Excitation`
+(:mod:`analytic.excitation_contract`, re-exported here): it gives the ground
+acceleration ``xg_ddot(t)`` [m/s^2] and its integrals (for the moving-ground
+option of the engines), and ``end_time``: after it the ground is still
+(``xg_ddot = 0``), which lets a run stop as soon as its verdict is decided.
 
 Eq. 22 as printed reads ``0 <= t <= T_s`` on both branches (OCR); the intended
 form is ``A sin(Omega t)`` for ``0 <= t <= T_s`` and ``0`` for ``t > T_s``, with
@@ -20,9 +21,12 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Pulse", "SampledRecord", "Still", "Excitation", "PULSE_KINDS", "OMEGA_RANGE",
-           "MAX_PULSE_LENGTH", "MAX_RECORD_LENGTH", "MAX_RECORD_SAMPLES", "G_STANDARD",
-           "MAX_ACCELERATION"]
+from .excitation_contract import (CompiledForm, Excitation, check_excitation,
+                                  check_excitation_contract)
+
+__all__ = ["Pulse", "SampledRecord", "Still", "Excitation", "CompiledForm", "check_excitation",
+           "check_excitation_contract", "PULSE_KINDS", "OMEGA_RANGE", "MAX_PULSE_LENGTH",
+           "MAX_RECORD_LENGTH", "MAX_RECORD_SAMPLES", "G_STANDARD", "MAX_ACCELERATION"]
 
 PULSE_KINDS = ("sine", "cosine")
 # Pulse frequencies [rad/s]: the upper bound is the former one; the lower bound
@@ -65,7 +69,7 @@ def _check_amplitude(name: str, value, limit: float, unit: str) -> float:
 
 
 @dataclass(frozen=True)
-class Pulse:
+class Pulse(Excitation):
     """One full cycle of ``A sin(Omega t)`` (``kind='sine'``, Eq. 22) or
     ``A cos(Omega t)`` (``kind='cosine'``, Eq. 23).
 
@@ -96,6 +100,7 @@ class Pulse:
     amplitude: float
     omega: float
     kind: str = "sine"
+    type_name = "pulse"
 
     def __post_init__(self) -> None:
         if not isinstance(self.kind, str):
@@ -138,6 +143,17 @@ class Pulse:
         arg = self.omega * t
         wave = np.cos(arg) if self.is_cosine else np.sin(arg)
         return np.where((t >= 0.0) & (t <= self.period), self.amplitude * wave, 0.0)
+
+    def acceleration_bound(self) -> float:
+        return abs(self.amplitude)
+
+    def velocity_bound(self) -> float:
+        """``2 |A| / Omega``: the integral of one sine or cosine lobe bounds it."""
+        return 2.0 * abs(self.amplitude) / self.omega
+
+    def compiled_form(self) -> CompiledForm:
+        """The kernels of :mod:`analytic.fast` integrate Eq. 22/23 themselves."""
+        return CompiledForm(self.kind, self.amplitude, self.omega)
 
     def velocity(self, t: float) -> float:
         """Ground velocity [m/s], zero at ``t = 0``."""
@@ -188,7 +204,7 @@ class Pulse:
 
 
 @dataclass(frozen=True)
-class SampledRecord:
+class SampledRecord(Excitation):
     """A sampled ground-acceleration record, linearly interpolated, zero outside.
 
     Parameters
@@ -205,6 +221,7 @@ class SampledRecord:
     times: tuple
     accelerations: tuple
     label: str = "record"
+    type_name = "record"
 
     def __post_init__(self) -> None:
         if not isinstance(self.label, str):
@@ -241,6 +258,19 @@ class SampledRecord:
     @property
     def end_time(self) -> float:
         return self.times[-1]
+
+    @property
+    def start_time(self) -> float:
+        return self.times[0]
+
+    @property
+    def kink_times(self) -> np.ndarray:
+        """The samples: linear interpolation has kinks there."""
+        return np.asarray(self.times, dtype=float)
+
+    def acceleration_bound(self) -> float:
+        """Linear interpolation peaks at a sample."""
+        return max(abs(a) for a in self.accelerations)
 
     @property
     def pga(self) -> float:
@@ -338,8 +368,10 @@ class SampledRecord:
 
 
 @dataclass(frozen=True)
-class Still:
+class Still(Excitation):
     """No base motion: for free rocking released from a tilt (restitution runs)."""
+
+    type_name = "still"
 
     @property
     def end_time(self) -> float:
@@ -357,11 +389,14 @@ class Still:
     def displacement(self, t: float) -> float:
         return 0.0
 
+    def scaled(self, factor: float) -> "Still":
+        """Still: no motion times ``factor`` (> 0) is no motion."""
+        _positive_factor(factor)
+        return self
+
     def mirrored(self) -> "Still":
         return self
 
     def describe(self) -> dict:
         return {"type": "still"}
 
-
-Excitation = Pulse | SampledRecord | Still

@@ -33,9 +33,10 @@ Phase semantics
   the threshold, and its ``reason`` says so.  :func:`simulate` never exits
   early: a trajectory always shows the whole fall.
 
-Sampled records and the pulses of :mod:`analytic.pulses` are not compiled:
-:func:`simulate` hands them to the accurate path (``analytic.simulate``) and
-says so in the trajectory's diagnostics.
+Only what an excitation's ``compiled_form()`` describes (the one-sine and
+one-cosine pulses) is compiled: :func:`simulate` hands any other excitation
+(a record, the pulses of :mod:`analytic.pulses`, a user's own) to the accurate
+path (``analytic.simulate``) and says so in the trajectory's diagnostics.
 """
 from __future__ import annotations
 
@@ -45,7 +46,7 @@ import time
 import numpy as np
 
 from . import _fast_kernels as _k
-from .excitation import Pulse
+from .excitation import CompiledForm, Excitation, check_excitation
 from .fast_settings import Settings, version
 from .parameters import Scene
 from .trajectory import Event, Trajectory, Verdict
@@ -116,15 +117,30 @@ def overturn_verdict(b: float, h: float, mu: float, gamma: float, j: float, l: f
                                         rest_step_fraction, True, restitution_factor))
 
 
-def verdict_for(scene: Scene, pulse: Pulse, settings: Settings | None = None) -> Verdict:
+def verdict_for(scene: Scene, pulse: Excitation, settings: Settings | None = None) -> Verdict:
     """The :class:`Verdict` of ``scene`` under ``pulse`` without sampling the
     trajectory (see :func:`overturn_verdict` for fixed-window runs).  A certain
     overturn ends the run early: ``Verdict.time`` is then the instant it became
-    certain (``Verdict.reason`` says so); :func:`simulate` gives the fall itself."""
+    certain (``Verdict.reason`` says so); :func:`simulate` gives the fall itself.
+
+    ``pulse`` must be an excitation the kernels integrate (its
+    ``compiled_form()`` is not None: a one-sine or one-cosine pulse),
+    ``TypeError`` otherwise."""
     settings = _check(scene, pulse, settings)
-    st, rs, tv, ni = _k.verdict(pulse.amplitude,
-                                *kernel_args(scene, pulse.omega, pulse.kind, settings))
+    form = _compiled(pulse)
+    if form is None:
+        raise TypeError(f"verdict_for: pulse must be an excitation the compiled kernels "
+                        f"integrate (compiled_form() of kind {tuple(PULSE_CODES)}: a sine or "
+                        f"cosine Pulse), got {type(pulse).__name__}")
+    st, rs, tv, ni = _k.verdict(form.amplitude,
+                                *kernel_args(scene, form.omega, form.kind, settings))
     return _make_verdict(st, rs, tv, ni)
+
+
+def _compiled(excitation: Excitation) -> CompiledForm | None:
+    """The excitation's compiled form if the kernels know its kind, else None."""
+    form = excitation.compiled_form()
+    return form if form is not None and form.kind in PULSE_CODES else None
 
 
 def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
@@ -140,10 +156,7 @@ def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
 def _check(scene, excitation, settings) -> Settings:
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
-    if not (hasattr(excitation, "acceleration") and hasattr(excitation, "end_time")):
-        raise ValueError("excitation must be a ground motion (Pulse, Ricker, "
-                         "MavroeidisPapageorgiou, SampledRecord), got "
-                         f"{type(excitation).__name__}")
+    check_excitation(excitation)
     settings = Settings() if settings is None else settings
     if not isinstance(settings, Settings):
         raise ValueError(f"settings must be analytic.fast.Settings, got {type(settings).__name__}")
@@ -165,11 +178,12 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     """Run ``scene`` under ``excitation``; returns a :class:`Trajectory`.
 
     Samples on the ``sample_dt`` grid plus one row at every event (the state
-    after it).  Any other ground motion than a one-sine or one-cosine
-    :class:`Pulse` (a record, a Ricker wavelet, ...) is handed to the accurate path.
+    after it).  An excitation without a compiled form (a record, a Ricker
+    wavelet, ...: ``compiled_form()`` is None) is handed to the accurate path.
     """
     settings = _check(scene, excitation, settings)
-    if not isinstance(excitation, Pulse):
+    form = _compiled(excitation)
+    if form is None:
         from . import simulate as accurate  # the fallback the docstring promises
         acc_settings = accurate.Settings(criterion=settings.criterion, t_max=settings.t_max,
                                          rest_velocity=settings.rest_velocity,
@@ -180,9 +194,9 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         return traj
     t0 = time.perf_counter()
     # No early exit here: a trajectory shows the fall up to the threshold.
-    args = kernel_args(scene, excitation.omega, excitation.kind, settings, certain_exit=False)
+    args = kernel_args(scene, form.omega, form.kind, settings, certain_exit=False)
     (st, rs, tv, ni, samples, ns, events, ne, n_steps, _e_out) = _k.run(
-        excitation.amplitude, *args, True, settings.sample_dt)
+        form.amplitude, *args, True, settings.sample_dt)
     wall = time.perf_counter() - t0
     data = samples[:ns]
     evs = []

@@ -169,7 +169,7 @@ def first_overturn_intensity(motion, overturns: Callable[[object], bool],
 
     grid = settings.grid()
     verdicts = [run(v) for v in grid]
-    name = label if label is not None else getattr(motion, "label", type(motion).__name__)
+    name = label if label is not None else motion.label
     if not any(verdicts):
         return IDAResult(name, settings.im, math.inf, grid[-1], (), tuple(runs))
     k = verdicts.index(True)

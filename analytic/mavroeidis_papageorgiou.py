@@ -16,14 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .excitation import (MAX_ACCELERATION, MAX_PULSE_LENGTH, _check_amplitude, _positive_factor,
-                         _real)
+from .excitation import (MAX_ACCELERATION, MAX_PULSE_LENGTH, Excitation, _check_amplitude,
+                         _positive_factor, _real)
 
 __all__ = ["MavroeidisPapageorgiou"]
 
 
 @dataclass(frozen=True)
-class MavroeidisPapageorgiou:
+class MavroeidisPapageorgiou(Excitation):
     """The Mavroeidis-Papageorgiou (2003) near-fault velocity pulse (module docstring).
 
     Parameters
@@ -48,6 +48,7 @@ class MavroeidisPapageorgiou:
     frequency: float
     gamma: float = 2.0
     nu: float = 0.0
+    type_name = "mavroeidis-papageorgiou"
 
     def __post_init__(self) -> None:
         a = _check_amplitude("velocity_amplitude", self.velocity_amplitude, 1e3, "m/s")

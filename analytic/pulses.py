@@ -4,11 +4,12 @@ wavelets (:mod:`analytic.ricker`) and the Mavroeidis-Papageorgiou pulse
 spectrum or a map scans (:class:`PulseShape`).
 
 Every ground motion of the project (:class:`~analytic.excitation.Pulse`, the
-Ricker and M-P pulses, :class:`~analytic.excitation.SampledRecord`) offers the same
-members: ``acceleration(t)`` [m/s^2], ``acceleration_array``, ``velocity`` [m/s]
-and ``displacement`` [m] (both zero at ``t = 0``), ``end_time`` [s] (the ground
-is still after it), ``pga`` [m/s^2], ``pgv`` [m/s], ``scaled(factor)``,
-``mirrored()`` and ``describe()``; the pulses also give ``peak_times`` (the
+Ricker and M-P pulses, :class:`~analytic.excitation.SampledRecord`) derives from
+:class:`~analytic.excitation.Excitation` and offers its members:
+``acceleration(t)`` [m/s^2], ``acceleration_array``, ``velocity`` [m/s] and
+``displacement`` [m] (both zero at ``t = 0``), ``end_time`` [s] (the ground is
+still after it), ``pga`` [m/s^2], ``pgv`` [m/s], ``scaled(factor)`` and
+``describe()``; the pulses also give ``mirrored()`` and ``peak_times`` (the
 extrema of ``|xg_ddot|``, where the uplift margin is smallest).
 """
 from __future__ import annotations

@@ -183,10 +183,7 @@ def _history(t, theta, theta_dot, psi, psi_dot, excitation, model_args):
     theta, theta_dot, psi, psi_dot = (np.asarray(a, dtype=float)
                                       for a in (theta, theta_dot, psi, psi_dot))
     sides = sample_sides(t, theta, theta_dot)
-    if hasattr(excitation, "acceleration_array"):
-        xg = np.asarray(excitation.acceleration_array(t), dtype=float)
-    else:
-        xg = np.array([excitation.acceleration(float(x)) for x in t])
+    xg = np.asarray(excitation.acceleration_array(t), dtype=float)
     b, h, mu, gamma, j, l, g = model_args
     compiled = _compiled_accelerations()
     if compiled is not None:  # the same numbers, ~50x faster

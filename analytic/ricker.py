@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .excitation import (MAX_ACCELERATION, MAX_PULSE_LENGTH, _check_amplitude, _positive_factor,
-                         _real)
+from .excitation import (MAX_ACCELERATION, MAX_PULSE_LENGTH, Excitation, _check_amplitude,
+                         _positive_factor, _real)
 
 __all__ = ["Ricker", "RICKER_KINDS", "RICKER_TAU_MAX"]
 
@@ -35,7 +35,7 @@ MIN_PERIOD = 2.0 * math.pi / 1e4
 
 
 @dataclass(frozen=True)
-class Ricker:
+class Ricker(Excitation):
     """A Ricker wavelet of ground acceleration (module docstring).
 
     Parameters
@@ -57,6 +57,7 @@ class Ricker:
     amplitude: float
     period: float
     kind: str = "symmetric"
+    type_name = "ricker"
 
     def __post_init__(self) -> None:
         if not isinstance(self.kind, str) or self.kind not in RICKER_KINDS:

@@ -57,6 +57,7 @@ from scipy.integrate import solve_ivp
 
 from . import equations as eq
 from .events import Settings, SampleBuffer, excitation_window, return_time, segment_acceleration
+from .excitation import check_excitation
 from .parameters import Scene
 from .reactions import validity_diagnostics
 from .rest_phase import RestPhase
@@ -92,15 +93,14 @@ class _Run(RestPhase):
         self.t_on, self.t_off = excitation_window(excitation)
         self.t_stop = st.t_max if st.t_max is not None else self.t_off + st.t_cap
         self.breaks = sorted({x for x in (self.t_on, self.t_off) if 0.0 < x < self.t_stop})
-        times = getattr(excitation, "times", None)
         # A record's xg_ddot has kinks at its samples, where the (then piecewise
         # linear) margin has its minima: REST checks the margin at every sample.
-        self.kinks = np.asarray(times, dtype=float) if times is not None else None
+        self.kinks = excitation.kink_times
         self.rest_block = 1  # kinks per REST integration, grows while at rest
         # A pulse's |xg_ddot| extrema, where the margin has its minima: REST
         # segments stop there too, so a short dip below zero cannot hide inside
         # one step (exact without a pendulum, whose margin depends on t only).
-        self.peaks = list(getattr(excitation, "peak_times", ()))
+        self.peaks = list(excitation.peak_times)
         self.t = 0.0
         self.theta, self.theta_dot = st.theta0, st.theta_dot0
         self.psi, self.psi_dot = st.psi0, st.psi_dot0
@@ -293,8 +293,9 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     Parameters
     ----------
     scene : Scene
-    excitation : Pulse or SampledRecord
-        Anything with ``acceleration(t)`` and ``end_time``.
+    excitation : Excitation
+        A :class:`~analytic.excitation.Excitation` (a pulse, a record, a user's
+        own subclass); ``TypeError`` otherwise.
     settings : Settings, optional
 
     Returns
@@ -310,8 +311,7 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     """
     if not isinstance(scene, Scene):
         raise ValueError(f"scene must be an analytic.Scene, got {type(scene).__name__}")
-    if not (hasattr(excitation, "acceleration") and hasattr(excitation, "end_time")):
-        raise ValueError("excitation must be a Pulse or a SampledRecord")
+    check_excitation(excitation)
     st = Settings() if settings is None else settings
     if not isinstance(st, Settings):
         raise ValueError(f"settings must be analytic.simulate.Settings, got {type(st).__name__}")

@@ -20,11 +20,9 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 from trilith_xval.analytic.bounds import required_friction
-from trilith_xval.analytic.excitation import Pulse, SampledRecord, Still
-from trilith_xval.analytic.mavroeidis_papageorgiou import MavroeidisPapageorgiou
+from trilith_xval.analytic.excitation import check_excitation
 from trilith_xval.analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
 from trilith_xval.analytic.parameters import Scene
-from trilith_xval.analytic.ricker import Ricker
 from trilith_xval.analytic.trajectory import Trajectory
 
 from .diagnostics import Diagnostics, PlaneState
@@ -48,7 +46,6 @@ BASE_MOTIONS = ("gravity", "ground")
 # (analytic.bounds.required_friction): 20 % headroom over a bound that is itself
 # conservative (it exceeded the exact demand along the analytic runs at A-D).
 FRICTION_MARGIN = 1.2
-EXCITATIONS = (Pulse, Ricker, MavroeidisPapageorgiou, SampledRecord, Still)
 
 
 @dataclass(frozen=True)
@@ -166,7 +163,9 @@ class Engine:
     Parameters
     ----------
     scene : Scene
-    excitation : Pulse, Ricker, MavroeidisPapageorgiou, SampledRecord or Still
+    excitation : Excitation
+        Any :class:`~analytic.excitation.Excitation` (the shipped pulses and
+        records, or a user's own subclass).
     settings : Settings, optional
         The engine's own ``Settings``; None: the calibrated defaults.
 
@@ -210,10 +209,7 @@ class Engine:
         name = self.name
         if not isinstance(scene, Scene):
             raise TypeError(f"{name}: scene must be a Scene, got {type(scene).__name__}")
-        if not isinstance(excitation, EXCITATIONS):
-            raise TypeError(f"{name}: excitation must be a Pulse, Ricker, "
-                            f"MavroeidisPapageorgiou, SampledRecord or Still, "
-                            f"got {type(excitation).__name__}")
+        check_excitation(excitation, where=name)
         s = settings if settings is not None else self.Settings()
         if not isinstance(s, self.Settings):
             raise TypeError(f"{name} settings must be {type(self).__module__}.Settings, "

@@ -30,8 +30,6 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-from trilith_xval.analytic.excitation import Pulse
-
 from . import geometry
 
 __all__ = ["Pose", "PlaneState", "Diagnostics", "peak_ground_speed", "joint_plane_state"]
@@ -89,13 +87,9 @@ def joint_plane_state(states, pendulum=None) -> PlaneState:
 
 
 def peak_ground_speed(excitation) -> float:
-    """A bound of ``max |xg_dot|`` [m/s] (it only scales the blow-up speed limit)."""
-    if isinstance(excitation, Pulse):  # integral of one sine/cosine lobe: <= 2 A / Omega
-        return 2.0 * abs(excitation.amplitude) / excitation.omega
-    if excitation.end_time <= 0.0:
-        return 0.0
-    ts = [excitation.end_time * k / 400.0 for k in range(401)]
-    return max(abs(excitation.velocity(t)) for t in ts)
+    """A bound of ``max |xg_dot|`` [m/s] (it only scales the blow-up speed limit):
+    the excitation's ``velocity_bound()``."""
+    return excitation.velocity_bound()
 
 
 class Diagnostics:

@@ -53,17 +53,16 @@ def check_budget(study, file, loaded=None) -> None:
 
     from trilith_xval.compare.cli.options import file_options
 
-    motions = [pulse_of(p, 1.0, min(study.omegas)) for p in study.pulses] if study.omegas else []
+    # (motion, fixed run length or None: until the verdict is decided)
+    motions = ([(pulse_of(p, 1.0, min(study.omegas)), None) for p in study.pulses]
+               if study.omegas else [])
     if study.records is not None:  # a record runs its fixed window: end + tail
         longest = max(study.records.records(), key=lambda r: r.end_time)
-        motions.append(longest)
+        motions.append((longest, longest.end_time + study.records.ida.tail))
     for engine in study.engines:
         settings = configure(engine, **file_options(loaded, engine))
         for dt in study.steps:
-            for motion in motions:
-                window = (motion.end_time + study.records.ida.tail
-                          if study.records is not None and not hasattr(motion, "peak_times")
-                          else None)
+            for motion, window in motions:
                 if dt or window is not None:
                     check_run_budget(engine, dataclasses.replace(settings, dt=dt or settings.dt),
                                      motion, option=f"{file}: campaign.steps", length=window)

@@ -99,7 +99,7 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
     over = p.bracketed and p.a_engine <= st.im_hi
     censored = p.bracketed and not over or (not p.bracketed and _survives_all(p, st.im_hi))
     long_run = _long_run(backend, scene, motion, st, settings, p, over)
-    return {"label": getattr(motion, "label", type(motion).__name__), "im": st.im,
+    return {"label": motion.label, "im": st.im,
             "im_overturn": p.a_engine if over else None,
             "im_safe": p.a_survives if over else None,
             "censored": bool(censored), "bracketed": bool(p.bracketed),

@@ -99,8 +99,10 @@ def settings_dict(settings) -> dict:
 
 
 def excitation_dict(excitation) -> dict:
-    """Type and every field (a SampledRecord's samples included, not its summary)."""
-    return {"type": type(excitation).__name__, **_plain(dataclasses.asdict(excitation))}
+    """The excitation's ``key_fields()``: its class name and every field (a
+    SampledRecord's samples included, not its summary)."""
+    from trilith_xval.analytic.excitation import check_excitation
+    return _plain(check_excitation(excitation).key_fields())
 
 
 def scene_dict(scene) -> dict:

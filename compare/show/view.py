@@ -53,10 +53,12 @@ def _configured_backend() -> str | None:
 def record_hint(scene_name: str, engine: str, excitation) -> str:
     """The ``trilith record`` command that shows the same run in a file (a record
     is named by its file name: its path is the user's own)."""
-    if hasattr(excitation, "amplitude"):
-        what = f"--amplitude {excitation.amplitude:g} --omega {excitation.omega:g}"
+    form = excitation.compiled_form()  # a sine or cosine pulse: the options give it
+    if form is not None:
+        shape = "" if form.kind == "sine" else f"--pulse {form.kind} "
+        what = f"{shape}--amplitude {form.amplitude:g} --omega {form.omega:g}"
     else:
-        what = f"--record {getattr(excitation, 'label', 'FILE')}"
+        what = f"--record {excitation.label}"
     return f"trilith record --scene {scene_name} --engine {engine} {what} --out run.gif"
 
 

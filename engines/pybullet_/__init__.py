@@ -40,7 +40,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from trilith_xval.analytic.options import check_real
-from trilith_xval.analytic.excitation import Still
 from trilith_xval.engines.base import Engine, EngineSettings
 from trilith_xval.engines.diagnostics import PlaneState, Pose
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
@@ -183,9 +182,11 @@ class PyBulletEngine(Engine):
         self.client = c = world.acquire_client(mode)
         world.configure_client(c, scene, s)
         self.moving = s.base_motion == "ground"
+        # An excitation whose window is empty (Still) never loads the bodies.
+        exc = self.excitation
         self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(self.friction),
                                   self.moving, s.friction_anchor, slop=world.effective_slop(s),
-                                  under_load=not isinstance(self.excitation, Still))
+                                  under_load=exc.end_time > exc.start_time)
         self.start_y = {body: pb.getBasePositionAndOrientation(body, physicsClientId=c)[0][1]
                         for body in self.bodies.dynamic}
         if self.moving:

@@ -201,7 +201,7 @@ def test_contract_and_validation(fig5):
             fast.Settings(**bad)
     with pytest.raises(ValueError, match="scene"):
         fast.simulate("fig5", Pulse(1.0, 1.0))
-    with pytest.raises(ValueError, match="excitation"):
+    with pytest.raises(TypeError, match="excitation must be an analytic.excitation.Excitation"):
         fast.simulate(fig5, 3.0)
     with pytest.raises(ValueError, match="settings"):
         fast.simulate(fig5, Pulse(1.0, 1.0), accurate.Settings())
