@@ -125,7 +125,7 @@ class DuckTyped:
         return 0.0
 
 
-@pytest.mark.parametrize("bad", NOT_EXCITATIONS + [DuckTyped()], ids=repr)
+@pytest.mark.parametrize("bad", NOT_EXCITATIONS + [DuckTyped()], ids=lambda b: type(b).__name__ if isinstance(b, DuckTyped) else repr(b))
 def test_one_type_error_everywhere(bad):
     scene = load_scene("fig5")
     message = r"excitation must be an analytic\.excitation\.Excitation \(Pulse, .*Still"
