@@ -15,7 +15,7 @@
    +-7 % of the model's), and at one point with the contact damping doubled.
 
 Records the command, the openseespy version, the CPU seconds of each part
-(``time.process_time``) and the load average.  About 7 CPU minutes.
+(``time.process_time``) and the load average.  About 6.5 CPU minutes (388 s measured).
 """
 from __future__ import annotations
 
