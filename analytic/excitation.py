@@ -21,14 +21,13 @@ from typing import Callable
 
 import numpy as np
 
-from .excitation_contract import (CompiledForm, Excitation, check_excitation,
+from .excitation_contract import (PULSE_KINDS, CompiledForm, Excitation, check_excitation,
                                   check_excitation_contract)
 
 __all__ = ["Pulse", "SampledRecord", "Still", "Excitation", "CompiledForm", "check_excitation",
            "check_excitation_contract", "PULSE_KINDS", "OMEGA_RANGE", "MAX_PULSE_LENGTH",
            "MAX_RECORD_LENGTH", "MAX_RECORD_SAMPLES", "G_STANDARD", "MAX_ACCELERATION"]
 
-PULSE_KINDS = ("sine", "cosine")
 # Pulse frequencies [rad/s]: the upper bound is the former one; the lower bound
 # caps a pulse's length (and so a run's) at 2 pi / 0.1 = 62.8 s.
 OMEGA_RANGE = (0.1, 1e4)

@@ -25,6 +25,9 @@ from typing import Callable, ClassVar, NamedTuple
 
 import numpy as np
 
+# The pulse shapes the compiled kernels integrate (a CompiledForm's kind).
+PULSE_KINDS = ("sine", "cosine")
+
 __all__ = ["Excitation", "CompiledForm", "check_excitation", "check_excitation_contract",
            "EXCITATION_TYPES"]
 
@@ -350,7 +353,6 @@ def _check_compiled(cls, obj, t, a, scale) -> None:
     form = obj.compiled_form()
     if form is None:
         return
-    from .excitation import PULSE_KINDS
     if not isinstance(form, CompiledForm) or form.kind not in PULSE_KINDS:
         _fail(cls, f"compiled_form() must be None or a CompiledForm of kind {PULSE_KINDS}")
     wave = np.cos if form.kind == "cosine" else np.sin
