@@ -15,8 +15,9 @@ IM_TEXT = {"pga": "PGA", "pgv": "PGV", "scale": "scale factor"}
 def plot_fragility(path, doc: dict, st: IDASettings) -> None:
     """The fragility figure of a ``trilith fragility`` result ``doc``: per backend the
     empirical overturning fraction (steps), the lognormal fit (line) and its 90 %
-    band, against the intensity measure of ``st`` (PGA with g on the top axis),
-    written atomically to ``path``."""
+    band, with ``--stripes`` the stripes' overturned fractions (circles) and their
+    fit (dashes), against the intensity measure of ``st`` (PGA with g on the top
+    axis), written atomically to ``path``."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -45,6 +46,15 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
             lo = np.array([np.nan if v is None else v for v in fit["band"]["lower"]])
             hi = np.array([np.nan if v is None else v for v in fit["band"]["upper"]])
             ax.fill_between(grid, lo, hi, color=c, alpha=0.12, lw=0)
+        msa = body.get("msa")
+        if msa:  # the stripes' overturned fractions (dots) and their fit (dashes)
+            xs = np.array(msa["stripes"])
+            ax.plot(xs, np.array(msa["overturned"]) / np.array(msa["n"]), "o", color=c,
+                    ms=4, mfc="none")
+            if msa["median"] is not None:
+                ax.plot(grid, stats.norm.cdf(np.log(grid / msa["median"]) / msa["beta"]),
+                        "--", color=c, lw=1.2, label=f"{b} MSA: median {msa['median']:.3g}, "
+                                                    f"beta {msa['beta']:.2f}")
     ax.set_xscale("log")
     unit = IM_UNITS[st.im]
     ax.set_xlabel(f"{IM_TEXT[st.im]}" + (f" [{unit}]" if unit else ""))
@@ -57,9 +67,10 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
     if ax.get_legend_handles_labels()[1]:  # no fit (fewer than 2 overturns): no line
         ax.legend(fontsize=8, loc="upper left")
     pendulum = "" if doc["scene"].get("gamma", 0.0) > 0.0 else " without pendulum"
+    msa = any(body.get("msa") for body in doc["backends"].values())
     ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records "
-                 "(steps: empirical; lines: lognormal fit, 90 % band)",
-                 fontsize=9)
+                 "(steps: empirical; lines: IDA lognormal fit, 90 % band"
+                 + ("; circles, dashes: MSA stripes and fit)" if msa else ")"), fontsize=9)
     fig.tight_layout()
     savefig(fig, path, dpi=120)
     plt.close(fig)
