@@ -58,9 +58,18 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
     ax.set_xscale("log")
     unit = IM_UNITS[st.im]
     ax.set_xlabel(f"{IM_TEXT[st.im]}" + (f" [{unit}]" if unit else ""))
+    # Plain numbers on the log axes (matplotlib's default writes 2 x 10^0 and
+    # overlaps the minor labels); in g on the top axis at the values engineers use.
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
+    ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
     if st.im == "pga":
         sec = ax.secondary_xaxis("top", functions=(lambda a: a / G_STANDARD,
                                                    lambda g: g * G_STANDARD))
+        sec.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 3.0, 5.0, 7.0)))
+        sec.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        sec.xaxis.set_minor_formatter(NullFormatter())
         sec.set_xlabel("PGA [g]")
     ax.set_ylabel("P(overturn | IM)")
     ax.set_ylim(0.0, 1.0)
@@ -68,9 +77,9 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
         ax.legend(fontsize=8, loc="upper left")
     pendulum = "" if doc["scene"].get("gamma", 0.0) > 0.0 else " without pendulum"
     msa = any(body.get("msa") for body in doc["backends"].values())
-    ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records "
-                 "(steps: empirical; lines: IDA lognormal fit, 90 % band"
-                 + ("; circles, dashes: MSA stripes and fit)" if msa else ")"), fontsize=9)
+    ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records\n"
+                 "steps: empirical; lines: IDA lognormal fit, 90 % band"
+                 + ("; circles, dashes: MSA stripes and fit" if msa else ""), fontsize=8)
     fig.tight_layout()
     savefig(fig, path, dpi=120)
     plt.close(fig)
