@@ -3,7 +3,8 @@ the same data, written here from the likelihoods and maximised by
 ``scipy.optimize`` (Nelder-Mead, a method neither fit uses): the IDA fit
 (lognormal with right censoring, ``compare.measure.fragility.fit_lognormal``)
 and the MSA fit (binomial counts per stripe, ``compare.measure.msa``, Baker
-2015), agreeing to 1e-3 (relative) in the median and beta.  The last test shows
+2015), agreeing to 1e-3 (relative) in the median and beta, on generated data
+and on the model's results for the shipped synthetic suite.  One test shows
 the tolerance is tight enough to catch a plausible mistake."""
 from __future__ import annotations
 
@@ -111,3 +112,26 @@ def test_the_tolerance_catches_a_plausible_mistake():
     m_ref, _ = independent_censored(cens, cut)
     dropped = math.exp(float(np.log(cens[np.isfinite(cens)]).mean()))
     assert abs(dropped / m_ref - 1.0) > 10 * TOL
+
+
+# The model's results on the shipped suite (trilith fragility --records synthetic
+# --no-pendulum --stripes 0.2g,0.3g,0.4g,0.5g,0.6g,0.8g,1g, fragility.json): each
+# motion's first overturning PGA [m/s^2], and the overturns at each stripe.
+SUITE_IDA = [9.745387487932174, 5.820708166324371, 2.560802077516948, 4.6381184430960625,
+             4.719859436922727, 2.970759323818459, 12.123820210630777, 4.033146472257445,
+             2.408910742248223, 5.9232908140354406, 6.0805645141863796, 2.843802251582252]
+SUITE_STRIPES_G = [0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0]
+SUITE_OVERTURNED = [0, 2, 4, 7, 9, 9, 11]
+
+
+def test_the_suites_fits_equal_the_independent_mle():
+    im = np.array(SUITE_IDA)
+    m, b = fit_lognormal(im, censored_at=20.0)
+    m_ref, b_ref = independent_censored(im, 20.0)
+    assert (m, b) == (pytest.approx(m_ref, rel=TOL), pytest.approx(b_ref, rel=TOL))
+    stripes = [9.80665 * s for s in SUITE_STRIPES_G]
+    m, b = fit_stripes(stripes, [12] * 7, SUITE_OVERTURNED)
+    m_ref, b_ref = independent_binomial(stripes, [12] * 7, SUITE_OVERTURNED)
+    assert (m, b) == (pytest.approx(m_ref, rel=TOL), pytest.approx(b_ref, rel=TOL))
+    # The printed fits of docs/earthquakes.md.
+    assert m == pytest.approx(4.81, abs=0.005) and b == pytest.approx(0.490, abs=0.0005)
