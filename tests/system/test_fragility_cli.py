@@ -56,7 +56,12 @@ def test_fragility_writes_consistent_outputs_and_resumes(tmp_path, capsys):
     (["--im-range", "5"], "error: --im-range expects LO:HI"),
     (["--im-range", "1g:x"], "error: --im-range"),
     (["--engine", "bullet"], "error: --engine: unknown engine 'bullet'"),
-    (["--rel-step", "0"], "error: --rel-step must be in")])
+    (["--rel-step", "0"], "error: --rel-step must be in"),
+    (["--stripes", "0,2"], "error: --stripes must be finite and > 0"),
+    (["--stripes=-1g,2g"], "error: --stripes must be finite and > 0"),
+    (["--stripes", "5"], "error: --stripes needs 2 to 100 distinct intensities"),
+    (["--stripes", "2,x"], "error: --stripes"),
+    (["--stripes", "2,nan"], "error: --stripes")])
 def test_bad_input_is_one_line(tmp_path, capsys, extra, message):
     suite = write_suite(tmp_path / "suite", n=1)
     argv = ["fragility", "--records", str(suite), "--out", str(tmp_path / "o"), "--no-cache",
@@ -76,7 +81,7 @@ def test_empty_folder_is_refused(tmp_path, capsys):
 def test_spectrum_record_equals_the_fragility_ida(tmp_path, capsys):
     """``spectrum --record`` is the IDA of one record: the same first overturning
     intensity as ``fragility`` gives that record (same search, same window)."""
-    suite = write_suite(tmp_path / "suite", n=1)
+    suite = write_suite(tmp_path / "suite", n=2)
     cache = tmp_path / "cache"
     assert main(["fragility", "--records", str(suite), "--out", str(tmp_path / "o"),
                  "--cache", str(cache), *ARGS]) == 0
@@ -94,3 +99,36 @@ def test_spectrum_record_refuses_pulse_options(tmp_path, capsys):
     suite = write_suite(tmp_path / "suite", n=1)
     assert main(["spectrum", "--record", str(suite / "r0.csv"), "--tol", "0.1"]) == 2
     assert capsys.readouterr().err.startswith("error: --record searches the record's intensity")
+
+
+def test_one_record_is_refused_at_the_door(tmp_path, capsys):
+    suite = write_suite(tmp_path / "suite", n=1)
+    for records in (str(suite), str(suite / "r0.csv"), "sample"):
+        assert main(["fragility", "--records", records, "--out", str(tmp_path / "o"),
+                     "--no-cache", *ARGS]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: --records: 1 record in") and err.count("\n") == 1
+        assert not (tmp_path / "o").exists()
+
+
+def test_msa_beside_ida_counts_the_ida_verdicts(tmp_path, capsys):
+    """With --stripes on grid points of the IDA (2 x 1.5^k), each record's
+    stripe verdict is the IDA's verdict at that intensity: the same runs."""
+    suite = write_suite(tmp_path / "suite", n=3)
+    out = tmp_path / "out"
+    stripes = [3.0, 6.75, 15.1875, 34.171875]
+    assert main(["fragility", "--records", str(suite), "--out", str(out), "--cache",
+                 str(tmp_path / "cache"), "--stripes", ",".join(map(str, stripes)),
+                 *ARGS]) == 0
+    printed = capsys.readouterr().out
+    doc = json.loads((out / "fragility.json").read_text())
+    body = doc["backends"]["analytic"]
+    msa = body["msa"]
+    assert msa["stripes"] == stripes and msa["n"] == [3] * 4
+    for rec in body["records"]:
+        runs = dict((v, o) for v, o in rec["runs"])
+        assert msa["verdicts"][rec["label"]] == [runs[x] for x in stripes]
+    assert msa["overturned"] == [sum(v[j] for v in msa["verdicts"].values())
+                                 for j in range(4)]
+    assert "  MSA, 4 stripes of 3 runs, overturned " in printed
+    assert set(body["fit"]) >= {"median_ci", "beta_ci", "bootstrap"}

@@ -37,7 +37,7 @@ def test_fragility_never_writes_into_a_users_folder(decoy, here, capsys):
     (["--records", "suite", "--engine", "nosuch"], "--engine"),
 ])
 def test_a_refused_fragility_run_leaves_nothing(extra, needle, here, capsys):
-    write_suite(here / "suite", n=1)
+    write_suite(here / "suite", n=2)
     (here / "bad").mkdir()
     (here / "bad" / "r.csv").write_text("t,a\n0,x\n")
     before = snapshot(here)
@@ -46,7 +46,7 @@ def test_a_refused_fragility_run_leaves_nothing(extra, needle, here, capsys):
 
 
 def test_fragility_output_is_whole_marked_and_lock_free(here, capsys):
-    write_suite(here / "suite", n=1)
+    write_suite(here / "suite", n=2)
     argv = ["fragility", "--records", "suite", "--out", "o", "--no-cache", *ARGS]
     assert main(argv) == 0, capsys.readouterr().err
     names = sorted(p.name for p in here.iterdir())

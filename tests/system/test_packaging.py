@@ -100,6 +100,8 @@ def test_the_wheel_holds_one_import_name_and_the_calibrations(wheel):
     for engine in ("pymunk_", "mujoco_", "dart_", "pybullet_", "drake_"):
         assert f"{NAME}/engines/{engine}/thresholds.toml" in names
     assert f"{NAME}/scenes/data/fig5.toml" in names
+    # The synthetic suite (fragility --records synthetic), all twelve motions.
+    assert sum(n.startswith(f"{NAME}/scenes/records/synthetic/cp-") for n in names) == 12
     assert not any(n.startswith(f"{NAME}/docs") for n in names)
 
 

@@ -16,8 +16,9 @@ import pytest
 from tests.support.paths import ROOT
 README = ROOT / "README.md"
 PREFIX = ".venv/bin/"
-# Lines that run for a minute or more (campaigns, the benchmarks).
-SLOW = ("trilith report", "trilith bench")
+# Lines that run for a minute or more (campaigns, the benchmarks, the fragility
+# of the twelve-motion suite).
+SLOW = ("trilith report", "trilith bench", "trilith fragility")
 
 
 def readme_cli_lines() -> list[str]:
