@@ -14,9 +14,10 @@ from trilith_xval.compare.cli.main import main
 def write_suite(folder):
     folder.mkdir()
     t = np.arange(0.0, 1.5, 0.01)
-    a = np.where(t <= 2 * np.pi / 9.0, np.sin(9.0 * t), 0.0)
-    np.savetxt(folder / "r9.csv", np.column_stack([t, a]), delimiter=",", header="t,a",
-               comments="")
+    for w in (9.0, 11.0):  # two records: a fragility curve needs at least two
+        a = np.where(t <= 2 * np.pi / w, np.sin(w * t), 0.0)
+        np.savetxt(folder / f"r{w:02.0f}.csv", np.column_stack([t, a]), delimiter=",",
+                   header="t,a", comments="")
     return folder
 
 
@@ -47,21 +48,22 @@ def test_records_only_campaign_needs_no_omega(tmp_path):
 
 @pytest.mark.slow
 def test_campaign_rows_equal_the_fragility_results(tmp_path, capsys):
-    """One record, Pymunk: the campaign's row is the fragility's robust bracket
+    """Two records, Pymunk: each campaign row is the fragility's robust bracket
     (the same stored job), and its reference the model's IDA."""
     suite = write_suite(tmp_path / "suite")
     ida = 'im_range = "2:40"\nrel_step = 0.5\nrtol = 0.05\ntail = 1.0'
     cache = str(tmp_path / "cache")
     assert main(["campaign", str(write(tmp_path, f'suite = "{suite}"\n{ida}')), "--out",
                  str(tmp_path / "camp"), "--workers", "1", "--cache", cache]) == 0
-    (row,) = json.loads((tmp_path / "camp" / "campaign.json").read_text())["rows"]
+    rows = json.loads((tmp_path / "camp" / "campaign.json").read_text())["rows"]
     assert main(["fragility", "--records", str(suite), "--engine", "pymunk", "--no-pendulum",
                  "--im-range", "2:40", "--rel-step", "0.5", "--rtol", "0.05", "--tail", "1",
                  "--workers", "1", "--out", str(tmp_path / "frag"), "--cache", cache,
                  "-q"]) == 0
     capsys.readouterr()
     frag = json.loads((tmp_path / "frag" / "fragility.json").read_text())["backends"]
-    (eng,) = frag["pymunk"]["records"]
-    (mod,) = frag["analytic"]["records"]
-    assert row["a_engine"] == eng["im_overturn"] and row["a_reference"] == mod["im_overturn"]
-    assert row["bracketed"] and row["a_reference_safe"] <= row["a_engine"] * 1.02
+    engine, model = frag["pymunk"]["records"], frag["analytic"]["records"]
+    assert len(rows) == len(engine) == len(model) == 2
+    for row, eng, mod in zip(rows, engine, model):  # both in the suite's (file name) order
+        assert row["a_engine"] == eng["im_overturn"] and row["a_reference"] == mod["im_overturn"]
+        assert row["bracketed"] and row["a_reference_safe"] <= row["a_engine"] * 1.02
