@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-__all__ = ["FragilityFit", "fit_lognormal", "empirical_curve", "fragility",
+__all__ = ["FragilityFit", "lognormal_cdf", "fit_lognormal", "empirical_curve", "fragility",
            "agreement", "MAX_MOTIONS", "MAX_BOOT", "MAX_GRID"]
 
 # Sizes beyond which an argument is a mistake, not a suite: a record suite has
@@ -73,6 +73,14 @@ def _intensities(im, name: str = "im", least: int = 1) -> np.ndarray:
     return arr
 
 
+def lognormal_cdf(x, median: float, beta: float) -> np.ndarray:
+    """P(overturn | IM = x) of a lognormal fragility: Phi(ln(x / median) / beta);
+    NaN everywhere when there is no fit (a median or beta that is not finite)."""
+    x = np.asarray(x, dtype=float)
+    if not (math.isfinite(median) and math.isfinite(beta)):
+        return np.full(x.shape, math.nan)
+    return stats.norm.cdf(np.log(x / median) / beta)
+
 @dataclass(frozen=True)
 class FragilityFit:
     """A fragility curve of one backend.
@@ -99,10 +107,7 @@ class FragilityFit:
     seed: int = 0
 
     def cdf(self, x) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        if not (math.isfinite(self.median) and math.isfinite(self.beta)):
-            return np.full(x.shape, math.nan)
-        return stats.norm.cdf(np.log(x / self.median) / self.beta)
+        return lognormal_cdf(x, self.median, self.beta)
 
     def describe(self) -> dict:
         grid, lo, hi = self.band

@@ -152,10 +152,8 @@ class MSAFit:
     seed: int
 
     def cdf(self, x) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        if not (math.isfinite(self.median) and math.isfinite(self.beta)):
-            return np.full(x.shape, math.nan)
-        return stats.norm.cdf(np.log(x / self.median) / self.beta)
+        from trilith_xval.compare.measure.fragility import lognormal_cdf
+        return lognormal_cdf(x, self.median, self.beta)
 
     def describe(self) -> dict:
         fin = lambda v: float(v) if math.isfinite(v) else None  # noqa: E731

@@ -263,13 +263,18 @@ def write_report(result, out_dir, provenance: dict | None = None,
                              max(1, int(result.config.workers or 1)))
     doc.update(plain(extra or {}))
     alphas = {True: result.scene.alpha, False: result.scene.without_pendulum().alpha}
+    return _write_documents(doc, out, result.histories, alphas)
+
+
+def _write_documents(doc: dict, out: Path, histories=None, alphas=None) -> dict[str, Path]:
+    """The report's five files from the summary document ``doc``, each written whole."""
     paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md",
              "trust_csv": out / "trust.csv", "thresholds_csv": out / "thresholds.csv"}
     atomic.write_text(paths["json"], json.dumps(doc, indent=1, allow_nan=False))
     atomic.write_text(paths["md"], render_markdown(doc))
     atomic.write_text(paths["trust_csv"], tables.csv_text(*tables.trust_rows(doc)))
     atomic.write_text(paths["thresholds_csv"], threshold_table.threshold_csv(doc))
-    atomic.write_text(paths["html"], render_html(doc, result.histories, alphas))
+    atomic.write_text(paths["html"], render_html(doc, histories, alphas))
     return paths
 
 
@@ -281,12 +286,4 @@ def write_stored_report(doc: dict, out_dir, source: dict) -> dict[str, Path]:
     and commit: nothing is recomputed."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    doc = {**doc, "rendered_from": dict(source)}
-    paths = {"html": out / "index.html", "json": out / "summary.json", "md": out / "summary.md",
-             "trust_csv": out / "trust.csv", "thresholds_csv": out / "thresholds.csv"}
-    atomic.write_text(paths["json"], json.dumps(doc, indent=1, allow_nan=False))
-    atomic.write_text(paths["md"], render_markdown(doc))
-    atomic.write_text(paths["trust_csv"], tables.csv_text(*tables.trust_rows(doc)))
-    atomic.write_text(paths["thresholds_csv"], threshold_table.threshold_csv(doc))
-    atomic.write_text(paths["html"], render_html(doc))
-    return paths
+    return _write_documents({**doc, "rendered_from": dict(source)}, out)
