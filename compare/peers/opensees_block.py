@@ -56,10 +56,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from trilith_xval.analytic.parameters import G_STANDARD
+
 __all__ = ["ContactSettings", "free_rocking", "one_sine_overturns", "threshold",
            "housner_restitution", "rocking_cycles", "version", "G", "SUBSTEPS"]
 
-G = 9.81  # m/s^2, as analytic.parameters.G_STANDARD
+G = G_STANDARD  # m/s^2: the model's g (analytic.parameters)
 DENSITY = 2500.0  # kg/m^3 (mass drops out of rigid rocking; sets force scales only)
 TOPPLE_ANGLE = 1.5  # rad, analytic.trajectory.DEFAULT_TOPPLE_ANGLE
 
@@ -194,13 +196,19 @@ class _Block:
         for tag, mi in self.masses.items():
             ops.load(tag, 0.0, -mi * G, 0.0)
 
-    def transient(self) -> None:
+    def _solver(self) -> None:
+        """What the static settle and the transient share: constraints, equation
+        numbering, a banded system, Newton on the displacement increment."""
         ops = self.ops
         ops.constraints("Plain")
         ops.numberer("RCM")
         ops.system("BandGeneral")
         ops.test("NormDispIncr", self.cs.tol, 50)
         ops.algorithm("Newton")
+
+    def transient(self) -> None:
+        ops = self.ops
+        self._solver()
         if self.cs.integrator == "HHT":
             ops.integrator("HHT", self.cs.hht_alpha)
         elif self.cs.integrator == "TRBDF2":
@@ -212,11 +220,7 @@ class _Block:
     def settle(self) -> None:
         """Upright block: let it sink onto its contacts (a static step)."""
         ops = self.ops
-        ops.constraints("Plain")
-        ops.numberer("RCM")
-        ops.system("BandGeneral")
-        ops.test("NormDispIncr", self.cs.tol, 50)
-        ops.algorithm("Newton")
+        self._solver()
         ops.integrator("LoadControl", 1.0)
         ops.analysis("Static")
         if ops.analyze(1) != 0:
