@@ -19,6 +19,7 @@ import numpy as np
 
 from trilith_xval.analytic.spectrum import overturning_spectrum
 from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.compare.run.spec import RunSpec
 from trilith_xval.scenes import load_scene
 
 from . import machine, write
@@ -34,7 +35,8 @@ def main(argv: list[str] | None = None) -> int:
     rows, failed = [], False
     for engine in ENGINES:
         load0, t0, c0 = os.getloadavg()[0], time.perf_counter(), time.process_time()
-        out = es.engine_spectrum(engine, scene, ref, workers=2, convergence=False)
+        out = es.engine_spectrum(RunSpec.resolve(engine, scene), ref, workers=2,
+                                 convergence=False)
         wall, parent_cpu = time.perf_counter() - t0, time.process_time() - c0
         cost = out.cost()
         pts = [p for c in out.curves.values() for p in c]

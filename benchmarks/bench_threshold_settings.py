@@ -24,6 +24,7 @@ import numpy as np
 from trilith_xval.analytic.spectrum import overturning_spectrum
 from trilith_xval.compare.campaign.settings_file import threshold_options
 from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.compare.run.spec import RunSpec
 from trilith_xval.compare.run import runs
 from trilith_xval.compare.run.jsonable import plain
 from trilith_xval.engines import configure
@@ -50,7 +51,9 @@ def _engines() -> list[str]:
 def _spectrum(engine: str, scene, ref, options: dict) -> tuple[dict, list, float]:
     load0 = os.getloadavg()[0]
     t0 = time.perf_counter()
-    out = es.engine_spectrum(engine, scene, ref, workers=1, convergence=False, **options)
+    out = es.engine_spectrum(RunSpec.resolve(engine, scene, overrides=options,
+                                             overrides_from="the benchmark"),
+                             ref, workers=1, convergence=False)
     cost = out.cost()
     cost.update(wall_s=time.perf_counter() - t0, load_average=[load0, os.getloadavg()[0]],
                 dt=out.settings["dt"])

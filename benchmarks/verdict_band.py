@@ -24,7 +24,7 @@ from trilith_xval.scenes import load_scene
 
 
 def band(engine: str, scene, omega: float, dt: float, lo: float, hi: float, n: int) -> list:
-    settings = pulse_settings(engine, scene, 2.0 * hi, omega, dt=dt)
+    settings = pulse_settings(engine, scene, 2.0 * hi, omega, options={"dt": dt})
     rows = []
     for a in np.round(np.linspace(lo, hi, n), 6):
         t0 = time.process_time()

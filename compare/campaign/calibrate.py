@@ -213,8 +213,12 @@ def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
 
 
 def _thresholds(engine, scene, reference, options, workers):
+    from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
-    es = engine_spectrum(engine, scene, reference, workers=workers, **options)
+    from trilith_xval.compare.run.spec import RunSpec
+    run = RunSpec.resolve(engine, scene, Still(), overrides=options,
+                          overrides_from="the candidate settings")
+    es = engine_spectrum(run, reference, workers=workers)
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for curve, points in es.curves.items():
         for p in points:

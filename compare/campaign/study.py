@@ -236,12 +236,14 @@ class ThresholdJob:
     @functools.cached_property
     def spec(self):
         """The search's run: calibration (in its domain), the settings file, ``dt``,
-        and friction for the largest pulse of the bisection (2 ``a_ref``)."""
+        and friction for the largest pulse the search may try
+        (:meth:`Search.widest <compare.measure.thresholds.Search.widest>`)."""
         from trilith_xval.analytic.pulses import pulse_of
+        from trilith_xval.compare.measure.engine_spectrum import point_search
         from trilith_xval.compare.run.spec import RunSpec
-        scene = _scene(self.scene, self.case)
-        return RunSpec.resolve(self.engine, scene, pulse_of(self.pulse, 2.0 * self.a_ref,
-                                                            self.omega),
+        widest = point_search(self.rel_tol, self.rel_bracket).widest
+        return RunSpec.resolve(self.engine, _scene(self.scene, self.case),
+                               pulse_of(self.pulse, widest * self.a_ref, self.omega),
                                calibrated=True, file_options=dict(self.options),
                                file_name="file", overrides={"dt": self.dt} if self.dt else None,
                                overrides_from="the study's steps")
@@ -273,19 +275,6 @@ def threshold_jobs(study: Study, references: dict,
     return jobs
 
 
-def job_settings(engine: str, dt: float, scene, a_ref: float, omega: float,
-                 options: tuple = (), pulse: str = "sine"):
-    """A threshold search's settings on ``scene``, as a :class:`ThresholdJob`
-    resolves them: the engine's calibrated threshold settings (in their domain),
-    ``options`` (a settings file's table) over them, at time step ``dt`` (0: the
-    table's step, else the calibrated one), friction for pulses up to 2 ``a_ref``."""
-    from trilith_xval.analytic.pulses import pulse_of
-    from trilith_xval.compare.run.spec import RunSpec
-    return RunSpec.resolve(engine, scene, pulse_of(pulse, 2.0 * a_ref, omega), calibrated=True,
-                           file_options=dict(options), file_name="file",
-                           overrides={"dt": dt} if dt else None).settings
-
-
 def threshold_description(job: ThresholdJob) -> dict:
     """Everything that determines a threshold job's result (its store key)."""
     return job.description()
@@ -298,12 +287,11 @@ def run_threshold(job: ThresholdJob) -> dict:
 
     n, c, p, w, a_ref, mode, e, dt = (job.scene, job.case, job.pulse, job.omega, job.a_ref,
                                       job.mode_ref, job.engine, job.dt)
-    scene, settings = job.spec.scene, job.spec.settings
-    rb, rt = job.rel_bracket, job.rel_tol
+    settings, rb, rt = job.spec.settings, job.rel_bracket, job.rel_tol
 
     def compute():  # the one threshold measurement; causes without the reruns
-        return measure_point(e, scene, w, a_ref, mode, case=c, kind=p, rel_tol=rt,
-                             rel_bracket=rb, convergence=False, settings=settings)
+        return measure_point(job.spec, w, a_ref, mode, case=c, kind=p, rel_tol=rt,
+                             rel_bracket=rb, convergence=False)
     row = {"scene": n, "case": c, "pulse": p, "omega": w, "engine": e, "dt": dt or None,
            "dt_used": settings.dt, "a_reference": a_ref, "mode_reference": mode}
     description = threshold_description(job)

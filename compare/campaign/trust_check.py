@@ -91,15 +91,18 @@ def _spread(rows: list[dict], n: int) -> list[dict]:
     return [ok[int(round(i))] for i in np.linspace(0, len(ok) - 1, n)]
 
 
-def _thresholds(engine, scene, band, options, progress) -> list[dict]:
-    from trilith_xval.compare.measure.engine_spectrum import measure_point
+def _thresholds(run, band, progress) -> list[dict]:
+    """The threshold design of ``band`` measured from ``run`` (the engine's
+    threshold-search :class:`~compare.run.spec.RunSpec` on the scene)."""
+    from trilith_xval.compare.measure.engine_spectrum import measure_point, point_spec
+    scene = run.scene
     jobs = [(case, r) for case, rows in band["curves"].items()
             for r in _spread(rows, N_THRESHOLDS)]
     out = []
     for i, (case, r) in enumerate(jobs):
         sc = scene if case == "pendulum" else scene.without_pendulum()
-        ep = measure_point(engine, sc, r["omega"], r["a_model"], r["mode"], case=case,
-                           **options)
+        ep = measure_point(point_spec(run, sc, r["omega"], r["a_model"]), r["omega"],
+                           r["a_model"], r["mode"], case=case)
         out.append({"case": case, "omega": r["omega"], "a_model": r["a_model"],
                     "a_engine": ep.a_engine if ep.bracketed else None,
                     "rel_error": ep.rel_error if ep.bracketed else None,
@@ -108,7 +111,7 @@ def _thresholds(engine, scene, band, options, progress) -> list[dict]:
                     "cpu_s": ep.cpu_s, "search_cpu_s": ep.point.cpu_s,
                     "cpu_per_sim_s": ep.point.cpu_per_sim_s,
                     "from_store": ep.point.from_store})
-        progress.stage(f"{engine} thresholds", i + 1, len(jobs))
+        progress.stage(f"{run.backend} thresholds", i + 1, len(jobs))
     return out
 
 
@@ -216,14 +219,17 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     doc = {"schema_version": 1, "what": "trust of each engine on one scene",
            "scene": scene.to_dict(), "band": band, "tolerances": dataclasses.asdict(tol),
            "engines": {}, "project": project_version()}
+    from trilith_xval.analytic.excitation import Still
+    from trilith_xval.compare.run.spec import RunSpec
+    runs = {e: RunSpec.resolve(e, scene, Still(), calibrated=True) for e in engines}
     for e in engines:
         choice = threshold_choice(e, scene)
-        settings = configure(e, **choice.options)
+        settings = runs[e].settings
         entry = {"label": get_backend(e).label, "version": get_backend(e).version(),
                  "threshold_dt": settings.dt, "reference_dt": configure(e).dt,
                  "calibrated_inside": choice.inside, "note": choice.note}
         progress.next(f"{e} thresholds", N_THRESHOLDS * len(band["curves"]))
-        entry["thresholds"] = _thresholds(e, scene, band, choice.options, progress)
+        entry["thresholds"] = _thresholds(runs[e], band, progress)
         entry["threshold_verdict"] = _verdict(entry["thresholds"])
         progress.next(f"{e} restitution")
         entry["restitution"] = _restitution(e, scene, tol)

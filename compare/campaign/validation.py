@@ -74,16 +74,17 @@ def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omeg
     """Calibrated settings (with the campaign's ``engine_dt``) and the friction raised
     for the largest pulse of the job (:func:`compare.measure.engine_spectrum.pulse_settings`)."""
     from trilith_xval.compare.measure.engine_spectrum import pulse_settings
-    return pulse_settings(name, scene, a_max, omega, **engine_options(name, config))
+    return pulse_settings(name, scene, a_max, omega, options=engine_options(name, config))
 
 
 def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
     """The one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`)."""
-    from trilith_xval.compare.measure.engine_spectrum import measure_point
-    return measure_point(name, scene, omega, a_ref, mode_ref, case=case,
+    from trilith_xval.compare.measure.engine_spectrum import measure_point, threshold_spec
+    spec = threshold_spec(name, scene, omega, a_ref,
+                          options=engine_options(name, config, thresholds=True, scene=scene))
+    return measure_point(spec, omega, a_ref, mode_ref, case=case,
                          tol=config.tolerances.threshold, rel_tol=config.rel_tol,
-                         convergence=True,
-                         **engine_options(name, config, thresholds=True, scene=scene))
+                         convergence=True)
 
 
 def _job_jump(name, scene, amplitude, w_lo, w_hi, config):

@@ -81,26 +81,19 @@ def _engine_grid(args, omegas, amps, n_engines: int):
 
 
 class _EngineRun:
-    """``(A, Omega) -> Verdict`` of one backend: its calibrated settings with the
-    friction the pulse needs (as every threshold search,
-    :func:`compare.measure.engine_spectrum.pulse_settings`), ``t_max`` fixed with
-    no early stop when given, through the run store."""
+    """``(A, Omega) -> Verdict`` of one engine: its run ``spec`` (a
+    :class:`compare.run.spec.RunSpec`) at each cell's pulse, verdict only, the
+    friction rule evaluated for that pulse, through the run store."""
 
-    def __init__(self, name: str, scene, pulse, t_max: float | None = None,
-                 base: dict | None = None):
-        self.name, self.scene, self.pulse = name, scene, pulse
-        self.options = dict(base or {})  # the --settings table, under --t-max
-        if t_max is not None:
-            self.options.update(t_max=t_max, early_stop=False)
+    def __init__(self, spec, pulse):
+        self.spec = spec.with_options("the map's cells", verdict_only=True)
+        self.pulse = pulse
 
     def __call__(self, amplitude: float, omega: float):
         from trilith_xval.analytic.pulses import pulse_of
-        from trilith_xval.compare.measure.engine_spectrum import pulse_settings
         from trilith_xval.compare.run import runs
-        settings = pulse_settings(self.name, self.scene, amplitude, omega, self.pulse,
-                                  verdict_only=True, **self.options)
-        return runs.simulate(self.name, self.scene, pulse_of(self.pulse, amplitude, omega),
-                             settings).verdict
+        spec = self.spec.at(excitation=pulse_of(self.pulse, amplitude, omega))
+        return runs.simulate(spec.backend, spec.scene, spec.excitation, spec.settings).verdict
 
 
 CSV_COLUMNS = ("backend", "omega", "amplitude", "verdict", "model_valid_at_first_overturning",
@@ -170,15 +163,20 @@ def run(args: argparse.Namespace) -> int:
                                             "~20 ms a cell)")
         raise ValueError(f"--omega x --amplitude gives {omegas.size * amps.size} cells, "
                          f"more than {top}{why}")
+    from trilith_xval.analytic.excitation import Still
+    window = None if args.t_max is None else {"t_max": args.t_max, "early_stop": False}
+    # Each engine's runs, resolved once here (a bad value stops the command before
+    # any run): the cells at its defaults, the threshold searches from its
+    # calibration; the --settings table and --t-max over both.
+    cells = {n: _options.run_spec(n, scene, Still(), loaded, overrides=window) for n in engines}
+    searches = {n: _options.run_spec(n, scene, Still(), loaded, calibrated=True,
+                                     overrides=window) for n in engines}
     maps = [analytic_map(scene, omegas, amps, settings, workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(name, scene, settings.pulse, args.t_max,
-                                           _options.file_options(loaded, name)), scene,
-                                *eng_grid,
+        maps.append(verdict_map(_EngineRun(cells[name], settings.pulse), scene, *eng_grid,
                                 backend=name, pulse=settings.pulse, workers=workers))
     thresholds = {}
     if engines:
-        from trilith_xval.compare.campaign.settings_file import threshold_options
         from trilith_xval.compare.measure.map_thresholds import map_thresholds, model_thresholds
         reference = model_thresholds(scene, eng_grid[0], settings.pulse, workers,
                                      restitution_factor=rf)
@@ -186,9 +184,7 @@ def run(args: argparse.Namespace) -> int:
         for name in engines:  # as spectrum --engine: calibrated threshold step, then the file
             thresholds[name] = map_thresholds(name, scene, eng_grid[0], settings.pulse,
                                               workers=workers, convergence=args.convergence,
-                                              t_max=args.t_max, reference=reference,
-                                              **{**threshold_options(name, scene),
-                                                 **_options.file_options(loaded, name)})
+                                              reference=reference, spec=searches[name])
     from trilith_xval.analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers,
                               restitution_factor=rf)

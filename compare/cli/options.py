@@ -341,6 +341,18 @@ def file_options(loaded, engine: str) -> dict:
     return {} if loaded is None else loaded.options(engine)
 
 
+def run_spec(engine: str, scene, excitation, loaded=None, *, calibrated: bool = False,
+             overrides: dict | None = None):
+    """``engine``'s run, resolved once (:class:`compare.run.spec.RunSpec`): its
+    defaults, its calibration where ``calibrated`` (threshold searches), the
+    ``--settings`` table (``loaded``), then ``overrides`` (the command line)."""
+    from trilith_xval.compare.run.spec import RunSpec
+    return RunSpec.resolve(engine, scene, excitation, calibrated=calibrated,
+                           file_options=file_options(loaded, engine),
+                           file_name="" if loaded is None else str(loaded.path),
+                           overrides=overrides)
+
+
 def settings_line(loaded, engine: str) -> str:
     """One line saying which ``--settings`` values ``engine`` ran with."""
     shown = ", ".join(f"{k} = {v}" for k, v in loaded.options(engine).items())

@@ -10,8 +10,8 @@ from trilith_xval.compare.cli.units import acceleration_text, frequency_text, ve
 from trilith_xval.compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
                                          excitation_from_args)
 from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add_scene_args, add_settings_arg,
-                                 check_output_path, detail, envelope, file_options, info,
-                                 print_json, scene_from_args, settings_from_args, settings_line,
+                                 check_output_path, detail, envelope, info, print_json,
+                                 run_spec, scene_from_args, settings_from_args, settings_line,
                                  sig)
 from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
                                                     restitution_text)
@@ -48,17 +48,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
-def _settings(name: str, criterion: str | None, t_max: float | None, base: dict | None = None,
-              restitution: float = 1.0):
-    """Backend ``name``'s calibrated settings with ``base`` (a ``--settings`` table)
-    and ``--criterion``/``--t-max`` applied (``--t-max`` fixes the run's window: no
-    early stop, in every backend); ``restitution`` (``--restitution-factor``) is
-    the model's, set on the analytic backends only (at 1 their settings stay the
-    defaults)."""
-    from trilith_xval.engines import configure
+def _overrides(name: str, criterion: str | None, t_max: float | None,
+               restitution: float = 1.0) -> dict:
+    """The command line's layer of backend ``name``'s run: ``--criterion``,
+    ``--t-max`` (it fixes the run's window: no early stop, in every backend) and
+    ``--restitution-factor`` (the model's, set on the analytic backends only; at 1
+    their settings stay the defaults)."""
     if t_max is not None and not (math.isfinite(t_max) and 0.0 < t_max <= 1e5):
         raise ValueError(f"--t-max must be a time in (0, 1e5] s, got {t_max!r}")
-    options = dict(base or {})
+    options = {}
     if criterion is not None:  # configure keeps the backend's topple angle
         options["criterion"] = criterion
     if t_max is not None:  # the same fixed window in every backend: no early stop
@@ -67,7 +65,7 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
             options["early_stop"] = False
     if restitution != 1.0 and name.startswith("analytic"):
         options["restitution_factor"] = restitution
-    return configure(name, **options)
+    return options
 
 
 def _describe_excitation(excitation) -> str:
@@ -99,20 +97,23 @@ def run(args: argparse.Namespace) -> int:
                          f"{args.engine} alone runs no model (add --plot to draw the model "
                          f"beside it)")
     loaded = settings_from_args(args, (args.engine,))
-    settings = _settings(args.engine, args.criterion, args.t_max,
-                         file_options(loaded, args.engine), r)
+    # The run, resolved once: defaults, the --settings table, the command line.
+    spec = run_spec(args.engine, scene, excitation, loaded,
+                    overrides=_overrides(args.engine, args.criterion, args.t_max, r))
+    settings = spec.settings
     check_run_budget(args.engine, settings, excitation)
     # An engine's plot shows the model's run beside it (same scene, excitation,
     # criterion and window): what a cross-validation is read from.
     overlay = args.plot is not None and not args.engine.startswith("analytic")
     if overlay:
-        model_settings = _settings("analytic", args.criterion, args.t_max, restitution=r)
+        model_settings = run_spec("analytic", scene, excitation, overrides=_overrides(
+            "analytic", args.criterion, args.t_max, r)).settings
         check_run_budget("analytic", model_settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
     if args.plot is not None:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
-    traj = backend.simulate(scene, excitation, settings)
+    traj = backend.simulate(spec.scene, spec.excitation, settings)
     if args.csv is not None:
         from trilith_xval.compare.run.atomic import atomic_path
         with atomic_path(args.csv) as tmp:

@@ -12,7 +12,7 @@ from trilith_xval.compare.cli import options as _common
 from trilith_xval.compare.cli.fragility import add_ida_args, record_spectrum
 from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg, add_scene_args, add_store_args,
                                  add_workers_arg, check_output_path, parse_engine_list, envelope,
-                                 file_options, info, parse_omega_range, print_json,
+                                 info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
                                  settings_line, use_store)
 from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
@@ -199,12 +199,13 @@ def run(args: argparse.Namespace) -> int:
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
     loaded = settings_from_args(args, engines_wanted)
-    _check_engine_budget(args, engines_wanted, omegas, settings.pulse, loaded)
+    runs = _engine_runs(args, scene, engines_wanted, loaded)
+    _check_engine_budget(args, runs, omegas, settings.pulse)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
                                 map_fn=_map_fn(scene, settings, workers, args.scheduler))
     if engines_wanted:
-        return _run_engines(args, scene, spec, engines_wanted, workers, loaded)
+        return _run_engines(args, scene, spec, runs, workers, loaded)
     from trilith_xval.analytic.threshold_validity import spectrum_validity
     validity = spectrum_validity(spec, workers=workers)
     if args.csv is not None:
@@ -297,37 +298,47 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     return names
 
 
-def _check_engine_budget(args, names, omegas, shape, loaded=None) -> None:
+def _engine_runs(args, scene, names, loaded=None) -> dict:
+    """Each engine's threshold-search run on ``scene``, resolved once before any
+    work (:class:`compare.run.spec.RunSpec`): its calibrated threshold settings
+    where the scene is in their domain, else its reference ones, the ``--settings``
+    table over them, ``--dt``/``--t-max`` over both; one note per engine whose
+    calibration does not hold here."""
+    from trilith_xval.analytic.excitation import Still
+    from trilith_xval.compare.cli.options import run_spec, step_notes
+    options = {} if args.dt is None else {"dt": args.dt}
+    if args.t_max is not None:  # the model's window, fixed, in every engine run
+        options.update(t_max=args.t_max, early_stop=False)
+    if args.dt is None and names:
+        step_notes(names, [scene, scene.without_pendulum()] if scene.has_pendulum else [scene])
+    return {name: run_spec(name, scene, Still(), loaded, calibrated=True, overrides=options)
+            for name in names}
+
+
+def _check_engine_budget(args, runs: dict, omegas, shape) -> None:
     """Refuse before any work an engine run over the run budget: the longest is at
-    the lowest Omega, at the finest step (``--convergence`` reruns at dt/4)."""
+    the lowest Omega, at the finest step a search may take (the step rule goes
+    down to the engine's reference step; ``--convergence`` reruns at dt/4)."""
     import dataclasses
 
     from trilith_xval.analytic.pulses import pulse_of
-    from trilith_xval.engines import configure
+    from trilith_xval.engines.calibration import reference_dt
 
     from trilith_xval.compare.cli.excitation_args import check_run_budget
 
-    for name in names:
-        settings = configure(name, **file_options(loaded, name))
-        dt = args.dt if args.dt is not None else settings.dt
+    for name, run in runs.items():
+        dt = min(run.settings.dt, reference_dt(name))
         finest = dt / 4 if args.convergence else dt
-        if args.dt is not None:
-            option = "--dt"
-        elif "dt" in file_options(loaded, name):
-            option = f"--settings {loaded.path!r}"
-        else:
-            option = f"{name}'s calibrated step"
+        origin = dict(run.origin).get("dt", f"{name}'s reference step")
+        option = "--dt" if origin == "the command line" else origin
         option += " (with --convergence: dt/4)" if args.convergence else ""
-        check_run_budget(name, dataclasses.replace(settings, dt=finest),
+        check_run_budget(name, dataclasses.replace(run.settings, dt=finest),
                          pulse_of(shape, 1.0, float(min(omegas))), option=option)
 
 
-def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
-    """Each engine's spectrum on the model's grid: its calibrated threshold settings
-    where the scene is in their domain, else its reference ones
-    (:func:`compare.campaign.settings_file.threshold_options`), the ``--settings``
-    file's table over them, ``--dt``/``--t-max`` over both."""
-    from trilith_xval.compare.campaign.settings_file import threshold_options
+def _run_engines(args, scene, spec, runs: dict, workers: int, loaded=None) -> int:
+    """Each engine's spectrum on the model's grid ``spec``, from its resolved run
+    (:func:`_engine_runs`)."""
     from pathlib import Path
 
     from trilith_xval.compare.run import atomic
@@ -337,19 +348,12 @@ def _run_engines(args, scene, spec, names, workers: int, loaded=None) -> int:
     import os
     import time
 
-    options = {} if args.dt is None else {"dt": args.dt}
-    if args.dt is None:
-        from trilith_xval.compare.cli.options import step_notes
-        step_notes(names, [scene, scene.without_pendulum()] if scene.has_pendulum else [scene])
-    if args.t_max is not None:  # the model's window, fixed, in every engine run
-        options.update(t_max=args.t_max, early_stop=False)
+    names = tuple(runs)
     results, walls = [], {}
-    for name in names:
+    for name, run in runs.items():
         t0 = time.perf_counter()
-        results.append(es.engine_spectrum(name, scene, spec, kind=spec.settings.pulse,
-                                          workers=workers, convergence=args.convergence,
-                                          **{**threshold_options(name, scene),
-                                             **file_options(loaded, name), **options}))
+        results.append(es.engine_spectrum(run, spec, kind=spec.settings.pulse,
+                                          workers=workers, convergence=args.convergence))
         walls[name] = time.perf_counter() - t0
     if args.csv:
         with atomic.atomic_path(args.csv) as tmp:

@@ -24,16 +24,18 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from trilith_xval.engines import configure
+from trilith_xval.analytic.pulses import pulse_of
 
+from trilith_xval.compare.run.spec import RunSpec
 from trilith_xval.compare.measure.causes import (PRIMARY_ORDER, classify, explain_isolated, model_validity,
                                     sensitivity_detail)
 from trilith_xval.compare.measure.step_rule import passes, rule_out_step
 from trilith_xval.compare.measure.threshold_point import ThresholdPoint
 from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
-__all__ = ["EnginePoint", "EngineSpectrum", "engine_spectrum", "engine_points", "measure_point",
-           "pulse_settings", "CAUSES", "DEFAULT_TOL", "DEFAULT_REL_TOL"]
+__all__ = ["EnginePoint", "EngineSpectrum", "PointJob", "engine_spectrum", "engine_points",
+           "measure_point", "point_search", "point_spec", "threshold_spec", "pulse_settings", "CAUSES", "DEFAULT_TOL",
+           "DEFAULT_REL_TOL"]
 
 CAUSES = ("agrees", *PRIMARY_ORDER, "unknown")
 DEFAULT_TOL = 0.02  # agreement tolerance on the threshold (2 %)
@@ -87,30 +89,59 @@ class EnginePoint:
         return out
 
 
-def pulse_settings(engine: str, scene, a_max: float, omega: float, kind: str = "sine",
-                   **options):
-    """The engine's settings (``options`` applied) with a fixed friction raised to
-    :data:`engines.base.FRICTION_MARGIN` times the no-sliding bound of the largest
-    pulse a bracket may try (a friction of None is the engine's own default for
-    each run, which follows the same rule): :meth:`compare.run.spec.RunSpec.resolve`."""
-    from trilith_xval.analytic.pulses import pulse_of
-    from trilith_xval.compare.run.spec import RunSpec
+def point_search(rel_tol: float = DEFAULT_REL_TOL, rel_bracket: float | None = None):
+    """The search :func:`measure_point` runs: :data:`SEARCH` at ``rel_tol``, its
+    first bracket's half-width ``rel_bracket`` when given."""
+    search = SEARCH.with_rel_tol(rel_tol)
+    return search if rel_bracket is None else dataclasses.replace(search, rel_bracket=rel_bracket)
+
+
+def threshold_spec(engine: str, scene, omega: float, a_reference: float, kind="sine", *,
+                   calibrated: bool = False, options: dict | None = None,
+                   search=SEARCH) -> RunSpec:
+    """The run of a threshold search at one point, resolved once
+    (:meth:`compare.run.spec.RunSpec.resolve`): ``engine`` on ``scene`` under the
+    largest ``kind`` pulse the search may try (``search.widest`` times
+    ``a_reference`` [m/s^2] at ``omega`` [rad/s]), so the friction rule holds for
+    every run of the search; ``calibrated`` starts from the engine's calibrated
+    threshold settings where the scene lies in their domain; ``options`` go over
+    them (the caller's own values)."""
+    return RunSpec.resolve(engine, scene, pulse_of(kind, search.widest * a_reference, omega),
+                           calibrated=calibrated, overrides=options,
+                           overrides_from="the options given")
+
+
+def point_spec(run: RunSpec, scene, omega: float, a_reference: float, kind="sine",
+               search=SEARCH) -> RunSpec:
+    """``run``'s layers at one threshold point: on ``scene`` under the largest
+    pulse the search may try (as :func:`threshold_spec`)."""
+    return run.at(scene, pulse_of(kind, search.widest * a_reference, omega))
+
+
+def pulse_settings(engine: str, scene, a_max: float, omega: float, kind="sine",
+                   options: dict | None = None):
+    """The engine's settings (``options`` applied) for runs under ``kind`` pulses up
+    to ``a_max`` [m/s^2] at ``omega``: a fixed friction is checked (or, set by a
+    calibration, raised) for the largest of them, as in every threshold search
+    (:meth:`compare.run.spec.RunSpec.resolve`)."""
     return RunSpec.resolve(engine, scene, pulse_of(kind, a_max, omega), overrides=options,
                            overrides_from="the options given").settings
 
 
-def measure_point(engine: str, scene, omega: float, a_reference: float,
-                  mode_reference: str | None = None, *, case: str = "", kind: str = "sine",
+def measure_point(spec: RunSpec, omega: float, a_reference: float,
+                  mode_reference: str | None = None, *, case: str = "", kind="sine",
                   tol: float = DEFAULT_TOL, rel_tol: float = DEFAULT_REL_TOL,
-                  rel_bracket: float | None = None, convergence: bool = True, settings=None,
-                  **options) -> EnginePoint:
+                  rel_bracket: float | None = None, convergence: bool = True) -> EnginePoint:
     """The one engine threshold measurement (module docstring).
 
     Parameters
     ----------
-    engine, scene, omega, a_reference, mode_reference
-        The engine, the scene (its pendulum included or not), the frequency
-        [rad/s], the model's threshold [m/s^2] and mode.
+    spec : RunSpec
+        The search's run: engine, scene (its pendulum included or not) and
+        settings, resolved at the largest pulse the search may try
+        (:func:`threshold_spec`, or :meth:`RunSpec.at` of a template).
+    omega, a_reference, mode_reference
+        The frequency [rad/s], the model's threshold [m/s^2] and mode.
     case : str
         'pendulum' or 'no_pendulum', carried into the result.
     kind : str or PulseShape
@@ -126,15 +157,12 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
     convergence : bool
         Rerun a disagreeing point at dt/2, dt/4 and doubled iterations (of the
         finest step the step rule measured).  The step rule itself always runs.
-    settings : EngineSettings, optional
-        Default: :func:`pulse_settings` for pulses up to 2.2 ``a_reference``
-        (the widest bracket) with ``options``.
     """
-    if settings is None:
-        settings = pulse_settings(engine, scene, 2.2 * a_reference, omega, kind, **options)
-    search = SEARCH.with_rel_tol(rel_tol)
-    if rel_bracket is not None:
-        search = dataclasses.replace(search, rel_bracket=rel_bracket)
+    if not isinstance(spec, RunSpec):
+        raise TypeError(f"spec must be a RunSpec (compare.run.spec; threshold_spec makes "
+                        f"one), got {type(spec).__name__}")
+    engine, scene, settings = spec.backend, spec.scene, spec.settings
+    search = point_search(rel_tol, rel_bracket)
     p = engine_threshold(engine, scene, omega, a_reference, settings, kind=kind,
                          mode_reference=mode_reference, search=search)
     isolated = tuple({**i, "detail": explain_isolated(engine, scene, omega, i, settings, kind)}
@@ -171,10 +199,29 @@ def measure_point(engine: str, scene, omega: float, a_reference: float,
                        c.convergence, isolated, check.rows if len(check.rows) > 1 else ())
 
 
-def _point_job(args) -> EnginePoint:
-    engine, scene, case, omega, a_ref, mode_ref, kind, options, tol, rel_tol, convergence = args
-    return measure_point(engine, scene, omega, a_ref, mode_ref, case=case, kind=kind, tol=tol,
-                         rel_tol=rel_tol, convergence=convergence, **options)
+@dataclass(frozen=True)
+class PointJob:
+    """One point of a spectrum or a curve: :func:`measure_point` of ``spec`` (the
+    point's run, resolved at its largest pulse) with these arguments."""
+
+    spec: RunSpec
+    case: str
+    omega: float
+    a_reference: float
+    mode_reference: str | None
+    kind: object = "sine"
+    tol: float = DEFAULT_TOL
+    rel_tol: float = DEFAULT_REL_TOL
+    convergence: bool = False
+
+    def run(self) -> EnginePoint:
+        return measure_point(self.spec, self.omega, self.a_reference, self.mode_reference,
+                             case=self.case, kind=self.kind, tol=self.tol,
+                             rel_tol=self.rel_tol, convergence=self.convergence)
+
+
+def _run_job(job: PointJob) -> EnginePoint:
+    return job.run()
 
 
 @dataclass
@@ -210,21 +257,22 @@ class EngineSpectrum:
                 "curves": {k: [p.to_dict() for p in v] for k, v in self.curves.items()}}
 
 
-def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", workers: int = 1,
+def engine_spectrum(spec: RunSpec, reference, *, kind="sine", workers: int = 1,
                     tol: float = DEFAULT_TOL, rel_tol: float = DEFAULT_REL_TOL,
-                    convergence: bool = False, **options) -> EngineSpectrum:
-    """``engine``'s first-overturning amplitudes on the grid of ``reference``.
+                    convergence: bool = False) -> EngineSpectrum:
+    """An engine's first-overturning amplitudes on the grid of ``reference``.
 
     Parameters
     ----------
-    engine : str
-        A registered engine (``engines.ENGINES``).
-    scene : Scene
-        With its pendulum; the no-pendulum curve uses ``scene.without_pendulum()``.
+    spec : RunSpec
+        The engine's run on the scene (with its pendulum; the no-pendulum curve
+        uses ``scene.without_pendulum()``): its layers are resolved again at
+        every point (:meth:`RunSpec.at`, the point's largest pulse), all before
+        any run, so a bad value stops the command at the door.
     reference : analytic.spectrum.Spectrum
         The analytic spectrum on the wanted grid (gives ``a_reference`` and the
         modes).
-    kind : {'sine', 'cosine'}
+    kind : {'sine', 'cosine'} or PulseShape
     workers : int
         Processes (one frequency each).
     tol : float
@@ -233,48 +281,49 @@ def engine_spectrum(engine: str, scene, reference, *, kind: str = "sine", worker
         Final bracket width relative to the analytic threshold (default 0.5 %).
     convergence : bool
         Rerun failing points at ``dt/2``, ``dt/4`` and doubled iterations.
-    **options
-        Engine settings (:func:`engines.configure`), e.g. ``dt``.
 
     Returns
     -------
     EngineSpectrum
     """
     from trilith_xval.engines import get_backend
-    settings = configure(engine, **options)  # validates the options up front
-    omegas = [float(w) for w in reference.omega]
-    jobs, keys = [], []
+    scene, omegas = spec.scene, [float(w) for w in reference.omega]
     curves = (("pendulum", scene, reference.a_pendulum, reference.mode_pendulum),
               ("no_pendulum", scene.without_pendulum(), reference.a_no_pendulum,
                reference.mode_no_pendulum))
+    jobs = []
     for curve, sc, amps, modes in curves:
         if curve == "pendulum" and not scene.has_pendulum:
             continue
-        for w, a, m in zip(omegas, amps, modes):
-            if not math.isfinite(a):
-                continue
-            jobs.append((engine, sc, curve, w, float(a), m, kind, options, tol, rel_tol,
-                         convergence))
-            keys.append(curve)
-    results = _map(_point_job, jobs, workers, f"spectrum {engine}")
-    out = EngineSpectrum(engine, get_backend(engine).version(), settings.describe(), kind, tol,
-                         rel_tol)
-    for key, point in zip(keys, results):
-        out.curves.setdefault(key, []).append(point)
+        jobs += _jobs(spec, sc, curve, omegas, amps, modes, kind, tol, rel_tol, convergence)
+    results = _map(_run_job, jobs, workers, f"spectrum {spec.backend}")
+    out = EngineSpectrum(spec.backend, get_backend(spec.backend).version(),
+                         spec.settings.describe(), kind, tol, rel_tol)
+    for job, point in zip(jobs, results):
+        out.curves.setdefault(job.case, []).append(point)
     return out
 
 
-def engine_points(engine: str, scene, omegas, a_references, modes, *, case: str = "",
-                  kind: str = "sine", workers: int = 1, tol: float = DEFAULT_TOL,
-                  rel_tol: float = DEFAULT_REL_TOL, convergence: bool = False,
-                  **options) -> list[EnginePoint]:
+def engine_points(spec: RunSpec, omegas, a_references, modes, *, case: str = "",
+                  kind="sine", workers: int = 1, tol: float = DEFAULT_TOL,
+                  rel_tol: float = DEFAULT_REL_TOL, convergence: bool = False
+                  ) -> list[EnginePoint]:
     """:func:`measure_point` at each ``(omega, a_reference, mode)`` of one curve of
-    one scene (``case`` names it), in order, ``workers`` processes (one frequency
-    each); frequencies whose model threshold is not finite are skipped."""
-    configure(engine, **options)  # validates the options up front
-    jobs = [(engine, scene, case, float(w), float(a), m, kind, options, tol, rel_tol,
-             convergence) for w, a, m in zip(omegas, a_references, modes) if math.isfinite(a)]
-    return _map(_point_job, jobs, workers, f"{engine} {case}".strip())
+    ``spec``'s scene (``case`` names it), in order, ``workers`` processes (one
+    frequency each); frequencies whose model threshold is not finite are skipped.
+    Every point's run is resolved before any runs (:func:`engine_spectrum`)."""
+    jobs = _jobs(spec, spec.scene, case, omegas, a_references, modes, kind, tol, rel_tol,
+                 convergence)
+    return _map(_run_job, jobs, workers, f"{spec.backend} {case}".strip())
+
+
+def _jobs(spec, scene, case, omegas, amps, modes, kind, tol, rel_tol, convergence) -> list:
+    """A :class:`PointJob` per finite model threshold, each run resolved at its
+    largest pulse (:meth:`SEARCH.widest <compare.measure.thresholds.Search.widest>`)."""
+    search = point_search(rel_tol)
+    return [PointJob(point_spec(spec, scene, float(w), float(a), kind, search), case,
+                     float(w), float(a), m, kind, tol, rel_tol, convergence)
+            for w, a, m in zip(omegas, amps, modes) if math.isfinite(a)]
 
 
 def _map(fn, items: list, workers: int, desc: str = "points") -> list:

@@ -45,23 +45,28 @@ def model_thresholds(scene, omegas, kind: str = "sine", workers: int = 1,
 
 def map_thresholds(engine: str, scene, omegas, kind: str = "sine", *, workers: int = 1,
                    convergence: bool = False, t_max: float | None = None, reference=None,
-                   **options):
+                   spec=None):
     """The engine's :class:`EnginePoint` at each of ``omegas`` (frequencies where
     the model does not overturn are skipped).
 
     ``reference``: the model's ``[(a_reference, mode)]`` on ``omegas`` when already
     computed (:func:`model_thresholds`).  ``t_max`` fixes every run's window with no
-    early stop, as in the map's cells.  ``options``: engine settings
-    (:func:`engines.configure`) the search runs with.
+    early stop, as in the map's cells.  ``spec``: the engine's run on ``scene``
+    (:class:`compare.run.spec.RunSpec`; default: its defaults), resolved again at
+    each point's largest pulse.
     """
+    from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.measure.engine_spectrum import engine_points
+    from trilith_xval.compare.run.spec import RunSpec
     reference = model_thresholds(scene, omegas, kind, workers) if reference is None else reference
-    if t_max is not None:
-        options = {**options, "t_max": t_max, "early_stop": False}
-    return engine_points(engine, scene, [float(w) for w in omegas],
+    if spec is None:
+        spec = RunSpec.resolve(engine, scene, Still())
+    if t_max is not None:  # the map's window, over every other layer
+        spec = spec.with_options("--t-max", t_max=t_max, early_stop=False)
+    return engine_points(spec, [float(w) for w in omegas],
                          [a for a, _ in reference], [m for _, m in reference],
                          case="pendulum" if scene.has_pendulum else "no_pendulum", kind=kind,
-                         workers=workers, convergence=convergence, **options)
+                         workers=workers, convergence=convergence)
 
 
 def threshold_cost(points) -> dict:

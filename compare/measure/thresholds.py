@@ -119,6 +119,21 @@ class Search:
     robust: bool = True
     max_isolated: int = 6
 
+    @property
+    def widest(self) -> float:
+        """The largest amplitude the search may try, relative to ``A_ref``, rounded
+        up to 0.1: the last widening ``1 + rel_bracket 2^max_expand`` with its
+        robustness neighbour (``x (1 + 2 REL_NEIGHBOUR)``); 2.2 for :data:`SEARCH`
+        (2.15 unrounded).  Every run of a search has the friction this pulse needs
+        (:class:`compare.run.spec.RunSpec`), so its verdicts differ by the
+        amplitude alone.
+
+        >>> SEARCH.widest
+        2.2
+        """
+        reach = (1.0 + self.rel_bracket * 2 ** self.max_expand) * (1.0 + 2.0 * REL_NEIGHBOUR)
+        return math.ceil(10.0 * reach - 1e-9) / 10.0
+
     def with_rel_tol(self, rel_tol: float) -> "Search":
         return dataclasses.replace(self, rel_tol=rel_tol, rel_bracket=0.45 * rel_tol)
 

@@ -8,7 +8,8 @@ import pytest
 from trilith_xval import engines
 from trilith_xval.analytic.excitation import Pulse
 from trilith_xval.compare.cli.main import main
-from trilith_xval.compare.cli.simulate import _settings
+from trilith_xval.compare.cli.options import run_spec
+from trilith_xval.compare.cli.simulate import _overrides
 from trilith_xval.scenes import load_scene
 
 
@@ -18,9 +19,10 @@ def test_simulate_t_max_runs_every_backend_to_the_end(name):
     """The README's Fig. 8 record after its pulse: every backend, model included, runs
     the whole 1.5 s (they used to stop at 0.656 s, 'survived', where PyBullet's pivots
     go on sliding)."""
-    settings = _settings(name, None, 1.5)
+    scene, pulse = load_scene("fig8_lam3_gamma0.1"), Pulse(19.0, 15.0)
+    settings = run_spec(name, scene, pulse, overrides=_overrides(name, None, 1.5)).settings
     assert settings.early_stop is False and settings.t_max == 1.5
-    tr = engines.simulate(name, load_scene("fig8_lam3_gamma0.1"), Pulse(19.0, 15.0), settings)
+    tr = engines.simulate(name, scene, pulse, settings)
     assert tr.t[-1] == pytest.approx(1.5, abs=0.01) or tr.verdict.status != "survived"
 
 

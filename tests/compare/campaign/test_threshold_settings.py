@@ -10,13 +10,22 @@ import pytest
 
 from trilith_xval import engines as engines_pkg
 from trilith_xval.compare.campaign.settings_file import domain_notes, read_settings_file, threshold_options
-from trilith_xval.compare.campaign.study import job_settings
+from trilith_xval.analytic.pulses import pulse_of
+from trilith_xval.compare.run.spec import RunSpec
 from trilith_xval.compare.campaign.validation import CampaignConfig, backend_settings, engine_options
 from trilith_xval.engines import configure
 from trilith_xval.engines.calibration import calibrated, scene_coordinates, threshold_choice
 from trilith_xval.scenes import load_scene
 
 ENGINES = engines_pkg.ENGINES
+
+
+def job_settings(engine, dt, scene, a_ref, omega, options=()):
+    """A threshold search's settings as a study's job resolves them: calibration
+    (in its domain), a settings file's table, then ``dt`` (0: none)."""
+    return RunSpec.resolve(engine, scene, pulse_of("sine", 2.2 * a_ref, omega), calibrated=True,
+                           file_options=dict(options), file_name="file",
+                           overrides={"dt": dt} if dt else None).settings
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -130,7 +139,25 @@ def test_a_threshold_job_is_a_value_resolved_once():
     with pytest.raises(ValueError, match=r"\(from --settings my.toml\)"):
         RunSpec.resolve("pymunk", fig5, pulse_of("sine", 10.0, 12.0),
                         file_options={"iterations": -3}, file_name="my.toml")
-    # The friction rule raises a fixed coefficient below the no-sliding bound.
-    spec = RunSpec.resolve("pymunk", fig5, pulse_of("sine", 60.0, 12.0),
-                           overrides={"friction": 0.05})
-    assert spec.settings.friction > 0.05 and dict(spec.origin)["friction"] == "the friction rule"
+    # A friction the user gives is kept as given, and refused below the
+    # no-sliding bound of the largest pulse (the pivots would slide) ...
+    from trilith_xval.analytic.bounds import required_friction
+    from trilith_xval.compare.run.spec import _friction_rule
+    from trilith_xval.engines.base import FRICTION_MARGIN
+    pulse = pulse_of("sine", 60.0, 12.0)
+    need = required_friction(fig5, pulse)
+    with pytest.raises(ValueError, match=r"friction must be >= .*\(from the command line\)"):
+        RunSpec.resolve("pymunk", fig5, pulse, overrides={"friction": 0.5 * need})
+    spec = RunSpec.resolve("pymunk", fig5, pulse, overrides={"friction": 1.05 * need})
+    assert spec.settings.friction == 1.05 * need
+    assert dict(spec.origin)["friction"] == "the command line"
+    # ... one a calibration fixed is raised to the margin over it.
+    settings, origin = _friction_rule("pymunk", fig5, pulse, configure("pymunk", friction=0.05),
+                                      {"friction": "the calibration of pymunk"})
+    assert settings.friction == pytest.approx(FRICTION_MARGIN * need)
+    assert origin["friction"] == "the friction rule"
+    # The same layers on another excitation resolve by the same rules.
+    assert spec.at(excitation=pulse_of("sine", 1.0, 12.0)).settings.friction == 1.05 * need
+    with pytest.raises(ValueError, match="friction must be >="):
+        spec.at(excitation=pulse_of("sine", 120.0, 12.0))
+    assert spec.with_options("the step rule", dt=5e-5).settings.dt == 5e-5

@@ -12,6 +12,7 @@ from trilith_xval.analytic.excitation import Pulse
 from trilith_xval.analytic.spectrum import SpectrumSettings, overturning_spectrum
 from trilith_xval.compare.measure import causes
 from trilith_xval.compare.measure import engine_spectrum as es
+from trilith_xval.compare.run.spec import RunSpec
 from trilith_xval.compare.campaign.settings_file import threshold_options
 from trilith_xval.compare.cli.main import main
 from trilith_xval.scenes import load_scene
@@ -38,7 +39,7 @@ def test_brackets_are_honest_when_rerun_independently(fig5_ref):
     """The engine overturns at a_engine and survives at a_survives, rerun from scratch
     with the calibrated settings (not through the bisection's own probes)."""
     scene, ref = fig5_ref
-    out = es.engine_spectrum("pymunk", scene, ref, workers=1)
+    out = es.engine_spectrum(RunSpec.resolve("pymunk", scene), ref, workers=1)
     assert set(out.curves) == {"pendulum", "no_pendulum"}
     for curve, points in out.curves.items():
         sc = scene if curve == "pendulum" else scene.without_pendulum()
@@ -211,7 +212,8 @@ def test_same_point_same_cause_with_any_grid(monkeypatch):
     seen = []
     for grid in ([12.0, 23.0, 25.0], [11.0, 12.0, 13.0], [10.0, 12.0, 19.0]):
         ref = overturning_spectrum(bare, np.array(grid), SpectrumSettings())
-        out = es.engine_spectrum("pymunk", bare, ref, workers=1, convergence=True)
+        out = es.engine_spectrum(RunSpec.resolve("pymunk", bare), ref, workers=1,
+                                 convergence=True)
         (p,) = [q for q in out.curves["no_pendulum"] if q.omega == 12.0]
         seen.append((p.cause, tuple(c["name"] for c in p.causes), round(p.rel_error, 6)))
     assert seen[0] == seen[1] == seen[2] and seen[0][0] == "contact", seen

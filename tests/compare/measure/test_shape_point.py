@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from trilith_xval.analytic.first_overturn import SpectrumSettings, first_overturn_amplitude
-from trilith_xval.compare.measure.engine_spectrum import DEFAULT_TOL, measure_point
+from trilith_xval.compare.measure.engine_spectrum import (DEFAULT_TOL, measure_point,
+                                                         threshold_spec)
 from trilith_xval.scenes import load_scene
 
 
@@ -19,7 +20,8 @@ def test_ricker_point_pymunk_agrees_with_the_model():
     scene = load_scene("fig5").without_pendulum()
     a_ref, _, mode, _, _ = first_overturn_amplitude(scene, 11.0,
                                                     SpectrumSettings(pulse="ricker"))
-    p = measure_point("pymunk", scene, 11.0, a_ref, mode, kind="ricker", convergence=False)
+    p = measure_point(threshold_spec("pymunk", scene, 11.0, a_ref, "ricker"), 11.0, a_ref, mode,
+                      kind="ricker", convergence=False)
     assert p.bracketed and p.a_survives < p.a_engine
     assert abs(p.rel_error) <= DEFAULT_TOL, p.cause_detail
     assert p.cause == "agrees"

@@ -9,7 +9,7 @@ import pytest
 
 from trilith_xval.analytic.parameters import Scene
 from trilith_xval.analytic.spectrum import overturning_spectrum
-from trilith_xval.compare.measure.engine_spectrum import measure_point
+from trilith_xval.compare.measure.engine_spectrum import measure_point, threshold_spec
 from trilith_xval.compare.measure.step_rule import finer_steps, passes, rule_out_step
 from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 from trilith_xval.engines import configure
@@ -33,8 +33,8 @@ def test_the_ladder_goes_down_to_the_reference_step():
 
 def test_a_coarse_step_is_named_discretisation_with_the_finer_steps_bracket(reference):
     a_ref, mode = reference
-    point = measure_point("pymunk", SMALL_SLENDER, OMEGA, a_ref, mode, case="pendulum",
-                          dt=5e-4)
+    spec = threshold_spec("pymunk", SMALL_SLENDER, OMEGA, a_ref, options={"dt": 5e-4})
+    point = measure_point(spec, OMEGA, a_ref, mode, case="pendulum")
     # The coarse step alone misses by more than the 2 % tolerance...
     assert not passes(point.point, 0.02)
     # ...and the cause is the step, never the model or a collapse.
