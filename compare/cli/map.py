@@ -171,6 +171,11 @@ def run(args: argparse.Namespace) -> int:
     cells = {n: _options.run_spec(n, scene, Still(), loaded, overrides=window) for n in engines}
     searches = {n: _options.run_spec(n, scene, Still(), loaded, calibrated=True,
                                      overrides=window) for n in engines}
+    if engines:  # a friction given below a cell's bound: refused here, not mid-map
+        from trilith_xval.analytic.pulses import pulse_of
+        for n in engines:
+            for w in eng_grid[0]:
+                cells[n].at(excitation=pulse_of(shape, float(max(eng_grid[1])), float(w)))
     maps = [analytic_map(scene, omegas, amps, settings, workers=workers)]
     for name in engines:
         maps.append(verdict_map(_EngineRun(cells[name], settings.pulse), scene, *eng_grid,

@@ -154,10 +154,10 @@ def _friction_rule(backend, scene, excitation, settings, origin: dict):
     where = origin.get("friction", "")
     if not where.startswith("the calibration of"):  # the user's own value: kept, checked
         if friction < need:
-            raise ValueError(f"friction must be >= {need:.4g}, the no-sliding bound of the "
-                             f"excitation (peak {excitation.acceleration_bound():.4g} m/s^2; "
-                             f"analytic.bounds.required_friction), got {friction!r} "
-                             f"(from {where})")
+            raise ValueError(f"friction must be >= {need:.4g}, the no-sliding bound of scene "
+                             f"{getattr(scene, 'name', '')!s} under a peak ground acceleration "
+                             f"of {excitation.acceleration_bound():.4g} m/s^2 (analytic.bounds."
+                             f"required_friction), got {friction!r} (from {where})")
         return settings, origin
     if friction < FRICTION_MARGIN * need:
         settings = engines.configure(backend, settings, friction=FRICTION_MARGIN * need)

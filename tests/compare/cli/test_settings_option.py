@@ -135,3 +135,29 @@ def test_recordings_run_with_the_file_options():
     assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
     run = backend_settings("pymunk", 2.0, settings.options("pymunk"))
     assert (run.dt, run.t_max, run.early_stop) == (1e-3, 2.0, False)
+
+
+@pytest.mark.parametrize("command", ["simulate", "map"])
+def test_a_friction_given_below_the_no_sliding_bound_is_refused_at_the_door(
+        command, tmp_path, no_work, capsys):
+    """A friction the user gives is the user's: never raised behind their back
+    (compare.run.spec), and refused before any run where a pulse of the command
+    would need more (the pivots would slide: not the mechanism compared)."""
+    path = tmp_path / "slippery.toml"
+    # 0.27: above fig5's static bound (0.23), below what 3 m/s^2 needs (0.31)
+    path.write_text("[pymunk]\nfriction = 0.27\n")
+    assert main(COMMANDS[command] + ["--settings", str(path)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "friction must be >=" in err[0], err
+    assert f"(from --settings {path})" in err[0]
+
+
+def test_a_friction_given_above_the_bound_is_kept_as_given(tmp_path, capsys):
+    from trilith_xval.analytic.bounds import required_friction
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.scenes import load_scene
+    need = required_friction(load_scene("fig5"), Pulse(3.0, 12.0))
+    path = tmp_path / "just.toml"
+    path.write_text(f"[pymunk]\nfriction = {1.05 * need!r}\n")  # below the 1.2x margin
+    doc = _simulate_json(COMMANDS["simulate"] + ["--settings", str(path)], capsys)
+    assert doc["settings"]["friction_used"] == 1.05 * need
