@@ -44,6 +44,11 @@ def add_parser(subparsers) -> None:
                    help="a stored atlas JSON; run nothing, write it with --html/--json. "
                         "Repeated: one atlas of the engines of every file (measured "
                         "separately, on the same scenes, grid and model)")
+    p.add_argument("--consensus", default=None, metavar="E1,E2[,...]|all",
+                   help="also where the model is invalid: each engine's own first-failure "
+                        "amplitude, converged in the step, and the engines' consensus (engine "
+                        "against engine, never the model); with --from, added to the stored "
+                        "atlas (docs/atlas.md)")
     p.add_argument("--time-budget", type=float, default=None, metavar="MIN",
                    help="wall minutes after which no new chunk of engine jobs starts; the "
                         "jobs left are recorded as not run (default: no limit)")
@@ -78,6 +83,11 @@ def run(args: argparse.Namespace) -> int:
     if args.html is not None:
         check_output_path(args.html, "--html", suffixes=(".html",))
     sources = getattr(args, "from")  # "from" is a keyword: the flag's own name as dest
+    consensus = (None if args.consensus is None
+                 else parse_engine_list(args.consensus, "--consensus"))
+    if consensus is not None and len(consensus) < 2:
+        raise ValueError(f"--consensus needs at least two engines to compare, got "
+                         f"{args.consensus!r}")
     if sources is not None:
         if args.html is None and args.json is None:
             raise ValueError("--from reads stored atlases: give --html FILE and/or --json FILE")
@@ -92,6 +102,9 @@ def run(args: argparse.Namespace) -> int:
             doc["command"] = doc["provenance"]["command"] = _join_command(args, sources)
         else:
             doc = docs[0]
+        if consensus is not None:
+            use_store(args)
+            doc = _with_consensus(doc, consensus, resolve_workers(args.workers), args)
         page = _render(doc, args, " ".join(f"--from {p!r}" for p in sources))
         if args.json is not None:
             _write_json(args.json, doc)
@@ -124,6 +137,8 @@ def run(args: argparse.Namespace) -> int:
         from trilith_xval.compare.run.provenance import collect
         doc["provenance"] = collect(args)
         doc["command"] = doc["provenance"]["command"]
+        if consensus is not None:
+            doc = _with_consensus(doc, consensus, workers, args)
         page = _render(doc, args, "the atlas")
         if args.json is not None:
             _write_json(args.json, doc)
@@ -133,6 +148,16 @@ def run(args: argparse.Namespace) -> int:
         info(f"wrote {args.html}")
     _print(doc)
     return 0
+
+
+def _with_consensus(doc: dict, engines, workers: int, args) -> dict:
+    """``doc`` with the engines' consensus at its invalid points, and the command
+    that added it."""
+    from trilith_xval.compare.campaign.atlas_consensus import add_consensus
+    from trilith_xval.compare.run.provenance import collect
+    doc = add_consensus(doc, engines, workers)
+    doc["consensus"]["command"] = collect(args)["command"]
+    return doc
 
 
 def _render(doc: dict, args: argparse.Namespace, where: str) -> str | None:
@@ -163,3 +188,9 @@ def _print(doc: dict) -> None:
           "where not", file=sys.stdout)
     for engine, dt, agree, share, worst, where in trusted_rows(doc):
         print(f"{engine}, {dt}: {agree} ({share}), {worst}; {where}", file=sys.stdout)
+    c = doc.get("consensus")
+    if c:
+        print(f"where the model is invalid ({c['invalid_points']} points; engine against "
+              f"engine, {', '.join(c['engines'])}): {c['gained']} gained an answer of "
+              f"{c['answerable']} the engines can answer; "
+              + ", ".join(f"{k} {v}" for k, v in sorted(c["status"].items())), file=sys.stdout)

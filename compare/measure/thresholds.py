@@ -108,7 +108,10 @@ class Search:
     the tolerance), so a narrow bracket cannot hide an overturn up to 3 % below
     the model.  ``max_expand`` 9: widenings up to 0.45 rel_tol 2^9 (115 % at
     0.5 %).  ``max_isolated`` 6: isolated overturns tolerated before the point
-    is given up as not robustly bracketed.
+    is given up as not robustly bracketed.  ``failure``: the verdicts that end a
+    run as a failure (default an overturn alone; the engines' consensus where
+    the model is invalid also counts a collapse, with ``stop_on_collapse``
+    False, :mod:`compare.measure.consensus`).
     """
 
     rel_tol: float = 5e-3
@@ -118,6 +121,7 @@ class Search:
     stop_on_collapse: bool = True
     robust: bool = True
     max_isolated: int = 6
+    failure: tuple = ("overturned",)
 
     @property
     def widest(self) -> float:
@@ -144,8 +148,9 @@ SEARCH = Search()
 class _Runs:
     """The probes of one search, in order, with the CPU time they cost here."""
 
-    def __init__(self, backend, probe, settings):
+    def __init__(self, backend, probe, settings, failure=("overturned",)):
         self.backend, self.probe = backend, probe  # probe(value, settings) -> Probe
+        self.failure = failure
         self.settings, self._tilted = settings, None
         self.probes: list[Probe] = []
         self.nominal: dict[float, Probe] = {}
@@ -167,12 +172,16 @@ class _Runs:
             self.nominal[p.amplitude] = p
         return p
 
+    def fails(self, p: Probe) -> bool:
+        """The run ended in a failure of the search (an overturn, by default)."""
+        return p.status in self.failure
+
     def over(self, amplitude: float) -> bool:
-        return self.run(amplitude).overturned
+        return self.fails(self.run(amplitude))
 
     def survived(self, amplitude: float) -> bool:
         p = self.nominal.get(amplitude)
-        return p is not None and not p.overturned
+        return p is not None and not self.fails(p)
 
 
 def _isolated(p: Probe, neighbours) -> dict:
@@ -243,7 +252,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
     if not 0.0 < s.rel_tol < 0.5:
         raise ValueError(f"rel_tol must be in (0, 0.5), got {s.rel_tol!r}")
     t0 = time.perf_counter()
-    r = _Runs(backend, probe, settings)
+    r = _Runs(backend, probe, settings, s.failure)
     ok, lo, hi = _first_bracket(r, a_ref, s)
     isolated: list[dict] = []
     while ok:
@@ -252,8 +261,8 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
                 # Every run between the last isolated overturn and hi overturned: that
                 # overturn was the threshold after all, its perturbed twin flipped (kept
                 # in ``isolated``, the point is sensitive); back to the last survivor.
-                lo = max(a for a, p in r.nominal.items() if not p.overturned and a < hi)
-                hi = min(a for a, p in r.nominal.items() if p.overturned and a > lo)
+                lo = max(a for a, p in r.nominal.items() if not r.fails(p) and a < hi)
+                hi = min(a for a, p in r.nominal.items() if r.fails(p) and a > lo)
                 break
             mid = 0.5 * (lo + hi)
             if r.over(mid):
@@ -264,7 +273,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
             if s.robust:
                 checks = [r.run(hi * (1.0 + REL_NEIGHBOUR), "above"),
                           r.run(hi * (1.0 + 2.0 * REL_NEIGHBOUR), "tilt")]
-                if not all(c.overturned for c in checks):
+                if not all(r.fails(c) for c in checks):
                     isolated.append(_isolated(r.nominal[hi], checks))
                     ok, lo, hi = _past_isolated(r, hi, a_ref, s,
                                                 [i["amplitude"] for i in isolated])
@@ -275,7 +284,7 @@ def engine_threshold(backend: str, scene, omega: float, a_reference: float, sett
         nominal = r.nominal[lo]
         for c in (r.run(lo * (1.0 - REL_NEIGHBOUR), "below"),
                   r.run(lo * (1.0 - 2.0 * REL_NEIGHBOUR), "tilt")):
-            if c.overturned:  # a perturbation flipped a survivor: isolated, not the threshold
+            if r.fails(c):  # a perturbation flipped a survivor: isolated, not the threshold
                 isolated.append(_isolated(c, [nominal]))
     a_eng, a_surv = (hi, lo) if ok else (math.nan, math.nan)
     mode = r.nominal[hi].mode if ok else None
@@ -324,7 +333,7 @@ def _past_isolated(r: _Runs, a_iso: float, a_ref: float, s: Search,
     """A new bracket above the isolated overturn ``a_iso``: up to the lowest nominal
     overturn above it not yet isolated, else widening upwards (doubling)."""
     above = sorted(a for a, p in r.nominal.items()
-                   if p.overturned and a > a_iso and a not in isolated)
+                   if r.fails(p) and a > a_iso and a not in isolated)
     lo = a_iso
     if above:
         return True, lo, above[0]

@@ -7,7 +7,8 @@ its calibrated threshold step, on a diverging map centred on 0 (blue: the engine
 overturns below the model), clipped at 3x the tolerance, with the tolerance
 marked on the colour bar; a letter names the primary cause where the engine
 disagrees; grey cells are points where the model itself is invalid (no engine
-run there).  A number in an agreeing cell is the coarsest step factor that still
+compared with it; in the consensus colour where the engines answered each other,
+:mod:`compare.report.atlas_consensus_page`).  A number in an agreeing cell is the coarsest step factor that still
 agrees.
 """
 from __future__ import annotations
@@ -18,6 +19,11 @@ import io
 import math
 from pathlib import Path
 
+from trilith_xval.compare.report.atlas_consensus_page import (CONSENSUS_COLOUR,
+                                                               CONSENSUS_LEGEND,
+                                                               CONSENSUS_SYMBOLS,
+                                                               consensus_html,
+                                                               consensus_symbol)
 from trilith_xval.compare.report.cells import unbroken
 from trilith_xval.compare.report.trust import label
 
@@ -173,6 +179,7 @@ def _grid(doc: dict, engine: str, case: str):
         i, j = labels.index(f"{pt['scene']} ({pt['pulse']})"), omegas.index(pt["omega"])
         if pt["valid"] is False:
             invalid[i, j] = True
+            text[i][j] = consensus_symbol(pt, engine)
             continue
         rows = pt["engines"].get(engine, [])
         if pt["a_reference"] is None:
@@ -198,7 +205,7 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.colors import ListedColormap, TwoSlopeNorm
     from matplotlib.ticker import PercentFormatter
 
     tol = _tol(doc)
@@ -218,6 +225,11 @@ def heat_map_png(doc: dict, engine: str) -> bytes:
                           norm=TwoSlopeNorm(0.0, -lim, lim), interpolation="nearest")
         grey = np.ma.masked_where(~invalid, np.ones_like(err))
         ax.imshow(grey, cmap="Greys", vmin=0, vmax=3, aspect="auto", interpolation="nearest")
+        # Engine against engine, never against the model: its own colour.
+        answered = invalid & np.array([[t in CONSENSUS_SYMBOLS for t in row] for row in text])
+        ax.imshow(np.ma.masked_where(~answered, np.ones_like(err)),
+                  cmap=ListedColormap([CONSENSUS_COLOUR]), aspect="auto",
+                  interpolation="nearest")
         for i in range(len(labels)):
             for j in range(len(omegas)):
                 if text[i][j]:
@@ -282,7 +294,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              + (f" Not run ({budget_text(doc)} reached): {html.escape(skipped)}."
                 if skipped else "") + "</p>"]
     legend = ("Colour: threshold error at the calibrated step (black lines on the bar: the "
-              "tolerance); grey: the model is invalid (no engine run); a digit: the coarsest "
+              "tolerance); grey: the model is invalid (no engine compared with it); "
+              + (CONSENSUS_LEGEND if doc.get("consensus") else "") + "a digit: the coarsest "
               "step factor that still agrees; a letter: the cause of a disagreement ("
               + ", ".join(f"{s} {c}" for c, s in CAUSE_SYMBOL.items())
               + "); a dot: the model does not overturn in its search range; a dash: not "
@@ -295,6 +308,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
                      f"style='min-width:600px' alt='atlas heat map {html.escape(engine)}' "
                      f"src='data:image/png;base64,{png}'></div>"
                      f"<p class='small'>{html.escape(legend)}</p>")
+    if doc.get("consensus"):
+        parts.append(consensus_html(doc, sub))
     parts += [f"<{sub}>Trusted region per engine and step</{sub}>",
               _table(TRUSTED_HEAD, trusted_rows(doc)),
               f"<{sub}>Cost per engine and step</{sub}>", _table(COST_HEAD, cost_rows(doc)),
