@@ -15,7 +15,9 @@ step is first remeasured at finer steps down to the reference
 atlas's own, served by the run store.
 
 Nothing is simulated that a verdict does not need: a point where the model is
-invalid is recorded as such and no engine runs there (no engine is to blame);
+invalid is recorded as such and no engine is compared with the model there (no
+engine is to blame; the engines' consensus there is a pass of its own,
+:mod:`compare.campaign.atlas_consensus`);
 identical tricks (the no-pendulum frames of the Fig. 8 scenes differ only in the
 pendulum) are one job (the store key leaves the scene's name out); a coarser
 step runs only where the finer one agreed.  Every job goes through the run

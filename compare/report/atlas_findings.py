@@ -86,6 +86,7 @@ def render_atlas(doc: dict) -> str:
                      + (where if row["measured"] else "not run") + " | "
                      + ("-" if per_job is None else f"{per_job:.3g}") + " | "
                      + ("-" if per_sim is None else f"{per_sim:.3g}") + " |")
+    lines += consensus_lines(doc)
     not_run = doc.get("engines_not_run") or []
     lines += ["", "Measured in parts, joined by `trilith atlas --from ... --json "
               "docs/validation/atlas.json`:" if len(parts_of(doc)) > 1 else "Measured by:"]
@@ -93,6 +94,36 @@ def render_atlas(doc: dict) -> str:
     if not_run:
         lines.append(f"- Not in the atlas: {', '.join(label(e) for e in not_run)}.")
     return "\n".join(lines)
+
+
+def consensus_lines(doc: dict) -> list[str]:
+    """Where the model is invalid: how many points gained an engine-against-engine
+    answer (``trilith atlas --consensus``), with the outliers by engine and cause."""
+    c = doc.get("consensus")
+    if not c:
+        return []
+    outliers = Counter((o["engine"], o["cause"]) for pt in doc["points"]
+                       for o in (pt.get("consensus") or {}).get("outliers", []))
+    no_answer = Counter((n["engine"], n["cause"]) for pt in doc["points"]
+                        for n in (pt.get("consensus") or {}).get("no_answer", []))
+    status = ", ".join(f"{k} {v}" for k, v in sorted(c["status"].items()))
+
+    def listed(counter):
+        return ", ".join(f"{label(e)} {cause} {n}" for (e, cause), n in sorted(counter.items())) \
+            or "none"
+    return ["", f"Where the model is invalid (engine against engine, never the model; "
+                f"{', '.join(label(e) for e in c['engines'])}): **{c['gained']} of the "
+                f"{c['invalid_points']} invalid points gained an answer** ({status}); "
+                f"{c['invalid_points'] - c['answerable']} are left without one (the bob meets "
+                "a column, and the engines' bob collides with nothing). Each engine's own "
+                "first failure (overturn or collapse), converged in the step (two steps "
+                "within 1 %); outliers beyond 2 % of the engines' median by cause: "
+                f"{listed(outliers)}; no converged answer: {listed(no_answer)}. Cost "
+                f"{c['cpu_s']:.0f} CPU s in the engine jobs ("
+                + ("-" if c.get("cpu_s_per_engine_point") is None
+                   else f"{c['cpu_s_per_engine_point']:.2g}")
+                + f" per engine and point), load average {c['load_average'][0]:.1f} -> "
+                f"{c['load_average'][1]:.1f}: `{c.get('command', '')}`."]
 
 
 def main(argv: list[str] | None = None) -> int:
