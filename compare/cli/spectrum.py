@@ -14,7 +14,9 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  add_workers_arg, check_output_path, parse_engine_list, envelope,
                                  info, parse_omega_range, print_json,
                                  resolve_workers, scene_from_args, settings_from_args,
-                                 settings_line, use_store)
+                                 use_store)
+from trilith_xval.compare.cli.spectrum_engines import (check_engine_budget, engine_runs,
+                                                       run_engines)
 from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
                                                     restitution_text)
 from trilith_xval.compare.report.spectrum_plot import plot_spectrum
@@ -60,6 +62,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
                              "solver iterations to classify the cause")
+    parser.add_argument("--consensus", action="store_true",
+                        help="where the model cannot judge an engine point (cause 'model'), "
+                             "the engines against each other: each one's own first failure, "
+                             "converged in the step, their median and outliers (two engines "
+                             "or more; docs/atlas.md)")
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
@@ -199,13 +206,16 @@ def run(args: argparse.Namespace) -> int:
     progress = (not args.json) and sys.stdout.isatty() and _common.VERBOSITY >= 0
     engines_wanted = _engines(args)
     loaded = settings_from_args(args, engines_wanted)
-    runs = _engine_runs(args, scene, engines_wanted, loaded)
-    _check_engine_budget(args, runs, omegas, settings.pulse)
+    if args.consensus and len(engines_wanted) < 2:
+        raise ValueError(f"--consensus compares engines with each other: give --engine with "
+                         f"two or more, got {', '.join(engines_wanted) or 'none'}")
+    runs = engine_runs(args, scene, engines_wanted, loaded)
+    check_engine_budget(args, runs, omegas, settings.pulse)
     use_store(args)
     spec = overturning_spectrum(scene, omegas, settings, progress=progress,
                                 map_fn=_map_fn(scene, settings, workers, args.scheduler))
     if engines_wanted:
-        return _run_engines(args, scene, spec, runs, workers, loaded)
+        return run_engines(args, scene, spec, runs, workers, loaded)
     from trilith_xval.analytic.threshold_validity import spectrum_validity
     validity = spectrum_validity(spec, workers=workers)
     if args.csv is not None:
@@ -296,105 +306,3 @@ def _engines(args: argparse.Namespace) -> tuple[str, ...]:
     if args.dt is not None and not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_ENGINE_DT):
         raise ValueError(f"--dt must be in (0, {MAX_ENGINE_DT:g}] s, got {args.dt!r}")
     return names
-
-
-def _engine_runs(args, scene, names, loaded=None) -> dict:
-    """Each engine's threshold-search run on ``scene``, resolved once before any
-    work (:class:`compare.run.spec.RunSpec`): its calibrated threshold settings
-    where the scene is in their domain, else its reference ones, the ``--settings``
-    table over them, ``--dt``/``--t-max`` over both; one note per engine whose
-    calibration does not hold here."""
-    from trilith_xval.analytic.excitation import Still
-    from trilith_xval.compare.cli.options import run_spec, step_notes
-    options = {} if args.dt is None else {"dt": args.dt}
-    if args.t_max is not None:  # the model's window, fixed, in every engine run
-        options.update(t_max=args.t_max, early_stop=False)
-    if args.dt is None and names:
-        step_notes(names, [scene, scene.without_pendulum()] if scene.has_pendulum else [scene])
-    return {name: run_spec(name, scene, Still(), loaded, calibrated=True, overrides=options)
-            for name in names}
-
-
-def _check_engine_budget(args, runs: dict, omegas, shape) -> None:
-    """Refuse before any work an engine run over the run budget: the longest is at
-    the lowest Omega, at the finest step a search may take (the step rule goes
-    down to the engine's reference step; ``--convergence`` reruns at dt/4)."""
-    import dataclasses
-
-    from trilith_xval.analytic.pulses import pulse_of
-    from trilith_xval.engines.calibration import reference_dt
-
-    from trilith_xval.compare.cli.excitation_args import check_run_budget
-
-    for name, run in runs.items():
-        dt = min(run.settings.dt, reference_dt(name))
-        finest = dt / 4 if args.convergence else dt
-        origin = dict(run.origin).get("dt", f"{name}'s reference step")
-        option = "--dt" if origin == "the command line" else origin
-        option += " (with --convergence: dt/4)" if args.convergence else ""
-        check_run_budget(name, dataclasses.replace(run.settings, dt=finest),
-                         pulse_of(shape, 1.0, float(min(omegas))), option=option)
-
-
-def _run_engines(args, scene, spec, runs: dict, workers: int, loaded=None) -> int:
-    """Each engine's spectrum on the model's grid ``spec``, from its resolved run
-    (:func:`_engine_runs`)."""
-    from pathlib import Path
-
-    from trilith_xval.compare.run import atomic
-    from trilith_xval.compare.measure import engine_spectrum as es
-    from trilith_xval.compare.measure import engine_spectrum_files as files
-
-    import os
-    import time
-
-    names = tuple(runs)
-    results, walls = [], {}
-    for name, run in runs.items():
-        t0 = time.perf_counter()
-        results.append(es.engine_spectrum(run, spec, kind=spec.settings.pulse,
-                                          workers=workers, convergence=args.convergence))
-        walls[name] = time.perf_counter() - t0
-    if args.csv:
-        with atomic.atomic_path(args.csv) as tmp:
-            files.write_csv(results, tmp)
-    if args.plot:
-        with atomic.atomic_path(args.plot, Path(args.plot).suffix) as tmp:
-            files.plot(spec, results, tmp)
-    if args.json:
-        from trilith_xval.analytic.fast_settings import version
-        analytic = spec.to_dict()
-        timings = {"wall_time": analytic.pop("wall_time"), "engine_wall_time": walls,
-                   "engine_cpu_s": {r.engine: r.cost() for r in results},
-                   "load_average": list(os.getloadavg()), "workers": workers}
-        inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": spec.settings.pulse,
-                  "criterion": args.criterion, "t_max": args.t_max, "tol": args.tol,
-                  "scan_step": args.scan_step, "engine": list(names), "dt": args.dt,
-                  "convergence": args.convergence,
-                  "settings_file": None if loaded is None else loaded.describe()}
-        if spec.settings.fast.restitution_factor != 1.0:  # the engines' target: the scaled model
-            inputs["restitution_factor"] = spec.settings.fast.restitution_factor
-        body = {"engine": list(names),
-                "engine_version": {"analytic": version(), **{r.engine: r.version for r in results}},
-                "analytic": analytic, "engines": {r.engine: r.to_dict() for r in results}}
-        print_json(envelope("spectrum", inputs, body, timings))
-        return 0
-    rf = spec.settings.fast.restitution_factor
-    if rf != 1.0:  # the engines' target is the scaled model, not the exact impact
-        print(f"A_model: the model with {restitution_text(rf, scene.has_pendulum)}")
-    for r in results:
-        cost = r.cost()
-        if loaded is not None:
-            print(settings_line(loaded, r.engine))
-        print(f"{r.engine} ({r.version}), dt = {r.settings['dt']:g} s, robust bracket "
-              f"{100 * r.rel_tol:g} % of A, tolerance {100 * r.tol:g} %; {cost['runs']} runs, "
-              f"{cost['cpu_s']:.1f} CPU s when computed ({cost['cpu_s_spent']:.1f} spent now, "
-              f"{cost['points_from_store']} of {cost['points']} points from the run store)")
-        print(f"{'curve':>11} {'Omega':>6} {'A_model':>8} {'A_engine':>8} {'error':>7}  cause")
-        for curve, points in r.curves.items():
-            for p in points:
-                iso = f" [{len(p.isolated)} isolated]" if p.isolated else ""
-                print(f"{curve:>11} {p.omega:6.3g} {p.a_reference:8.3f} {p.a_engine:8.3f} "
-                      f"{100 * p.rel_error:+6.2f}%  {p.cause}{iso}"
-                      + ("" if p.cause == "agrees" else f": {p.cause_detail}"))
-    return 0

@@ -41,7 +41,7 @@ import statistics
 from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
 __all__ = ["STEP_AGREE", "OUTLIER_TOL", "MAX_HALVINGS", "FAILURE_SEARCH", "own_threshold",
-           "consensus", "outlier_cause"]
+           "consensus", "outlier_cause", "consensus_at", "where_model_cannot_judge"]
 
 # Two steps agree when their failing amplitudes differ by at most 1 %: half the
 # 2 % tolerance the engines are held to against the model, so a converged answer
@@ -199,3 +199,35 @@ def outlier_cause(spec, omega: float, own: dict, failure: str, kind="sine") -> s
     ratios = {k: (tr.diagnostics.get(k) or 0.0) / _NOISE[k] for k in _CAUSE_OF}
     key = max(ratios, key=ratios.get)
     return _CAUSE_OF[key] if ratios[key] > 1.0 else "contact model"
+
+
+def consensus_at(runs: dict, scene, omega: float, a_guess: float, kind="sine", *,
+                 rel_tol: float = SEARCH.rel_tol) -> dict:
+    """The engines' consensus at one point of ``scene`` (module docstring).
+
+    ``runs``: engine -> its threshold-search :class:`~compare.run.spec.RunSpec`
+    (a template: resolved here at the point's largest pulse); ``a_guess`` the
+    model's number there [m/s^2].  Returns :func:`consensus`'s dict with
+    ``omega``, ``a_model`` and ``own`` (each engine's :func:`own_threshold`)."""
+    from trilith_xval.compare.measure.engine_spectrum import point_spec
+    search = FAILURE_SEARCH.with_rel_tol(rel_tol)
+    specs = {e: point_spec(r, scene, omega, a_guess, kind, search) for e, r in runs.items()}
+    owns = {e: own_threshold(s, omega, a_guess, kind, rel_tol=rel_tol)
+            for e, s in specs.items()}
+    first = consensus(owns)
+    causes = {o["engine"]: outlier_cause(specs[o["engine"]], omega, owns[o["engine"]],
+                                         first["failure"], kind) for o in first["outliers"]}
+    return {"omega": omega, "a_model": a_guess, **consensus(owns, causes), "own": owns}
+
+
+def where_model_cannot_judge(spectra) -> list[tuple[str, float, float]]:
+    """``(curve, omega, a_model)`` of every point of engine spectra
+    (:class:`~compare.measure.engine_spectrum.EngineSpectrum`) where some engine's
+    point found the model invalid (cause ``model``), once each, in order."""
+    seen: dict = {}
+    for spectrum in spectra:
+        for curve, points in spectrum.curves.items():
+            for p in points:
+                if p.cause == "model":
+                    seen.setdefault((curve, float(p.omega)), float(p.a_reference))
+    return [(c, w, a) for (c, w), a in seen.items()]

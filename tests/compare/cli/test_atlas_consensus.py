@@ -59,3 +59,26 @@ def test_a_consensus_of_fewer_than_two_engines_is_refused(value, message, small_
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and message in err[0] and "--consensus" in err[0]
     assert not (tmp_path / "o.json").exists()
+
+
+def test_spectrum_consensus_needs_two_engines(no_work, capsys):
+    assert main(["spectrum", "--engine", "pymunk", "--omega", "24", "--consensus"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "--consensus" in err[0] and "two or more" in err[0]
+
+
+@pytest.mark.slow
+def test_spectrum_consensus_where_the_model_cannot_judge(capsys):
+    """Fig. 5 at Omega 24: the model's lintel would be thrown off (cause 'model' for
+    both engines); the engines' own failures agree with each other, apart from
+    the model's comparison in the document."""
+    assert main(["spectrum", "--engine", "pymunk,mujoco", "--omega", "24", "--consensus",
+                 "--json", "--workers", "1"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    found = doc["consensus"]
+    assert {c["curve"] for c in found} == {"pendulum", "no_pendulum"}
+    for c in found:
+        assert c["status"] == "consensus" and set(c["own"]) == {"pymunk", "mujoco"}
+        assert all(abs(v["deviation"]) <= 0.02 for v in c["engines"].values())
+    for name in ("pymunk", "mujoco"):  # the model's comparison is unchanged beside it
+        assert {p["cause"] for p in doc["engines"][name]["curves"]["pendulum"]} == {"model"}
