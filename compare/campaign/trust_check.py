@@ -18,7 +18,11 @@ minutes, for any scene:
    around the model's threshold (0.9x and 1.1x) at the middle frequency
    (:func:`compare.measure.trajectories.compare_trajectories`);
 5. **a ground motion** (optional): the first overturning intensity of each
-   record, model against engine (:mod:`compare.measure.record_threshold`).
+   record, model against engine (:mod:`compare.measure.record_threshold`);
+6. **where the model is invalid** (two engines or more): at :data:`N_CONSENSUS`
+   frequencies per curve spread over the invalid band (not where the bob meets
+   a column: the engines' bob collides with nothing), the engines against each
+   other (:func:`compare.measure.consensus.consensus_at`), never the model.
 
 Each engine gets a verdict per use (trusted, trusted at a finer step, or not,
 with the measured cause) and its cost in CPU seconds per threshold point and per
@@ -40,6 +44,7 @@ __all__ = ["trust_scene", "GRID_OVER_P", "N_THRESHOLDS", "HISTORY_FACTORS"]
 # Omega / p of the model's grid: Fig. 5's 3-30 rad/s is 1.4-14 p.
 GRID_OVER_P = tuple(float(x) for x in np.linspace(1.5, 13.5, 25))
 N_THRESHOLDS = 6  # per curve: the issue's "about 6 across the valid band"
+N_CONSENSUS = 3  # per curve, where the model is invalid: the engines against each other
 HISTORY_FACTORS = (0.9, 1.1)  # x the model's threshold: one survives, one overturns
 
 
@@ -213,7 +218,8 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     from trilith_xval.compare.run.keys import project_version
     tol = Tolerances()
     t0, c0, load0 = time.perf_counter(), _cpu(), os.getloadavg()[0]
-    progress = _Progress(1 + 3 * len(engines) + (len(engines) if records else 0), quiet)
+    progress = _Progress(1 + 3 * len(engines) + (len(engines) if records else 0)
+                         + (len(engines) >= 2), quiet)
     progress.next("model: spectrum and validity")
     band = _band(scene, workers)
     doc = {"schema_version": 1, "what": "trust of each engine on one scene",
@@ -240,9 +246,34 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
             entry["records"] = _records(e, scene, records, choice.options)
         entry["cost"] = _cost(entry)
         doc["engines"][e] = entry
+    if len(engines) >= 2:
+        doc["consensus"] = _consensus(runs, scene, band, progress)
     doc["cost"] = {"wall_s": time.perf_counter() - t0, "cpu_s": _cpu() - c0,
                    "load_average": [load0, os.getloadavg()[0]]}
     return doc
+
+
+def _invalid(rows: list[dict], n: int) -> list[dict]:
+    """``n`` rows spread over the invalid ones the engines can answer."""
+    from trilith_xval.compare.campaign.atlas_consensus import BOB_MEETS
+    bad = [r for r in rows if r["valid"] is False and r["a_model"] is not None
+           and BOB_MEETS not in (r["reason"] or "")]
+    if len(bad) <= n:
+        return bad
+    return [bad[int(round(i))] for i in np.linspace(0, len(bad) - 1, n)]
+
+
+def _consensus(runs: dict, scene, band: dict, progress) -> list[dict]:
+    from trilith_xval.compare.measure.consensus import consensus_at
+    jobs = [(case, r) for case, rows in band["curves"].items()
+            for r in _invalid(rows, N_CONSENSUS)]
+    progress.next("consensus where the model is invalid", len(jobs))
+    out = []
+    for i, (case, r) in enumerate(jobs):
+        sc = scene if case == "pendulum" else scene.without_pendulum()
+        out.append({"case": case, **consensus_at(runs, sc, r["omega"], r["a_model"])})
+        progress.stage("consensus where the model is invalid", i + 1, len(jobs))
+    return out
 
 
 def _cost(entry: dict) -> dict:

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import html
 
-__all__ = ["CONSENSUS_COLOUR", "CONSENSUS_SYMBOLS", "CONSENSUS_LEGEND", "consensus_symbol",
-           "consensus_html"]
+__all__ = ["CONSENSUS_COLOUR", "CONSENSUS_SYMBOLS", "CONSENSUS_LEGEND", "CONSENSUS_HEAD",
+           "consensus_symbol", "consensus_row", "consensus_table", "consensus_html"]
 
 CONSENSUS_COLOUR = "#c9b3e6"  # lavender: outside the red-blue model-error scale
 CONSENSUS_SYMBOLS = ("≈", "≠")  # the cells drawn in the consensus colour
@@ -38,28 +38,36 @@ def _fmt(x, spec: str) -> str:
     return "–" if x is None else format(x, spec)
 
 
+CONSENSUS_HEAD = ["case", "Ω [rad/s]", "model's number (invalid) [m/s²]",
+                  "engines' median [m/s²]", "failure", "status", "each engine vs the median",
+                  "outliers (cause)", "no answer (cause)"]
+
+
+def consensus_row(case: str, omega: float, a_model, c: dict) -> list[str]:
+    """One point's consensus ``c`` as a table row under :data:`CONSENSUS_HEAD`."""
+    devs = "; ".join(f"{e} {100 * v['deviation']:+.2f} %" for e, v in c["engines"].items())
+    odd = "; ".join(f"{o['engine']} ({o['cause']})" for o in c["outliers"])
+    none = "; ".join(f"{n['engine']} ({n['cause']})" for n in c["no_answer"])
+    return [case.replace("_", " "), f"{omega:g}", _fmt(a_model, ".4g"),
+            _fmt(c["median"], ".4g"), c.get("failure") or "–", c["status"], devs or "–",
+            odd or "–", none or "–"]
+
+
+def consensus_table(head: list[str], rows: list[list]) -> str:
+    return ("<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(h)}</th>"
+                                                        for h in head) + "</tr>"
+            + "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r)
+                      + "</tr>" for r in rows) + "</table></div>")
+
+
 def consensus_html(doc: dict, tag: str = "h3") -> str:
     """The consensus section of the atlas page (``tag`` its heading)."""
     s = doc["consensus"]
-    rows = []
-    for pt in doc["points"]:
-        c = pt.get("consensus")
-        if not c or c["status"] == "not run":
-            continue
-        devs = "; ".join(f"{e} {100 * v['deviation']:+.2f} %" for e, v in c["engines"].items())
-        odd = "; ".join(f"{o['engine']} ({o['cause']})" for o in c["outliers"])
-        none = "; ".join(f"{n['engine']} ({n['cause']})" for n in c["no_answer"])
-        rows.append([pt["scene"], pt["case"].replace("_", " "), f"{pt['omega']:g}",
-                     _fmt(pt["a_reference"], ".3g"), _fmt(c["median"], ".4g"),
-                     c.get("failure") or "–", c["status"], devs or "–", odd or "–",
-                     none or "–"])
-    head = ["scene", "case", "Ω [rad/s]", "model's number (invalid) [m/s²]",
-            "engines' median [m/s²]", "failure", "status", "each engine vs the median",
-            "outliers (cause)", "no answer (cause)"]
-    table = ("<div class='scroll'><table><tr>" + "".join(f"<th>{html.escape(h)}</th>"
-                                                          for h in head) + "</tr>"
-             + "".join("<tr>" + "".join(f"<td>{html.escape(str(x))}</td>" for x in r)
-                       + "</tr>" for r in rows) + "</table></div>")
+    rows = [[pt["scene"]] + consensus_row(pt["case"], pt["omega"], pt["a_reference"],
+                                          pt["consensus"])
+            for pt in doc["points"]
+            if pt.get("consensus") and pt["consensus"]["status"] != "not run"]
+    table = consensus_table(["scene"] + CONSENSUS_HEAD, rows)
     not_run = s["invalid_points"] - s["answerable"]
     status = ", ".join(f"{k} {v}" for k, v in sorted(s["status"].items()))
     cost = (f"{s['cpu_s']:.0f} CPU s in the engine jobs "

@@ -139,6 +139,24 @@ def trust_csv(doc: dict) -> str:
     return csv_text(*point_rows(doc))
 
 
+def _consensus_section(doc: dict) -> str:
+    """Where the model is invalid: the engines against each other (two or more)."""
+    from trilith_xval.compare.report.atlas_consensus_page import (CONSENSUS_HEAD,
+                                                                   consensus_row,
+                                                                   consensus_table)
+    found = doc.get("consensus")
+    if found is None:
+        return ""
+    if not found:
+        return ("<h2>Where the model is invalid</h2><p>No frequency of the grid where the "
+                "model is invalid and the engines can answer.</p>")
+    rows = [consensus_row(c["case"], c["omega"], c["a_model"], c) for c in found]
+    return ("<h2>Where the model is invalid: engine against engine</h2><p>Each engine's own "
+            "first failure (overturn or collapse), converged in the step (two steps within "
+            "1 %), against the other engines' median; never agreement with the model, which "
+            "cannot judge there.</p>" + consensus_table(CONSENSUS_HEAD, rows))
+
+
 def trust_html(doc: dict) -> str:
     from trilith_xval.compare.report.html import _CSS
     esc = html.escape
@@ -162,7 +180,7 @@ def trust_html(doc: dict) -> str:
             "<div class='figs'>" + "".join(
                 f"<img alt='overturning spectrum and engine points' "
                 f"src='data:image/png;base64,{png}'>" for png in spectrum_figures(doc))
-            + "</div>", table(*point_rows(doc)),
+            + "</div>", table(*point_rows(doc)), _consensus_section(doc),
             f"<p class='small'>{esc(doc['project'])}; CPU {doc['cost']['cpu_s']:.1f} s in "
             f"this process, wall {doc['cost']['wall_s']:.1f} s, load average "
             + ", ".join(f"{x:.2f}" for x in doc['cost']['load_average']) + ".</p>"]
