@@ -58,7 +58,7 @@ def render_atlas(doc: dict) -> str:
     lines = [f"From `docs/validation/atlas.json`: {len(pts)} model points ({scenes} scenes "
              f"of the paper's Figs. 8-11, with and without the pendulum, Ω {min(w):g}-"
              f"{max(w):g} rad/s, {min(w) / (2 * math.pi):.2g}-{max(w) / (2 * math.pi):.2g} Hz); "
-             f"the model is invalid at {n_invalid} (no engine runs there) and overturns in "
+             f"the model is invalid at {n_invalid} (no engine is compared with it there) and overturns in "
              f"its search range at {n_valid} valid points. An engine agrees at a point when "
              f"its robust threshold bracket is within {100 * tol:g} % of the model's, at that "
              "step and every finer one (a coarser step runs only where the finer one "

@@ -286,7 +286,9 @@ def atlas_html(doc: dict, level: int = 2) -> str:
              f"<p>{len(doc['points'])} model points ({len({pt['scene'] for pt in doc['points']})} "
              f"scenes of Figs. 8-11, both curves, Ω {min(cfg.get('omegas', [0])):g}-"
              f"{max(cfg.get('omegas', [0])):g} rad/s); the model is invalid at {n_invalid} "
-             f"of them (no engine run there). Engines run: {html.escape(ran)}; not run: "
+             "of them (no engine compared with the model there"
+             + ("; the engines against each other, below" if doc.get("consensus") else "")
+             + f"). Engines run: {html.escape(ran)}; not run: "
              f"{html.escape(not_run)}. Tolerance {100 * _tol(doc):g} %; steps "
              f"{html.escape(', '.join(f'{f:g}' for f in cfg.get('factors') or []))} x each "
              "engine's calibrated threshold "
