@@ -249,9 +249,17 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         else:
             evs.append(Event(kind, float(row[1]), int(row[2]), psi=float(row[5])))
     settings_dict = settings.describe()
+    verdict = _make_verdict(st, rs, tv, ni)
+    diagnostics = {"steps": int(n_steps), "version": version()}
+    if form.kind == "samples" and np.all(np.isfinite(data)):
+        # A record's run keeps the contact checks the accurate path reports
+        # (docs/model.md, "Ground reaction"), which a record's reader relied on.
+        from .reactions import validity_diagnostics
+        diagnostics.update(validity_diagnostics(data[:, 0], data[:, 1], data[:, 2], data[:, 3],
+                                                data[:, 4], excitation, scene.model_args(),
+                                                scene.alpha, verdict.overturned))
     return Trajectory(backend=NAME, t=data[:, 0], theta=data[:, 1], theta_dot=data[:, 2],
                       psi=data[:, 3], psi_dot=data[:, 4], events=tuple(evs),
-                      verdict=_make_verdict(st, rs, tv, ni), criterion=settings.criterion,
-                      t_max=settings.t_max, settings=settings_dict,
-                      diagnostics={"steps": int(n_steps), "version": version()},
+                      verdict=verdict, criterion=settings.criterion,
+                      t_max=settings.t_max, settings=settings_dict, diagnostics=diagnostics,
                       wall_time=wall, scene=scene, excitation=excitation)

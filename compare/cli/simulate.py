@@ -70,6 +70,19 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
     return configure(name, **options)
 
 
+def model_backend(engine: str, excitation, options: dict | None = None) -> str:
+    """The backend that runs ``engine``'s model: a sampled record under the
+    model (``analytic``) runs in its compiled kernels (``analytic-fast``: the
+    same function integrated, the same events and verdict,
+    ``tests/analytic/test_fast_records.py``; a long record in a fraction of the
+    CPU), unless ``options`` (a ``--settings`` table) set the accurate path's
+    own settings; anything else runs where asked."""
+    if (engine == "analytic" and not options and excitation.describe()["type"] == "record"
+            and excitation.compiled_form() is not None):
+        return "analytic-fast"
+    return engine
+
+
 def _describe_excitation(excitation) -> str:
     d = excitation.describe()
     if d["type"] == "pulse":
@@ -91,7 +104,6 @@ def run(args: argparse.Namespace) -> int:
     # Every check before the run: scene, excitation, engine, settings, budget, outputs.
     scene = scene_from_args(args)
     excitation = excitation_from_args(args)
-    backend = get_backend(args.engine)
     r = restitution_factor(args)
     model_run = args.engine.startswith("analytic") or args.plot is not None
     if r != 1.0 and not model_run:
@@ -99,15 +111,17 @@ def run(args: argparse.Namespace) -> int:
                          f"{args.engine} alone runs no model (add --plot to draw the model "
                          f"beside it)")
     loaded = settings_from_args(args, (args.engine,))
-    settings = _settings(args.engine, args.criterion, args.t_max,
-                         file_options(loaded, args.engine), r)
-    check_run_budget(args.engine, settings, excitation)
+    name = model_backend(args.engine, excitation, file_options(loaded, args.engine))
+    backend = get_backend(name)
+    settings = _settings(name, args.criterion, args.t_max, file_options(loaded, args.engine), r)
+    check_run_budget(name, settings, excitation)
     # An engine's plot shows the model's run beside it (same scene, excitation,
     # criterion and window): what a cross-validation is read from.
     overlay = args.plot is not None and not args.engine.startswith("analytic")
     if overlay:
-        model_settings = _settings("analytic", args.criterion, args.t_max, restitution=r)
-        check_run_budget("analytic", model_settings, excitation)
+        model_name = model_backend("analytic", excitation)
+        model_settings = _settings(model_name, args.criterion, args.t_max, restitution=r)
+        check_run_budget(model_name, model_settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
     if args.plot is not None:
@@ -118,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         with atomic_path(args.csv) as tmp:
             traj.to_csv(tmp)
     if args.plot is not None:
-        model = [get_backend("analytic").simulate(scene, excitation, model_settings)
+        model = [get_backend(model_name).simulate(scene, excitation, model_settings)
                  ] if overlay else []
         from trilith_xval.compare.show.history import plot_runs  # matplotlib: only when asked
         plot_runs(model + [traj], scene, args.plot)
