@@ -41,16 +41,12 @@ def run(amp, b, h, mu, gamma, j, l, g, omega, pkind, t_end_pulse, thr, rtol, ato
     multiplies every impact's rocking ratio (Eq. 19/20,
     :func:`analytic.equations.impact_velocities`).
 
-    The excitation: ``pkind`` ``KIND_SINE`` / ``KIND_COSINE``, a pulse of
-    amplitude ``amp`` [m/s^2] and frequency ``omega`` [rad/s] ending at
-    ``t_end_pulse = 2 pi / omega``, its quarter periods breakpoints (``rec_t``,
-    ``rec_a`` unused); ``KIND_SAMPLES``, the record of sample times ``rec_t``
-    [s] and accelerations ``rec_a`` [m/s^2], linearly interpolated, times
-    ``amp`` (a scale factor), ending at ``t_end_pulse = rec_t[-1]`` (``omega``
-    unused): every sample is a breakpoint, so each step integrates one straight
-    line (:func:`_record_piece`) and the uplift margin is checked at every
-    sample, where a record's margin has its minima (as in the accurate path).
-    ``max_steps`` then counts the steps beyond the one per sample.
+    Excitation: a pulse (``pkind`` ``KIND_SINE``/``KIND_COSINE``, ``amp``
+    [m/s^2], ``omega`` [rad/s], ``t_end_pulse = 2 pi/omega``; ``rec_t``,
+    ``rec_a`` unused), or ``KIND_SAMPLES``: ``amp`` times the record
+    ``(rec_t [s], rec_a [m/s^2])`` linearly interpolated, ``t_end_pulse =
+    rec_t[-1]``, every sample a breakpoint (:func:`_record_piece`) and
+    ``max_steps`` counted beyond one step per sample.
 
     Returns ``(status, reason, t_verdict, n_impacts, samples, n_samples, events,
     n_events, n_steps, e_out)`` (``e_out``: how near the run came to the

@@ -70,14 +70,14 @@ def _settings(name: str, criterion: str | None, t_max: float | None, base: dict 
     return configure(name, **options)
 
 
-def model_backend(engine: str, excitation, options: dict | None = None) -> str:
-    """The backend that runs ``engine``'s model: a sampled record under the
-    model (``analytic``) runs in its compiled kernels (``analytic-fast``: the
-    same function integrated, the same events and verdict,
+def model_backend(engine: str, excitation) -> str:
+    """The backend that runs ``engine``: a sampled record under the model
+    (``analytic``) runs in its compiled kernels (``analytic-fast``: the same
+    function integrated, the same events and verdict,
     ``tests/analytic/test_fast_records.py``; a long record in a fraction of the
-    CPU), unless ``options`` (a ``--settings`` table) set the accurate path's
-    own settings; anything else runs where asked."""
-    if (engine == "analytic" and not options and excitation.describe()["type"] == "record"
+    CPU; the accurate path stays :func:`analytic.simulate.simulate` in Python);
+    anything else runs where asked."""
+    if (engine == "analytic" and excitation.describe()["type"] == "record"
             and excitation.compiled_form() is not None):
         return "analytic-fast"
     return engine
@@ -111,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
                          f"{args.engine} alone runs no model (add --plot to draw the model "
                          f"beside it)")
     loaded = settings_from_args(args, (args.engine,))
-    name = model_backend(args.engine, excitation, file_options(loaded, args.engine))
+    name = model_backend(args.engine, excitation)
     backend = get_backend(name)
     settings = _settings(name, args.criterion, args.t_max, file_options(loaded, args.engine), r)
     check_run_budget(name, settings, excitation)
