@@ -25,7 +25,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Run the trilith under a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse, "
                     "or a recorded ground motion (--record), in one backend and report the "
                     "verdict (overturned or not, mode, time), the events and the backend's "
-                    "diagnostics.")
+                    "diagnostics.  The model runs a record in its compiled kernels "
+                    "(analytic-fast: the accurate path's events and verdict).")
     add_scene_args(parser)
     add_pulse_args(parser, required=False)
     add_record_arg(parser)
