@@ -22,3 +22,12 @@ def test_the_model_runs_a_record_compiled(capsys):
     assert doc["status"] == ref.verdict.status
     assert doc["n_impacts"] == ref.sampled_events().n_impacts  # read from the samples
     assert [e["kind"] for e in doc["events"]] == [e.kind for e in ref.events]  # exact
+
+
+def test_record_hint_names_a_record_by_its_file_though_it_compiles():
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.show.view import record_hint
+    rec = load_record(SAMPLE)
+    assert rec.compiled_form() is not None
+    assert "--record sample.csv" in record_hint("fig5", "pymunk", rec)
+    assert "--amplitude 3 --omega 6" in record_hint("fig5", "pymunk", Pulse(3.0, 6.0))
