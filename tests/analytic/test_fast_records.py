@@ -112,6 +112,20 @@ def test_threshold_scale_is_the_accurate_one(fig5, path, lo, hi):
     assert exact(rec.scaled(hi * (1.0 + 1e-5)))
 
 
+@pytest.mark.parametrize("pendulum", [True, False])
+def test_a_record_that_starts_late_with_a_jump_lifts_off_at_once(fig5, pendulum):
+    """Still ground up to 0.5 s, then 3 m/s^2 at once (a record's first sample
+    need not be 0): past the uplift condition, the frame lifts off at the jump
+    in both paths, then rocks through the same impacts."""
+    scene = fig5 if pendulum else fig5.without_pendulum()
+    t = np.arange(0.5, 2.0, 0.01)
+    rec = SampledRecord(tuple(t), tuple(3.0 * np.cos(3.0 * np.pi * (t - 0.5))), "late")
+    tf = fast.simulate(scene, rec, fast.Settings(t_max=4.0))
+    ta = accurate.simulate(scene, rec, accurate.Settings(t_max=4.0))
+    assert (tf.events[0].kind, tf.events[0].t) == ("uplift", 0.5)
+    _assert_same_events(tf, ta, EVENT_TIME_TOL)
+
+
 def _tiled(n: int) -> SampledRecord:
     """The sample record at 200 Hz (scale 1: the trilith rocks to its end),
     repeated ``n`` times: 2000 n samples, 10 n s."""
