@@ -14,12 +14,11 @@ import math
 import numpy as np
 from numba import njit
 
-from ._fast_numerics import (_MAX_FACTOR, _MIN_FACTOR, _SAFETY, _dense, _ellipk,  # noqa: F401
-                             _push, _push_event, _samples_until)
-from ._fast_steps import (KIND_COSINE, KIND_LINE, KIND_SAMPLES, KIND_SINE,  # noqa: F401
-                          _barrier, _deriv, _dp_step, _energy, _frame_potential, _impact,
-                          _locate, _margin, _pendulum_period, _record_piece, _rest_energy,
-                          _xg, overturn_certain)
+from ._fast_numerics import (_MAX_FACTOR, _MIN_FACTOR, _SAFETY, _dense, _push, _push_event,
+                             _samples_until)
+from ._fast_steps import (KIND_LINE, KIND_SAMPLES, _barrier, _deriv, _dp_step, _energy,
+                          _frame_potential, _impact, _locate, _margin, _pendulum_period,
+                          _record_piece, _rest_energy, _xg, overturn_certain)
 
 # --- codes shared with analytic/fast.py --------------------------------------------
 ST_OVERTURNED, ST_SURVIVED, ST_UNSTABLE, ST_UNDECIDED = 0, 1, 2, 3
