@@ -15,7 +15,8 @@ import hashlib
 from pathlib import Path
 
 _HERE = Path(__file__).resolve().parent
-SOURCES = ("equations.py", "_fast_numerics.py", "_fast_steps.py", "_fast_kernels.py")
+SOURCES = ("equations.py", "_fast_numerics.py", "_fast_steps.py", "_fast_run.py",
+           "_fast_kernels.py")
 PREFIXES = tuple(Path(name).stem + "." for name in SOURCES)
 
 

@@ -21,11 +21,11 @@ from typing import Callable
 
 import numpy as np
 
-from .excitation_contract import (PULSE_KINDS, CompiledForm, Excitation, check_excitation,
-                                  check_excitation_contract)
+from .excitation_contract import (COMPILED_KINDS, PULSE_KINDS, CompiledForm, Excitation,
+                                  check_excitation, check_excitation_contract)
 
 __all__ = ["Pulse", "SampledRecord", "Still", "Excitation", "CompiledForm", "check_excitation",
-           "check_excitation_contract", "PULSE_KINDS", "OMEGA_RANGE", "MAX_PULSE_LENGTH",
+           "check_excitation_contract", "PULSE_KINDS", "COMPILED_KINDS", "OMEGA_RANGE", "MAX_PULSE_LENGTH",
            "MAX_RECORD_LENGTH", "MAX_RECORD_SAMPLES", "G_STANDARD", "MAX_ACCELERATION"]
 
 # Pulse frequencies [rad/s]: the upper bound is the former one; the lower bound
@@ -314,6 +314,12 @@ class SampledRecord(Excitation):
             raise ValueError(f"record {self.label!r} has {measure.upper()} = 0: it cannot be "
                              f"scaled to a target {measure.upper()}")
         return value
+
+    def compiled_form(self) -> CompiledForm:
+        """The kernels of :mod:`analytic.fast` integrate the same linear
+        interpolation of the samples (:meth:`acceleration`), stopping at every
+        sample (a kink of the interpolant)."""
+        return CompiledForm("samples", 1.0, 0.0, self._t, self._a)
 
     def acceleration(self, t: float) -> float:
         if t < self.times[0] or t > self.times[-1]:

@@ -27,19 +27,31 @@ import numpy as np
 
 # The pulse shapes the compiled kernels integrate (a CompiledForm's kind).
 PULSE_KINDS = ("sine", "cosine")
+# Every kind a CompiledForm may name: the pulses and a sampled record.
+COMPILED_KINDS = PULSE_KINDS + ("samples",)
 
 __all__ = ["Excitation", "CompiledForm", "check_excitation", "check_excitation_contract",
-           "EXCITATION_TYPES"]
+           "EXCITATION_TYPES", "COMPILED_KINDS"]
 
 
 class CompiledForm(NamedTuple):
-    """What the compiled kernels of :mod:`analytic.fast` integrate: a one-sine or
-    one-cosine pulse (Eq. 22/23) given by its kind name, amplitude [m/s^2] and
-    circular frequency [rad/s]."""
+    """What the compiled kernels of :mod:`analytic.fast` integrate.
+
+    * ``kind`` ``'sine'`` / ``'cosine'``: the one-sine or one-cosine pulse
+      (Eq. 22/23) of ``amplitude`` [m/s^2] and circular frequency ``omega``
+      [rad/s] (``times``, ``accelerations`` None);
+    * ``kind`` ``'samples'``: ``amplitude`` (a factor, 1 for the record as
+      given) times the linear interpolation of ``accelerations`` [m/s^2] at
+      ``times`` [s] (1-D float arrays, strictly increasing times), zero before
+      the first and after the last sample; ``omega`` unused (0).  The kernels
+      read the arrays and never write them.
+    """
 
     kind: str
     amplitude: float
     omega: float
+    times: np.ndarray | None = None
+    accelerations: np.ndarray | None = None
 
 
 class Excitation(abc.ABC):
@@ -353,9 +365,30 @@ def _check_compiled(cls, obj, t, a, scale) -> None:
     form = obj.compiled_form()
     if form is None:
         return
-    if not isinstance(form, CompiledForm) or form.kind not in PULSE_KINDS:
-        _fail(cls, f"compiled_form() must be None or a CompiledForm of kind {PULSE_KINDS}")
-    wave = np.cos if form.kind == "cosine" else np.sin
-    on = (t >= 0.0) & (t <= 2.0 * math.pi / form.omega)
-    if not _close(np.where(on, form.amplitude * wave(form.omega * t), 0.0), a, scale):
+    if not isinstance(form, CompiledForm) or form.kind not in COMPILED_KINDS:
+        _fail(cls, f"compiled_form() must be None or a CompiledForm of kind {COMPILED_KINDS}")
+    if form.kind == "samples":
+        compiled = _samples_form(cls, obj, form, t)
+    else:
+        wave = np.cos if form.kind == "cosine" else np.sin
+        on = (t >= 0.0) & (t <= 2.0 * math.pi / form.omega)
+        compiled = np.where(on, form.amplitude * wave(form.omega * t), 0.0)
+    if not _close(compiled, a, scale):
         _fail(cls, "compiled_form() must be the motion acceleration_array gives")
+
+
+def _samples_form(cls, obj, form: CompiledForm, t: np.ndarray) -> np.ndarray:
+    """The acceleration a 'samples' form gives at ``t``, after checking its arrays
+    (the kernels stop the excitation at the last sample: it must be the end)."""
+    ts, acc = form.times, form.accelerations
+    if not (isinstance(ts, np.ndarray) and isinstance(acc, np.ndarray)
+            and ts.dtype == np.float64 and acc.dtype == np.float64
+            and ts.ndim == 1 and ts.shape == acc.shape and ts.size >= 2):
+        _fail(cls, "a 'samples' compiled form needs times and accelerations as 1-D float64 "
+                   "arrays of one length >= 2")
+    if not (np.all(np.isfinite(ts)) and np.all(np.isfinite(acc)) and np.all(np.diff(ts) > 0.0)
+            and math.isfinite(form.amplitude)):
+        _fail(cls, "a 'samples' compiled form needs finite values and increasing times")
+    if ts[0] != obj.start_time or ts[-1] != obj.end_time:
+        _fail(cls, "a 'samples' compiled form must span [start_time, end_time]")
+    return np.interp(t, ts, form.amplitude * acc, left=0.0, right=0.0)

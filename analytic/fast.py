@@ -17,7 +17,12 @@ Phase semantics
   otherwise rocking continues about ``-s``.  Overturned when ``|theta|`` reaches
   ``criterion.threshold(alpha)``; mode 'no-impact' or 'after-impact'.
 * The pulse end, and its quarter periods (the extrema of a sine's uplift margin,
-  so a short uplift window is not stepped over), are breakpoints.
+  so a short uplift window is not stepped over), are breakpoints.  Under a
+  sampled record every sample is one: each step integrates one straight line
+  of the record's linear interpolation (the function the accurate path
+  integrates, ``SampledRecord.acceleration``), and the uplift margin, whose
+  minima lie at the samples, is checked at every sample, as the accurate path
+  checks it.  "The pulse" below is then the record: its end is the last sample.
 * Exact survival (``t_max=None``), after the pulse: energy below
   ``overturn_energy_barrier`` at the pulse end or after any later impact/rest;
   REST without pendulum; REST with pendulum and no uplift within one free
@@ -34,9 +39,20 @@ Phase semantics
   early: a trajectory always shows the whole fall.
 
 Only what an excitation's ``compiled_form()`` describes (the one-sine and
-one-cosine pulses) is compiled: :func:`simulate` hands any other excitation
-(a record, the pulses of :mod:`analytic.pulses`, a user's own) to the accurate
-path (``analytic.simulate``) and says so in the trajectory's diagnostics.
+one-cosine pulses, a sampled record) is compiled: :func:`simulate` hands any
+other excitation (the pulses of :mod:`analytic.pulses`, a user's own) to the
+accurate path (``analytic.simulate``) and says so in the trajectory's
+diagnostics.
+
+Notes
+-----
+A record costs at least one step per sample, and the steps of its rocking:
+linear in its length.  Measured by ``python -m benchmarks.run
+bench_record_paths`` (CPU seconds, compiled against accurate, in one run;
+``docs/earthquakes.md``): a 16,000-sample record (80 s, rocking to the end)
+0.042 against 17.4 CPU s (ratio 0.0024), the model's IDA of the 12 shipped
+synthetic motions (372 runs) 0.17 against 291 CPU s (ratio 0.0006), with the
+same verdicts at every run.
 """
 from __future__ import annotations
 
@@ -67,18 +83,22 @@ REASONS = ("overturned", "energy below the overturning barrier after the pulse",
            "time = when it became certain")
 # The one map from pulse names to the kernels' codes.
 PULSE_CODES = {"sine": _k.KIND_SINE, "cosine": _k.KIND_COSINE}
+# Every compiled form's kind: the pulses and a sampled record.
+KIND_CODES = {**PULSE_CODES, "samples": _k.KIND_SAMPLES}
 
 
 def _pack(model_args: tuple, omega: float, kind_code: int, threshold: float, rtol: float,
           atol: float, rest_velocity: float, t_max: float | None, t_cap: float,
           max_steps: int, rest_step_fraction: float, certain_exit: bool,
-          restitution_factor: float = 1.0) -> tuple:
+          restitution_factor: float = 1.0, t_end: float | None = None) -> tuple:
     """The kernels' arguments after the amplitude, in their order (the one place
-    that knows it); ``t_max`` None or <= 0 = exact survival.  The restitution
+    that knows it); ``t_max`` None or <= 0 = exact survival; ``t_end`` the end
+    of the excitation [s] (default a pulse's ``2 pi / omega``).  The restitution
     factor comes last: :func:`warm_up` and :func:`simulate` append ``record,
-    sample_dt`` after it."""
+    sample_dt, rec_t, rec_a`` after it."""
     t_max = -1.0 if t_max is None else float(t_max)
-    return (*model_args, float(omega), int(kind_code), 2.0 * math.pi / omega,
+    t_end = 2.0 * math.pi / omega if t_end is None else float(t_end)
+    return (*model_args, float(omega), int(kind_code), t_end,
             float(threshold), rtol, atol, rest_velocity, t_max, t_cap, int(max_steps),
             rest_step_fraction, bool(certain_exit), float(restitution_factor))
 
@@ -124,23 +144,38 @@ def verdict_for(scene: Scene, pulse: Excitation, settings: Settings | None = Non
     certain (``Verdict.reason`` says so); :func:`simulate` gives the fall itself.
 
     ``pulse`` must be an excitation the kernels integrate (its
-    ``compiled_form()`` is not None: a one-sine or one-cosine pulse),
-    ``TypeError`` otherwise."""
+    ``compiled_form()`` is not None: a one-sine or one-cosine pulse, a sampled
+    record), ``TypeError`` otherwise."""
     settings = _check(scene, pulse, settings)
     form = _compiled(pulse)
     if form is None:
         raise TypeError(f"verdict_for: pulse must be an excitation the compiled kernels "
-                        f"integrate (compiled_form() of kind {tuple(PULSE_CODES)}: a sine or "
-                        f"cosine Pulse), got {type(pulse).__name__}")
-    st, rs, tv, ni = _k.verdict(form.amplitude,
-                                *kernel_args(scene, form.omega, form.kind, settings))
-    return _make_verdict(st, rs, tv, ni)
+                        f"integrate (compiled_form() of kind {tuple(KIND_CODES)}: a sine or "
+                        f"cosine Pulse, a SampledRecord), got {type(pulse).__name__}")
+    args = _form_args(scene, form, settings)
+    if form.kind == "samples":
+        st, rs, tv, ni, _e, _n = _k.record_verdicts(np.array([form.amplitude]), *args,
+                                                    form.times, form.accelerations)
+        return _make_verdict(st[0], rs[0], tv[0], ni[0])
+    return _make_verdict(*_k.verdict(form.amplitude, *args))
 
 
 def _compiled(excitation: Excitation) -> CompiledForm | None:
     """The excitation's compiled form if the kernels know its kind, else None."""
     form = excitation.compiled_form()
-    return form if form is not None and form.kind in PULSE_CODES else None
+    return form if form is not None and form.kind in KIND_CODES else None
+
+
+def _form_args(scene: Scene, form: CompiledForm, settings: Settings,
+               certain_exit: bool = True) -> tuple:
+    """:func:`kernel_args` of a compiled form (a pulse or a record)."""
+    if form.kind != "samples":
+        return kernel_args(scene, form.omega, form.kind, settings, certain_exit)
+    return _pack(scene.model_args(), 0.0, _k.KIND_SAMPLES,
+                 settings.criterion.threshold(scene.alpha), settings.rtol, settings.atol,
+                 settings.rest_velocity, settings.t_max, settings.t_cap, settings.max_steps,
+                 settings.rest_step_fraction, certain_exit, settings.restitution_factor,
+                 t_end=float(form.times[-1]))
 
 
 def _make_verdict(st: int, rs: int, tv: float, ni: int) -> Verdict:
@@ -170,7 +205,12 @@ def warm_up(record: bool = True) -> float:
     args = kernel_args(Scene(), 10.0, "sine", Settings())
     _k.verdicts(np.array([10.0]), *args)
     if record:
-        _k.run(10.0, *args[:-2], False, args[-1], True, 1e-2)
+        none = np.zeros(1)
+        _k.run(10.0, *args[:-2], False, args[-1], True, 1e-2, none, none)
+        rec = np.array([0.0, 0.1])
+        _k.record_verdicts(np.array([1.0]), *_pack(Scene().model_args(), 0.0, _k.KIND_SAMPLES,
+                                                   1.5, 1e-8, 1e-10, 1e-6, None, 1.0, 1000,
+                                                   0.01, True, t_end=0.1), rec, rec)
     return time.perf_counter() - t0
 
 
@@ -178,8 +218,9 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
     """Run ``scene`` under ``excitation``; returns a :class:`Trajectory`.
 
     Samples on the ``sample_dt`` grid plus one row at every event (the state
-    after it).  An excitation without a compiled form (a record, a Ricker
-    wavelet, ...: ``compiled_form()`` is None) is handed to the accurate path.
+    after it).  An excitation without a compiled form (a Ricker wavelet, a
+    user's own, ...: ``compiled_form()`` is None) is handed to the accurate path.
+    ``diagnostics['steps']`` counts the kernel's accepted and rejected steps.
     """
     settings = _check(scene, excitation, settings)
     form = _compiled(excitation)
@@ -194,9 +235,12 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         return traj
     t0 = time.perf_counter()
     # No early exit here: a trajectory shows the fall up to the threshold.
-    args = kernel_args(scene, form.omega, form.kind, settings, certain_exit=False)
+    args = _form_args(scene, form, settings, certain_exit=False)
+    none = np.zeros(1)  # a pulse's record arrays (never read)
+    rec_t = none if form.times is None else form.times
+    rec_a = none if form.accelerations is None else form.accelerations
     (st, rs, tv, ni, samples, ns, events, ne, n_steps, _e_out) = _k.run(
-        form.amplitude, *args, True, settings.sample_dt)
+        form.amplitude, *args, True, settings.sample_dt, rec_t, rec_a)
     wall = time.perf_counter() - t0
     data = samples[:ns]
     evs = []
@@ -208,9 +252,17 @@ def simulate(scene: Scene, excitation, settings: Settings | None = None) -> Traj
         else:
             evs.append(Event(kind, float(row[1]), int(row[2]), psi=float(row[5])))
     settings_dict = settings.describe()
+    verdict = _make_verdict(st, rs, tv, ni)
+    diagnostics = {"steps": int(n_steps), "version": version()}
+    if form.kind == "samples" and np.all(np.isfinite(data)):
+        # A record's run keeps the contact checks the accurate path reports
+        # (docs/model.md, "Ground reaction"), which a record's reader relied on.
+        from .reactions import validity_diagnostics
+        diagnostics.update(validity_diagnostics(data[:, 0], data[:, 1], data[:, 2], data[:, 3],
+                                                data[:, 4], excitation, scene.model_args(),
+                                                scene.alpha, verdict.overturned))
     return Trajectory(backend=NAME, t=data[:, 0], theta=data[:, 1], theta_dot=data[:, 2],
                       psi=data[:, 3], psi_dot=data[:, 4], events=tuple(evs),
-                      verdict=_make_verdict(st, rs, tv, ni), criterion=settings.criterion,
-                      t_max=settings.t_max, settings=settings_dict,
-                      diagnostics={"steps": int(n_steps), "version": version()},
+                      verdict=verdict, criterion=settings.criterion,
+                      t_max=settings.t_max, settings=settings_dict, diagnostics=diagnostics,
                       wall_time=wall, scene=scene, excitation=excitation)

@@ -37,7 +37,8 @@ class Settings(RunOptions):
     rest_velocity: float = 1e-6
     # Output grid [s] of simulate(); 1 ms resolves the fastest rocking half-cycle.
     sample_dt: float = 1e-3
-    # Guard against Zeno chatter; no decided run measured needs 1e5 steps.
+    # Guard against Zeno chatter; no decided run measured needs 1e5 steps.  A
+    # record's run gets one step per sample on top (every sample is a breakpoint).
     max_steps: int = 2_000_000
     # Largest REST step / pulse period (after it: / pendulum period): a dip of the
     # uplift margin shorter than a step could be missed; 1 % costs <= 100 steps.

@@ -22,9 +22,11 @@ missed (as for the pulse spectra's coarse scan; the step is a setting).  A
 record that survives every grid point is right-censored at ``im_hi`` (``im =
 inf``), which the fragility fit treats as such.
 
-Every run is a function ``overturns(motion) -> bool`` (the model by default:
-:func:`analytic.simulate.simulate` with a fixed window ``t_max = end + tail``, the
-same window an engine is given, so the two are compared on the same run length).
+Every run is a function ``overturns(motion) -> bool`` (the model by default,
+:func:`model_verdict`: a fixed window ``t_max = end + tail``, the same window an
+engine is given, so the two are compared on the same run length; a record runs
+in the compiled kernels of :mod:`analytic.fast`, whose verdicts and thresholds
+are the accurate path's, ``tests/analytic/test_fast_records.py``).
 """
 from __future__ import annotations
 
@@ -130,12 +132,23 @@ def scale_to(motion, im: str, value: float):
     return motion.scaled(value / intensity_of(motion, im))
 
 
-def model_verdict(scene, tail: float) -> Callable[[object], bool]:
-    """``overturns(motion)`` for the accurate model with ``t_max = end + tail``."""
-    from .simulate import Settings, simulate
+def model_verdict(scene, tail: float, compiled: bool = True) -> Callable[[object], bool]:
+    """``overturns(motion)`` for the model with ``t_max = end + tail`` [s].
+
+    ``compiled`` True: a motion the compiled kernels integrate (a sampled
+    record, a one-sine or one-cosine pulse: ``compiled_form()`` not None) runs
+    there (:func:`analytic.fast.verdict_for`, verdict only), any other in the
+    accurate path (:func:`analytic.simulate.simulate`); False: always the
+    accurate path."""
+    from . import simulate as accurate
 
     def overturns(motion) -> bool:
-        return simulate(scene, motion, Settings(t_max=motion.end_time + tail)).verdict.overturned
+        window = motion.end_time + tail
+        if compiled and motion.compiled_form() is not None:
+            from . import fast  # numba: imported when a compiled run is made
+            return fast.verdict_for(scene, motion, fast.Settings(t_max=window)).overturned
+        return accurate.simulate(scene, motion,
+                                 accurate.Settings(t_max=window)).verdict.overturned
     return overturns
 
 

@@ -77,22 +77,26 @@ def _im_range(args) -> tuple[float, float]:
 
 def ida_job(item):
     """One record, one backend (with ``options``, a ``--settings`` table): its
-    :class:`analytic.ida.IDAResult` as plain data, through the run store (each run
-    stored, the whole search memoised)."""
+    :class:`analytic.ida.IDAResult` as plain data, the whole search memoised.
+    The model's runs are compiled (:func:`analytic.ida.model_verdict`: verdicts
+    only, milliseconds each, not stored); an engine's go through the run store."""
     from trilith_xval import engines
 
-    from trilith_xval.analytic.ida import first_overturn_intensity
+    from trilith_xval.analytic.ida import first_overturn_intensity, model_verdict
     from trilith_xval.compare.run import runs
     from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
     backend, scene, record, st, *rest = item
     options = rest[0] if rest else {}
-    extra = {"sample_dt": 0.01} if backend == "analytic" else dict(options)
+    model = backend == "analytic"
+    name = "analytic-fast" if model else backend
 
     def settings_for(motion):
-        return engines.configure(backend, t_max=motion.end_time + st.tail, **extra)
+        return engines.configure(name, t_max=motion.end_time + st.tail,
+                                 **({} if model else dict(options)))
 
-    def overturns(motion) -> bool:
+    def engine_overturns(motion) -> bool:
         return runs.simulate(backend, scene, motion, settings_for(motion)).verdict.overturned
+    overturns = model_verdict(scene, st.tail) if model else engine_overturns
 
     def compute():
         res = first_overturn_intensity(record, overturns, st)

@@ -25,7 +25,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Run the trilith under a one-sine (Eq. 22) or one-cosine (Eq. 23) pulse, "
                     "or a recorded ground motion (--record), in one backend and report the "
                     "verdict (overturned or not, mode, time), the events and the backend's "
-                    "diagnostics.")
+                    "diagnostics.  The model runs a record in its compiled kernels "
+                    "(analytic-fast: the accurate path's events and verdict).")
     add_scene_args(parser)
     add_pulse_args(parser, required=False)
     add_record_arg(parser)
@@ -68,6 +69,19 @@ def _overrides(name: str, criterion: str | None, t_max: float | None,
     return options
 
 
+def model_backend(engine: str, excitation) -> str:
+    """The backend that runs ``engine``: a sampled record under the model
+    (``analytic``) runs in its compiled kernels (``analytic-fast``: the same
+    function integrated, the same events and verdict,
+    ``tests/analytic/test_fast_records.py``; a long record in a fraction of the
+    CPU; the accurate path stays :func:`analytic.simulate.simulate` in Python);
+    anything else runs where asked."""
+    if (engine == "analytic" and excitation.describe()["type"] == "record"
+            and excitation.compiled_form() is not None):
+        return "analytic-fast"
+    return engine
+
+
 def _describe_excitation(excitation) -> str:
     d = excitation.describe()
     if d["type"] == "pulse":
@@ -89,7 +103,6 @@ def run(args: argparse.Namespace) -> int:
     # Every check before the run: scene, excitation, engine, settings, budget, outputs.
     scene = scene_from_args(args)
     excitation = excitation_from_args(args)
-    backend = get_backend(args.engine)
     r = restitution_factor(args)
     model_run = args.engine.startswith("analytic") or args.plot is not None
     if r != 1.0 and not model_run:
@@ -97,18 +110,21 @@ def run(args: argparse.Namespace) -> int:
                          f"{args.engine} alone runs no model (add --plot to draw the model "
                          f"beside it)")
     loaded = settings_from_args(args, (args.engine,))
+    name = model_backend(args.engine, excitation)
+    backend = get_backend(name)
     # The run, resolved once: defaults, the --settings table, the command line.
-    spec = run_spec(args.engine, scene, excitation, loaded,
-                    overrides=_overrides(args.engine, args.criterion, args.t_max, r))
+    spec = run_spec(name, scene, excitation, loaded,
+                    overrides=_overrides(name, args.criterion, args.t_max, r))
     settings = spec.settings
-    check_run_budget(args.engine, settings, excitation)
+    check_run_budget(name, settings, excitation)
     # An engine's plot shows the model's run beside it (same scene, excitation,
     # criterion and window): what a cross-validation is read from.
     overlay = args.plot is not None and not args.engine.startswith("analytic")
     if overlay:
-        model_settings = run_spec("analytic", scene, excitation, overrides=_overrides(
-            "analytic", args.criterion, args.t_max, r)).settings
-        check_run_budget("analytic", model_settings, excitation)
+        model_name = model_backend("analytic", excitation)
+        model_settings = run_spec(model_name, scene, excitation, overrides=_overrides(
+            model_name, args.criterion, args.t_max, r)).settings
+        check_run_budget(model_name, model_settings, excitation)
     if args.csv is not None:
         check_output_path(args.csv, "--csv")
     if args.plot is not None:
@@ -119,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
         with atomic_path(args.csv) as tmp:
             traj.to_csv(tmp)
     if args.plot is not None:
-        model = [get_backend("analytic").simulate(scene, excitation, model_settings)
+        model = [get_backend(model_name).simulate(scene, excitation, model_settings)
                  ] if overlay else []
         from trilith_xval.compare.show.history import plot_runs  # matplotlib: only when asked
         plot_runs(model + [traj], scene, args.plot)

@@ -209,23 +209,28 @@ def msa_fragility(verdicts, stripes, n_boot: int = 400, level: float = 0.9,
 
 
 def stripe_job(item) -> list[bool]:
-    """One record, one backend: its verdict at every stripe, each run through the
-    run store and the whole set memoised.  ``item`` is ``(backend, scene,
+    """One record, one backend: its verdict at every stripe, the whole set
+    memoised (an engine's runs each through the run store; the model's compiled,
+    verdict only).  ``item`` is ``(backend, scene,
     record, stripes, im, tail, options)``; each run lasts the record plus
     ``tail`` seconds (the window of :mod:`analytic.ida`, so a stripe's run is the
     IDA's run at that intensity)."""
     from trilith_xval import engines
-    from trilith_xval.analytic.ida import scale_to
+    from trilith_xval.analytic.ida import model_verdict, scale_to
     from trilith_xval.compare.run import runs
     from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
     backend, scene, record, stripes, im, tail, options = item
-    # The model samples its output as the IDA jobs do, so the two share stored runs.
-    extra = {"sample_dt": 0.01} if backend == "analytic" else dict(options or {})
-    settings = engines.configure(backend, t_max=record.end_time + tail, **extra)
+    model = backend == "analytic"
+    # The model runs compiled, as in the IDA jobs (analytic.ida.model_verdict):
+    # the same verdict of the same window; an engine through the run store.
+    settings = engines.configure("analytic-fast" if model else backend,
+                                 t_max=record.end_time + tail,
+                                 **({} if model else dict(options or {})))
+    overturns = model_verdict(scene, tail) if model else (
+        lambda motion: runs.simulate(backend, scene, motion, settings).verdict.overturned)
 
     def compute():
-        return [bool(runs.simulate(backend, scene, scale_to(record, im, s),
-                                   settings).verdict.overturned) for s in stripes]
+        return [bool(overturns(scale_to(record, im, s))) for s in stripes]
     what = {"backend": backend, "scene": scene_dict(scene),
             "record": digest(excitation_dict(record)), "stripes": list(stripes), "im": im,
             "settings": settings_dict(settings)}

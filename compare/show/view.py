@@ -12,6 +12,7 @@ import sys
 
 import numpy as np
 
+from trilith_xval.analytic.excitation_contract import PULSE_KINDS
 from trilith_xval.analytic.parameters import Scene
 
 __all__ = ["display_problem", "view", "NON_INTERACTIVE_BACKENDS"]
@@ -54,7 +55,7 @@ def record_hint(scene_name: str, engine: str, excitation) -> str:
     """The ``trilith record`` command that shows the same run in a file (a record
     is named by its file name: its path is the user's own)."""
     form = excitation.compiled_form()  # a sine or cosine pulse: the options give it
-    if form is not None:
+    if form is not None and form.kind in PULSE_KINDS:
         shape = "" if form.kind == "sine" else f"--pulse {form.kind} "
         what = f"{shape}--amplitude {form.amplitude:g} --omega {form.omega:g}"
     else:

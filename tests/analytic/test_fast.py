@@ -181,11 +181,11 @@ def test_rest_after_pulse_rules(fig5):
     assert tr.verdict.status == "survived" and not tr.events
 
 
-def test_sampled_record_falls_back_to_accurate(fig5):
+def test_sampled_record_is_compiled(fig5):
     rec = SampledRecord((0.0, 0.2, 0.4), (0.0, 4.0, 0.0))
     tr = fast.simulate(fig5, rec, fast.Settings(t_max=1.0))
-    assert tr.backend == accurate.NAME
-    assert "fallback" in " ".join(tr.diagnostics)
+    assert tr.backend == fast.NAME
+    assert "fast_path_fallback" not in tr.diagnostics
 
 
 def test_contract_and_validation(fig5):
