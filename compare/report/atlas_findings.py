@@ -122,8 +122,25 @@ def consensus_lines(doc: dict) -> list[str]:
                 f"{c['cpu_s']:.0f} CPU s in the engine jobs ("
                 + ("-" if c.get("cpu_s_per_engine_point") is None
                    else f"{c['cpu_s_per_engine_point']:.2g}")
-                + f" per engine and point), load average {c['load_average'][0]:.1f} -> "
-                f"{c['load_average'][1]:.1f}: `{c.get('command', '')}`."]
+                + f" per engine and point; {_per_engine(doc, c['engines'])}), load average "
+                f"{c['load_average'][0]:.1f} -> {c['load_average'][1]:.1f}: "
+                f"`{c.get('command', '')}`."]
+
+
+def _per_engine(doc: dict, engines) -> str:
+    """Per engine: mean CPU s of a consensus point, its first step, and at how many
+    points the first pair of steps (2x and 1x) already converged."""
+    out = []
+    for e in engines:
+        rows = [pt["own"][e] for pt in doc["points"] if e in (pt.get("own") or {})]
+        cpu = [r["cpu_s"] for r in rows if r.get("cpu_s") is not None
+               and math.isfinite(r["cpu_s"])]
+        first = sum(r["converged"] and len(r["steps"]) == 2 for r in rows)
+        base = {r["steps"][1]["dt"] for r in rows if len(r["steps"]) > 1}
+        out.append(f"{label(e)} {sum(cpu) / len(cpu):.2g} CPU s per point at "
+                   + "/".join(f"{dt:g}" for dt in sorted(base))
+                   + f" s, converged at the first two steps at {first} of {len(rows)}")
+    return "; ".join(out)
 
 
 def main(argv: list[str] | None = None) -> int:
