@@ -52,6 +52,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              f"cell, and at least {LEAST_RUNS} runs per robust threshold "
                              "point (one per engine frequency; more where the engine "
                              "disagrees)")
+    parser.add_argument("--consensus", action="store_true",
+                        help="where the model cannot judge an engine's threshold (cause "
+                             "'model'), the engines against each other (two engines or more; "
+                             "docs/atlas.md)")
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine threshold points at dt/2, dt/4 and "
                              "doubled solver iterations to classify the cause")
@@ -149,6 +153,10 @@ def run(args: argparse.Namespace) -> int:
                           parse_engine_list(args.engine) if args.engine is not None else ())
     if args.engine is not None:
         engines = parse_engine_list(args.engine)  # unknown name: refused before any work
+    if args.consensus and len(engines) < 2:
+        raise ValueError("--consensus compares engines with each other: give --engine with "
+                         f"two or more, got {', '.join(engines) or 'none'}")
+    if args.engine is not None:
         eng_grid = _engine_grid(args, omegas, amps, len(engines))
     loaded = _options.settings_from_args(args, engines)
     from trilith_xval.analytic.overturn_map import MAX_ACCURATE_CELLS, MAX_CELLS, analytic_map, verdict_map
@@ -190,6 +198,12 @@ def run(args: argparse.Namespace) -> int:
             thresholds[name] = map_thresholds(name, scene, eng_grid[0], settings.pulse,
                                               workers=workers, convergence=args.convergence,
                                               reference=reference, spec=searches[name])
+    agreed = None
+    if args.consensus:
+        from trilith_xval.compare.cli.spectrum_engines import consensus_where_model_cannot_judge
+        case = "pendulum" if scene.has_pendulum else "no_pendulum"
+        agreed = consensus_where_model_cannot_judge(
+            scene, searches, [(case, pts) for pts in thresholds.values()], settings.pulse)
     from trilith_xval.analytic.threshold_validity import curve_validity
     validity = curve_validity(scene, maps[0].omega, maps[0].first, settings.pulse, workers,
                               restitution_factor=rf)
@@ -219,6 +233,8 @@ def run(args: argparse.Namespace) -> int:
         doc = {"maps": [first] + engine_maps}
         if rf != 1.0:  # absent at 1: the documents of exact-impact maps stay as they were
             doc["restitution_factor"] = rf
+        if agreed is not None:  # engine against engine, apart from the model's comparison
+            doc["consensus"] = agreed
         print_json(plain(doc))
         return 0
     if rf != 1.0:
@@ -229,6 +245,9 @@ def run(args: argparse.Namespace) -> int:
                              f"frequencies x {m.amplitude.size} amplitudes")
     for name, pts in thresholds.items():
         _print_thresholds(name, pts)
+    if agreed is not None:
+        from trilith_xval.compare.cli.spectrum_engines import print_consensus
+        print_consensus(agreed)
     bad = [float(w) for w, v in zip(maps[0].omega, validity) if v["model_valid"] is False]
     if bad:
         print(f"note: the model is invalid at the first overturning for {len(bad)} "

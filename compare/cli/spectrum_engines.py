@@ -7,7 +7,8 @@ from __future__ import annotations
 from trilith_xval.compare.cli.options import envelope, print_json, settings_line
 from trilith_xval.compare.cli.model_options import restitution_text
 
-__all__ = ["engine_runs", "check_engine_budget", "run_engines"]
+__all__ = ["engine_runs", "check_engine_budget", "run_engines",
+           "consensus_where_model_cannot_judge", "print_consensus"]
 
 
 def engine_runs(args, scene, names, loaded=None) -> dict:
@@ -113,15 +114,22 @@ def run_engines(args, scene, spec, runs: dict, workers: int, loaded=None) -> int
                       f"{100 * p.rel_error:+6.2f}%  {p.cause}{iso}"
                       + ("" if p.cause == "agrees" else f": {p.cause_detail}"))
     if agreed is not None:
-        _print_consensus(agreed)
+        print_consensus(agreed)
     return 0
 
 
 def _consensus(scene, runs: dict, results, kind) -> list[dict]:
-    """The engines' consensus at every point where the model cannot judge them."""
+    return consensus_where_model_cannot_judge(
+        scene, runs, [(c, pts) for r in results for c, pts in r.curves.items()], kind)
+
+
+def consensus_where_model_cannot_judge(scene, runs: dict, curves, kind) -> list[dict]:
+    """The engines' consensus (:func:`compare.measure.consensus.consensus_at`) at
+    every point of ``curves`` (pairs ``(curve, engine points)``) where the model
+    cannot judge an engine, with a progress line per tenth."""
     from trilith_xval.compare.measure.consensus import consensus_at, where_model_cannot_judge
     from trilith_xval.compare.run.progress import bar
-    points = where_model_cannot_judge(results)
+    points = where_model_cannot_judge(curves)
     progress = bar(len(points), "consensus", "points")
     out = []
     try:
@@ -134,7 +142,7 @@ def _consensus(scene, runs: dict, results, kind) -> list[dict]:
     return out
 
 
-def _print_consensus(agreed: list[dict]) -> None:
+def print_consensus(agreed: list[dict]) -> None:
     print(f"where the model cannot judge ({len(agreed)} points): engine against engine, "
           "each one's own first failure converged in the step")
     print(f"{'curve':>11} {'Omega':>6} {'A_model':>8} {'median':>8}  status; each engine")

@@ -220,14 +220,14 @@ def consensus_at(runs: dict, scene, omega: float, a_guess: float, kind="sine", *
     return {"omega": omega, "a_model": a_guess, **consensus(owns, causes), "own": owns}
 
 
-def where_model_cannot_judge(spectra) -> list[tuple[str, float, float]]:
-    """``(curve, omega, a_model)`` of every point of engine spectra
-    (:class:`~compare.measure.engine_spectrum.EngineSpectrum`) where some engine's
+def where_model_cannot_judge(curves) -> list[tuple[str, float, float]]:
+    """``(curve, omega, a_model)`` of every engine point
+    (:class:`~compare.measure.engine_spectrum.EnginePoint`) of ``curves`` (pairs
+    ``(curve name, points)``, any number per curve: one per engine) where the
     point found the model invalid (cause ``model``), once each, in order."""
     seen: dict = {}
-    for spectrum in spectra:
-        for curve, points in spectrum.curves.items():
-            for p in points:
-                if p.cause == "model":
-                    seen.setdefault((curve, float(p.omega)), float(p.a_reference))
+    for curve, points in curves:
+        for p in points:
+            if p.cause == "model":
+                seen.setdefault((curve, float(p.omega)), float(p.a_reference))
     return [(c, w, a) for (c, w), a in seen.items()]

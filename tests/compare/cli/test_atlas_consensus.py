@@ -82,3 +82,11 @@ def test_spectrum_consensus_where_the_model_cannot_judge(capsys):
         assert all(abs(v["deviation"]) <= 0.02 for v in c["engines"].values())
     for name in ("pymunk", "mujoco"):  # the model's comparison is unchanged beside it
         assert {p["cause"] for p in doc["engines"][name]["curves"]["pendulum"]} == {"model"}
+
+
+@pytest.mark.parametrize("argv", [["--engine", "pymunk"], []])
+def test_map_consensus_needs_two_engines(argv, no_work, capsys):
+    assert main(["map", "--omega", "20:26:2", "--amplitude", "40:90:10", "--consensus",
+                 *argv]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "--consensus" in err[0] and "two or more" in err[0]
