@@ -64,6 +64,17 @@ def test_outputs_are_figures_and_loadable_settings(small_map):
         assert loaded.options("pymunk") == options[pick["variant"]]
 
 
+def test_every_grid_variant_is_a_loadable_settings_file(tmp_path):
+    # Any variant may come out cheapest, so each must be writable and read back
+    # as the same options (MuJoCo's solimp tuple as a TOML array included).
+    from trilith_xval.compare.campaign.settings_file import settings_toml
+    for engine, grid in GRIDS.items():
+        for k, v in enumerate(grid):
+            path = tmp_path / f"{engine}-{k}.toml"
+            path.write_text(settings_toml(engine, v.options, v.why))
+            assert read_settings_file(path).options(engine) == v.options
+
+
 @pytest.mark.parametrize("args, words", [
     (["--lam", "4"], "--lam must be one of 1.5, 2, 3, 5, 8, 10, got 4"),
     (["--engine", "bullet"], "--engine must be one of"),
