@@ -271,6 +271,11 @@ def restitution_map(engines=tuple(GRIDS), lams=LAMS, *, trilith: bool = True,
             "load_average": list(os.getloadavg())}
 
 
+# What a cell's result depends on: the model, the engines, the measurements and
+# the run layer; not the CLI nor the report, whose edits must not redo the map.
+CELL_CODE = ("analytic", "engines", "compare/measure", "compare/run")
+
+
 def _children_cpu() -> float:
     """CPU seconds (user + system) of this process's finished child processes."""
     import resource
@@ -281,13 +286,12 @@ def _children_cpu() -> float:
 def _cell_memo(job: tuple) -> dict:
     """:func:`measure_cell` through the store (whole cells: a warm rerun is instant)."""
     from trilith_xval.compare.run import runs
-    from trilith_xval.compare.run.runs import ALL_CODE
     variant = next(v for v in GRIDS[job[0]] if v.name == job[1])
     key = {"cell": list(job[:6]), "options": {k: list(v) if isinstance(v, tuple) else v
                                               for k, v in variant.options.items()},
            "n_impacts": N_IMPACTS}
     return runs.memo("restitution_map_cell", key, lambda: measure_cell(job),
-                     label=f"{job[0]} {job[1]} {job[2]}", code=ALL_CODE)
+                     label=f"{job[0]} {job[1]} {job[2]}", code=CELL_CODE)
 
 
 def passes(cell: dict) -> bool:

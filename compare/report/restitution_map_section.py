@@ -13,7 +13,7 @@ from pathlib import Path
 __all__ = ["restitution_map_html", "stored_restitution_map_section"]
 
 _COLS = (("engine", "engine"), ("variant", "variant"), ("scene", "scene"),
-         ("equation", "equation"), ("r_ratio", "r_eff/r_H"), ("r_worst", "worst impact [%]"),
+         ("equation", "equation"), ("n_impacts", "impacts"), ("r_ratio", "r_eff/r_H"), ("r_worst", "worst impact [%]"),
          ("thr_error", "threshold error [%]"), ("cpu_s", "CPU s"))
 
 
