@@ -29,12 +29,17 @@ SETTINGS_DIR = _DOCS / "validation" / "settings" / "restitution-map"
 FIGURE_DIR = _DOCS / "figures" / "restitution-map"
 
 
+def _fin(x) -> bool:
+    """A finite number (the stored JSON holds NaN as null)."""
+    return x is not None and math.isfinite(x)
+
+
 def _pct(x, digits: int = 2) -> str:
-    return "-" if x is None or not math.isfinite(x) else f"{100 * x:+.{digits}f}"
+    return f"{100 * x:+.{digits}f}" if _fin(x) else "-"
 
 
 def _range_text(values) -> str:
-    vals = [v for v in values if v is not None and math.isfinite(v)]
+    vals = [v for v in values if _fin(v)]
     return "-" if not vals else f"{min(vals):.4f}-{max(vals):.4f}"
 
 
@@ -69,18 +74,19 @@ def render_map(doc: dict) -> str:
             vc = [c for c in mine if c["variant"] == variant]
             blocks = [c for c in vc if c["scene"].startswith("block")]
             tri = {c["scene"]: c for c in vc if not c["scene"].startswith("block")}
-            worst_t = max((c["thr_error"] for c in blocks if math.isfinite(c["thr_error"])),
+            worst_t = max((c["thr_error"] for c in blocks if _fin(c["thr_error"])),
                           key=abs, default=math.nan)
-            worst_r = max((c["r_worst"] for c in blocks if math.isfinite(c["r_worst"])),
+            worst_r = max((c["r_worst"] for c in blocks if _fin(c["r_worst"])),
                           default=math.nan)
-            tri_r = " / ".join(f"{tri[s]['r_ratio']:.4f}" if s in tri else "-"
+            tri_r = " / ".join(f"{tri[s]['r_ratio']:.4f}" if s in tri and _fin(tri[s]["r_ratio"])
+                               else "-"
                                for s in ("fig5_eq20", "fig5_eq19"))
             tri_t = " / ".join(_pct(tri[s]["thr_error"]) if s in tri else "-"
                                for s in ("fig5_eq20", "fig5_eq19"))
             cost = math.fsum(c["cpu_s"] for c in vc)
             fewest = min(vc, key=lambda c: c["n_impacts"])
             lines.append(f"| {variant} | {_range_text(c['r_ratio'] for c in blocks)} | "
-                         f"{100 * worst_r:.2f} | {fewest['n_impacts']}/{doc['n_impacts']}"
+                         f"{_pct(worst_r)[1:]} | {fewest['n_impacts']}/{doc['n_impacts']}"
                          + ("" if fewest["complete"] else f" ({fewest['scene']})")
                          + f" | {_pct(worst_t)} | {tri_r} | {tri_t} | {cost:.1f} |")
         picks = [p for p in doc["cheapest"] if p["engine"] == engine]

@@ -31,8 +31,10 @@ def engine_figure(doc: dict, engine: str):
     for variant in dict.fromkeys(c["variant"] for c in cells):
         mine = sorted((c for c in cells if c["variant"] == variant), key=lambda c: c["lam"])
         lam = [c["lam"] for c in mine]
-        ax_r.plot(lam, [c["r_ratio"] for c in mine], marker="o", ms=3, label=variant)
-        ax_t.plot(lam, [100 * c["thr_error"] if math.isfinite(c["thr_error"]) else math.nan
+        ax_r.plot(lam, [c["r_ratio"] if c["r_ratio"] is not None else math.nan for c in mine],
+                  marker="o", ms=3, label=variant)
+        # The stored JSON holds NaN as null.
+        ax_t.plot(lam, [100 * c["thr_error"] if c["thr_error"] is not None else math.nan
                         for c in mine], marker="o", ms=3, label=variant)
     ax_r.set(xlabel="lam = h/b [-]", ylabel="r_eff / r_H [-]",
              title=f"{engine}: restitution (mean of {doc['n_impacts']} impacts)")
