@@ -182,22 +182,33 @@ def measure_cell(job: tuple) -> dict:
     variant = next(v for v in GRIDS[engine] if v.name == variant_name)
     scene = cell_scene(scene_name)
     c0 = time.process_time()
-    res = measure_restitution(engine, scene, n_impacts=N_IMPACTS, **variant.options)
-    ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
-    r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
     out = {"engine": engine, "variant": variant_name, "scene": scene_name, "lam": scene.lam,
-           "equation": res.equation, "n_impacts": res.n_impacts, "complete": res.complete,
-           "r_ratio": math.fsum(ratios) / len(ratios) if ratios else math.nan,
-           "r_worst": res.max_rel_error, "r_status": res.status, "r_cpu_s": r_cpu,
-           "omega": w, "a_model": a_model, "mode_model": mode}
+           "omega": w, "a_model": a_model, "mode_model": mode, "error": None}
+    # An engine that fails a run (Drake's SAP not converging) fails its cell, not
+    # the map: the cell is kept with the engine's message and counts as failing.
+    try:
+        res = measure_restitution(engine, scene, n_impacts=N_IMPACTS, **variant.options)
+        ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
+        r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
+        out.update(equation=res.equation, n_impacts=res.n_impacts, complete=res.complete,
+                   r_ratio=math.fsum(ratios) / len(ratios) if ratios else math.nan,
+                   r_worst=res.max_rel_error, r_status=res.status, r_cpu_s=r_cpu)
+    except RuntimeError as exc:
+        out.update(equation=None, n_impacts=0, complete=False, r_ratio=math.nan,
+                   r_worst=math.nan, r_status="error", r_cpu_s=math.nan,
+                   error=f"free rocking: {str(exc).splitlines()[0]}")
+    out.update(a_engine=math.nan, a_survives=math.nan, thr_error=math.nan,
+               mode_engine=None, thr_runs=0, thr_cpu_s=0.0)
     if math.isfinite(a_model):
-        spec = threshold_spec(engine, scene, w, a_model, options=dict(variant.options))
-        p = engine_threshold(engine, scene, w, a_model, spec.settings, mode_reference=mode)
-        out.update(a_engine=p.a_engine, a_survives=p.a_survives, thr_error=p.rel_error,
-                   mode_engine=p.mode_engine, thr_runs=p.n_runs, thr_cpu_s=p.cpu_s)
-    else:
-        out.update(a_engine=math.nan, a_survives=math.nan, thr_error=math.nan,
-                   mode_engine=None, thr_runs=0, thr_cpu_s=0.0)
+        try:
+            spec = threshold_spec(engine, scene, w, a_model, options=dict(variant.options))
+            p = engine_threshold(engine, scene, w, a_model, spec.settings, mode_reference=mode)
+            out.update(a_engine=p.a_engine, a_survives=p.a_survives, thr_error=p.rel_error,
+                       mode_engine=p.mode_engine, thr_runs=p.n_runs, thr_cpu_s=p.cpu_s)
+        except RuntimeError as exc:
+            out["error"] = "; ".join(filter(None, (out["error"], "threshold: "
+                                                   + str(exc).splitlines()[0])))
+    r_cpu = out["r_cpu_s"]
     out["cpu_s"] = (r_cpu if math.isfinite(r_cpu) else 0.0) + float(out["thr_cpu_s"])
     out["cpu_s_spent"] = time.process_time() - c0
     return out
