@@ -95,6 +95,10 @@ def render_map(doc: dict) -> str:
                                               else "none passes")
                          for p in picks)
         lines += ["", f"Cheapest passing: {text}.", ""]
+        raised = [c for c in mine if c.get("error")]
+        if raised:
+            lines += ["Runs that raised (the cell fails): " + "; ".join(
+                f"{c['variant']} on {c['scene']}: {c['error']}" for c in raised) + ".", ""]
     if doc.get("not_exposed"):
         lines += ["Not exposed as settings: " + "; ".join(
             f"{e}: {t}" for e, t in doc["not_exposed"].items()) + "."]
