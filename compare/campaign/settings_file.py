@@ -97,6 +97,9 @@ def _checked_tables(doc: dict, where: str) -> dict[str, dict]:
                              f"{', '.join(known)}")
         if not isinstance(table, dict):
             raise ValueError(f"{where}: [{name}] must be a table of settings")
+        # A TOML array is a list; the Settings' sequence fields (MuJoCo's solimp)
+        # are tuples, as frozen dataclasses keep them hashable.
+        table = {k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}
         for key, value in table.items():
             if key in RUN_FIELDS:
                 raise ValueError(f"{where}: [{name}] {key} is set by each command for its "
@@ -145,6 +148,9 @@ def settings_toml(engine: str, options: dict, comment: str = "") -> str:
             text = repr(value)
         elif isinstance(value, str):
             text = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        elif isinstance(value, (tuple, list)) and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) for x in value):
+            text = "[" + ", ".join(repr(x) for x in value) + "]"
         else:
             raise TypeError(f"setting {key!r}: cannot write a {type(value).__name__}")
         lines.append(f"{key} = {text}")

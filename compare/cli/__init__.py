@@ -2,5 +2,5 @@
 
 ``COMMANDS`` lists them in help order.
 """
-COMMANDS = ("simulate", "restitution", "spectrum", "figures", "report", "bench", "view",
+COMMANDS = ("simulate", "restitution", "restitution_map", "spectrum", "figures", "report", "bench", "view",
             "record", "map", "scenes", "campaign", "calibrate", "atlas", "fragility", "trust", "cache")

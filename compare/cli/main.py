@@ -135,7 +135,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict]:
     for name in COMMANDS:
         module = importlib.import_module(f"trilith_xval.compare.cli.{name}")
         module.add_parser(sub)
-        modules[name] = module
+        modules[name.replace("_", "-")] = module  # the command's name on the line
     return parser, modules
 
 

@@ -209,6 +209,9 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
         body += ["<h2>Runs that raised</h2>", tables.table(tables.HEADERS["errors"], tables.error_rows(doc))]
     from trilith_xval.compare.report.atlas_page import stored_atlas_section
     body.append(stored_atlas_section())
+    from trilith_xval.compare.report.restitution_map_section import (
+        stored_restitution_map_section)
+    body.append(stored_restitution_map_section())
     s_head, s_rows = tables.settings_rows(doc)
     body += ["<h2>Engine settings</h2>", tables.table(s_head, s_rows),
              "<h2>Provenance</h2>", tables.table(tables.HEADERS["provenance"], tables.provenance_rows(doc)),

@@ -1,0 +1,75 @@
+"""The HTML report's restitution-map section, from the stored map
+(``docs/validation/restitution_map.json``, measured by ``trilith restitution-map``,
+not by the report's own campaign): a table of every cell and one figure per
+engine (:mod:`compare.report.restitution_map_plot`)."""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+from pathlib import Path
+
+__all__ = ["restitution_map_html", "stored_restitution_map_section"]
+
+_COLS = (("engine", "engine"), ("variant", "variant"), ("scene", "scene"),
+         ("equation", "equation"), ("n_impacts", "impacts"), ("r_ratio", "r_eff/r_H"), ("r_worst", "worst impact [%]"),
+         ("thr_error", "threshold error [%]"), ("cpu_s", "CPU s"))
+
+
+def _cell(key: str, value) -> str:
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return "-"
+        if key in ("r_worst", "thr_error"):
+            return f"{100 * value:+.2f}"
+        return f"{value:.4f}" if key == "r_ratio" else f"{value:.2f}"
+    return "-" if value is None else str(value)
+
+
+def _figure_data(doc: dict, engine: str) -> str:
+    import matplotlib.pyplot as plt
+    from trilith_xval.compare.report.restitution_map_plot import engine_figure
+    fig = engine_figure(doc, engine)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def restitution_map_html(doc: dict, figures: bool = True) -> str:
+    """The section: heading, how it was measured, the cheapest settings, the
+    figures (``figures``) and the table of cells."""
+    from trilith_xval.compare.report.restitution_map_doc import settings_name
+    esc = html.escape
+    picks = "".join(
+        f"<li>{esc(p['engine'])} {esc(p['range'])}: "
+        + (f"<code>{esc(p['variant'])}</code> ({p['cpu_s']:.1f} CPU s, "
+           f"<code>{esc(settings_name(p))}</code>)" if p["variant"] else "none passes")
+        + "</li>" for p in doc["cheapest"])
+    imgs = "".join(f'<img alt="restitution map {esc(e)}" src="data:image/png;base64,'
+                   f'{_figure_data(doc, e)}">' for e in doc["engines"]) if figures else ""
+    head = "".join(f"<th>{esc(t)}</th>" for _, t in _COLS)
+    rows = "".join("<tr>" + "".join(f"<td>{esc(_cell(k, c.get(k)))}</td>" for k, _ in _COLS)
+                   + "</tr>" for c in doc["cells"])
+    return ("<h2 id='restitution-map'>Restitution map</h2>"
+            f"<p>Per engine and settings variant: r_eff / r_H (mean of the first "
+            f"{doc['n_impacts']} free-rocking impacts, measured / Eq. 20 or Eq. 19) and the "
+            f"one-sine threshold error at Omega = {doc['omega_ratio']:g} p, on the block "
+            f"family and the fig5 trilith. Pass: every impact within "
+            f"{100 * doc['r_tol']:g} %, threshold within {100 * doc['thr_tol']:g} % "
+            f"(docs/restitution-map.md).</p><p>Cheapest passing settings:</p><ul>{picks}</ul>"
+            f"{imgs}<table><tr>{head}</tr>{rows}</table>")
+
+
+def stored_restitution_map_section(path=None, figures: bool = True) -> str:
+    """The section from the stored map; a line saying it is missing when there is none."""
+    from trilith_xval.compare.report.restitution_map_doc import STORED, read_map
+    p = Path(path) if path is not None else STORED
+    if not p.is_file():
+        return ("<h2 id='restitution-map'>Restitution map</h2><p>No stored map "
+                f"(<code>{html.escape(p.name)}</code>); <code>trilith restitution-map --json "
+                "docs/validation/restitution_map.json</code> measures it.</p>")
+    return ("<p class='small'>From the stored map <code>docs/validation/restitution_map.json"
+            "</code> (measured separately from this report's campaign).</p>"
+            + restitution_map_html(read_map(p), figures))
