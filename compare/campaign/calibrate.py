@@ -42,6 +42,7 @@ import os
 from dataclasses import dataclass, field
 
 from trilith_xval.analytic._workers import cpu_seconds
+from trilith_xval.compare.run.spec import RunSpec
 
 __all__ = ["METRICS", "ValidationSet", "Evaluation", "Calibration", "calibrate",
            "default_space", "default_tolerance", "pareto_front"]
@@ -203,8 +204,10 @@ def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
         cases.append((f"lam {scene.lam:g} mu {scene.mu:g} gamma {scene.gamma:g}", scene))
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for label, sc in cases:
-        r = measure_restitution(engine, sc, n_impacts=vs.n_impacts, restitution_factor=rf,
-                                **options)
+        run = RunSpec.resolve(engine, sc, overrides=options,
+                              overrides_from="the candidate settings")
+        r = measure_restitution(engine, sc, settings=run.settings, n_impacts=vs.n_impacts,
+                                restitution_factor=rf)
         errors.append((label, r.max_rel_error if r.complete else math.nan))
         engine_cpu += r.diagnostics["cpu_time"]
         simulated += r.diagnostics["steps"] * r.settings["dt"]
@@ -215,7 +218,6 @@ def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
 def _thresholds(engine, scene, reference, options, workers):
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
-    from trilith_xval.compare.run.spec import RunSpec
     run = RunSpec.resolve(engine, scene, Still(), overrides=options,
                           overrides_from="the candidate settings")
     es = engine_spectrum(run, reference, workers=workers)
@@ -244,7 +246,9 @@ def _histories(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
             pulse = point_pulse(point)
             model = {} if rf == 1.0 else {"restitution_factor": rf}
             ref = engines.simulate("analytic", sc, pulse, **model)
-            test = engines.simulate(engine, sc, pulse, **options)
+            test = engines.simulate(engine, sc, pulse, RunSpec.resolve(
+                engine, sc, pulse, overrides=options,
+                overrides_from="the candidate settings").settings)
             c = compare_trajectories(ref, test)
             err = c.theta_rms_first if c.verdict_agrees else 1.0
             label = f"{point} {'pendulum' if sc.has_pendulum else 'no pendulum'}"

@@ -179,6 +179,7 @@ def measure_cell(job: tuple) -> dict:
     from trilith_xval.compare.measure.engine_spectrum import threshold_spec
     from trilith_xval.compare.measure.restitution import measure_restitution
     from trilith_xval.compare.measure.thresholds import engine_threshold
+    from trilith_xval.compare.run.spec import RunSpec
     variant = next(v for v in GRIDS[engine] if v.name == variant_name)
     scene = cell_scene(scene_name)
     c0 = time.process_time()
@@ -187,7 +188,9 @@ def measure_cell(job: tuple) -> dict:
     # An engine that fails a run (Drake's SAP not converging) fails its cell, not
     # the map: the cell is kept with the engine's message and counts as failing.
     try:
-        res = measure_restitution(engine, scene, n_impacts=N_IMPACTS, **variant.options)
+        run = RunSpec.resolve(engine, scene, overrides=dict(variant.options),
+                              overrides_from=f"the variant {variant.name}")
+        res = measure_restitution(engine, scene, settings=run.settings, n_impacts=N_IMPACTS)
         ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
         r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
         out.update(equation=res.equation, n_impacts=res.n_impacts, complete=res.complete,
