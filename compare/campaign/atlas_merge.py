@@ -100,11 +100,18 @@ def merge_atlases(docs: list[dict], names: list[str] | None = None) -> dict:
                 raise ValueError(f"engine {engine!r} is in both {seen[engine]} and {name}")
             seen[engine] = name
     engines = list(seen)
+    # The engines' consensus where the model is invalid (a pass of its own,
+    # atlas_consensus) comes from the first file that has one, whatever its place.
+    agreed = next((doc for doc in docs if doc.get("consensus")), None)
     points = []
     for i, pt in enumerate(first["points"]):
         rows = {e: r for doc in docs for e, r in doc["points"][i]["engines"].items()
                 if e in doc["steps"]}
-        points.append({**pt, "engines": {e: rows[e] for e in engines}})
+        point = {k: v for k, v in pt.items() if k not in ("consensus", "own")}
+        if agreed is not None:
+            point.update({k: agreed["points"][i][k] for k in ("consensus", "own")
+                          if k in agreed["points"][i]})
+        points.append({**point, "engines": {e: rows[e] for e in engines}})
     parts = [part for doc in docs for part in _parts_of(doc)]
     loads = [x for part in parts for x in (part.get("load_average") or [])]
     from trilith_xval.engines import engine_names
@@ -124,7 +131,8 @@ def merge_atlases(docs: list[dict], names: list[str] | None = None) -> dict:
             "load_average": [min(loads), max(loads)] if loads else None,
             "workers": sorted({part.get("workers") for part in parts
                                if part.get("workers") is not None}),
-            "budget_s": None}
+            "budget_s": None,
+            **({"consensus": agreed["consensus"]} if agreed is not None else {})}
 
 
 def select_engines(doc: dict, engines) -> dict:

@@ -148,3 +148,25 @@ def test_atlas_diff_counts_cause_changes_per_engine_and_step():
     assert sum(r["changed"] for r in rows.values()) == changed
     assert "-> contact" in markdown(list(rows.values())) or "-> unknown" in markdown(
         list(rows.values()))
+
+
+def test_a_join_keeps_the_consensus_of_the_part_that_has_one():
+    """The engines' consensus where the model is invalid survives a join, whichever
+    part carried it (a remeasured engine part is often joined first)."""
+    import json
+
+    from trilith_xval.compare.campaign.atlas_merge import merge_atlases, select_engines
+    from tests.support.paths import ROOT
+    stored = json.loads((ROOT / "docs" / "validation" / "atlas.json").read_text())
+    if not stored.get("consensus"):
+        pytest.skip("the stored atlas carries no consensus")
+    engines = list(stored["steps"])
+    one, rest = select_engines(stored, engines[:1]), select_engines(stored, engines[1:])
+    rest = {**rest, "consensus": None,
+            "points": [{k: v for k, v in p.items() if k not in ("consensus", "own")}
+                       for p in rest["points"]]}
+    for order in ((one, rest), (rest, one)):
+        joined = merge_atlases(list(order), ["a", "b"])
+        assert joined["consensus"] == stored["consensus"]
+        assert [p.get("consensus") for p in joined["points"]] == \
+            [p.get("consensus") for p in stored["points"]]
