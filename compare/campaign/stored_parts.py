@@ -97,6 +97,8 @@ def load_stored(path, scene, config) -> tuple[dict | None, str]:
             "rel_tol", "spectrum_cases", "jump_cases", "engine_dt", "engine_settings")
     ours = config.to_dict()
     theirs = doc.get("config") or {}
+    if doc.get("sources"):  # a default report's summary: its points are partly stored already
+        return None, "the stored run is itself a default report, not a full run"
     if doc.get("quick") or any(theirs.get(k) != ours.get(k) for k in grid):
         return None, "the stored run used another threshold grid or other settings"
     theirs_scene = doc.get("scene") or {}
