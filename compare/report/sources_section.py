@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from html import escape as esc
 
-__all__ = ["sources_html", "sources_markdown"]
+__all__ = ["sources_banner", "sources_html", "sources_markdown"]
 
 
 def _origin(src: dict | None) -> str:
@@ -31,6 +31,19 @@ def _pct(x) -> str:
 
 def _num(x) -> str:
     return "—" if x is None else f"{float(x):.4g}"
+
+
+def sources_banner(doc: dict) -> str:
+    """One line above the trust table of a default report (empty otherwise), so
+    no reader takes the stored parts for numbers measured now."""
+    src = doc.get("sources")
+    if not src:
+        return ""
+    from trilith_xval.compare.campaign.stored_parts import failures, summary_line
+    bad = failures(src)
+    return ("<p class='banner'>Default report: " + esc(summary_line(src)) + ". <a href="
+            "'#sources'>Recomputed and stored parts</a> says which number came from where."
+            + "".join(f"<br>{esc(line)}" for line in bad) + "</p>")
 
 
 def sources_html(doc: dict) -> str:

@@ -139,6 +139,10 @@ def test_the_page_and_json_label_what_is_stored(default_run, tmp_path, no_validi
     assert "Recomputed and stored parts" in page and "docs/validation/summary.json" in page
     assert doc["sources"]["stored_run"]["commit"][:12] in page
     assert "engine_spectrum_drake.json" in page and "DISAGREES" in page
+    # one line above the trust table, the section after it (the first screen stays the table)
+    assert page.index("Default report:") < page.index("<h2>Trust table</h2>") < page.index(
+        "id='sources'")
+    assert "re-verification failed: drake" in page.split("<h2>Trust table</h2>")[0]
     md = paths["md"].read_text()
     assert "re-verification failed: drake" in md
 
