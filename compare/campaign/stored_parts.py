@@ -143,15 +143,20 @@ def _spectrum_file(engine: str) -> Path:
     return VALIDATION / f"engine_spectrum_{engine}.json"
 
 
-def reverify_jobs(engines) -> list[tuple]:
-    """``(engine, stored point, source)`` per engine with a stored spectrum: its
-    :data:`REVERIFY_CASE` point nearest :data:`REVERIFY_OMEGA`."""
+def reverify_jobs(engines, scene=None) -> list[tuple]:
+    """``(engine, stored point, source)`` per engine with a stored spectrum of
+    ``scene`` (default: any): its :data:`REVERIFY_CASE` point nearest
+    :data:`REVERIFY_OMEGA`."""
+    from trilith_xval.compare.run.keys import scene_dict
     jobs = []
     for engine in engines:
         path = _spectrum_file(engine)
         if not path.is_file():
             continue
         doc = json.loads(path.read_text())
+        theirs = (doc.get("inputs") or {}).get("scene") or {}
+        if scene is not None and any(theirs.get(k) != v for k, v in scene_dict(scene).items()):
+            continue  # a spectrum of another scene says nothing of this one
         curve = doc["engines"][engine]["curves"][REVERIFY_CASE]
         point = min(curve, key=lambda p: abs(float(p["omega"]) - REVERIFY_OMEGA))
         jobs.append((engine, point, source_of(path)))
@@ -246,7 +251,8 @@ def merge(result, stored: dict | None, source: dict | None, recomputed: dict,
     reverified = list(reverified)
     done = {r["engine"] for r in reverified}
     for engine in result.config.engines:  # a job that raised is a failed re-verification
-        if result.config.reverify and engine not in done and _spectrum_file(engine).is_file():
+        if (result.config.reverify and engine not in done
+                and reverify_jobs([engine], result.scene)):
             reverified.append({"engine": engine, "case": REVERIFY_CASE, "omega": REVERIFY_OMEGA,
                                "passed": False, "tolerance": REVERIFY_TOL,
                                "error": "not measured (the run raised: see errors)",

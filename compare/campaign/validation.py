@@ -319,7 +319,7 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
                 jobs.append(("restitution", (name, scene.replace(lam=lam), config)))
                 labels.append(("restitution", True, name))
 
-    for name, point, src in (stored_parts.reverify_jobs(config.engines) if config.reverify
+    for name, point, src in (stored_parts.reverify_jobs(config.engines, scene) if config.reverify
                              else []):
         jobs.append(("reverify", (name, scene, point, src)))
         labels.append(("reverify", True, name))

@@ -55,6 +55,9 @@ def test_the_stored_run_is_refused_for_another_grid_or_scene():
     _, why = stored_parts.load_stored(STORED, scene.replace(lam=4.0),
                                       CampaignConfig.default_report())
     assert "scene" in why
+    # nor is a stored engine spectrum re-measured on another scene
+    assert stored_parts.reverify_jobs(["pymunk"], scene.replace(lam=4.0)) == []
+    assert len(stored_parts.reverify_jobs(["pymunk"], scene)) == 1
 
 
 @pytest.fixture(scope="module")
