@@ -50,7 +50,8 @@ def measure(extra: list[str], name: str, label: str) -> tuple[int, dict]:
                "cpu_s": cpu, "wall_s": wall,
                # largest resident set of any process reaped so far (Linux: kB), the
                # report's or a worker's: peak memory per process, not their sum
-               "max_rss_mb": after.ru_maxrss / 1024.0, "load_average": [load0[0], os.getloadavg()[0]],
+               "max_rss_mb": after.ru_maxrss / 1024.0,
+               "load_average": [load0[0], os.getloadavg()[0]],
                "target_cpu_s": TARGET_CPU_S, "target_wall_s": TARGET_WALL_S,
                "met": cpu <= TARGET_CPU_S and wall <= TARGET_WALL_S,
                "verdicts": [sum(bool(v["passed"]) for v in doc.get("verdicts", [])),

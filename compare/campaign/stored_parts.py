@@ -207,7 +207,8 @@ def reverify_message(row: dict) -> str:
         return "none" if a is None else f"{float(a):.4g}"
     diff = row["rel_difference"]
     return (f"re-verification failed: {row['engine']} {row['source']['file']} "
-            f"({row['case']}, Omega = {row['omega']:g} rad/s): stored a_engine {fmt(row['a_stored'])}"
+            f"({row['case']}, Omega = {row['omega']:g} rad/s): stored a_engine "
+            f"{fmt(row['a_stored'])}"
             f" ({row['mode_stored']}), now {fmt(row['a_now'])} ({row['mode_now']})"
             + ("" if diff is None else f", {100 * diff:+.2f} %")
             + f"; tolerance {100 * row['tolerance']:g} %")
