@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: report test bench figures atlas clean
+.PHONY: report report-full costs test bench figures atlas clean
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -12,8 +12,19 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# The default report: cheap checks and a sample of threshold points now, the rest
+# from docs/validation/ (labelled, re-verified on a sample); minutes on 2 cores.
 report: $(STAMP)
 	$(VENV)/bin/trilith report --out report
+
+# Everything remeasured (~1,300 CPU s on 2 cores: the stored docs/validation/summary.json).
+report-full: $(STAMP)
+	$(VENV)/bin/trilith report --full --out report
+
+# The README's command-cost block, from the stored measurements (make bench with
+# BENCH_STORE=1 stores them).
+costs: $(STAMP)
+	$(PY) -m trilith_xval.compare.report.cost_block docs/validation README.md
 
 # Test files are shared among TEST_WORKERS processes (pytest-xdist), a file's
 # tests on one of them so its module fixtures are computed once.

@@ -81,6 +81,15 @@ class CampaignConfig:
     long_runs: bool = True  # the trust table's long-run line (rest, after a pulse)
     workers: int = 2  # the target machine has 2 cores
     tolerances: Tolerances = Tolerances()
+    # What the default report takes from a stored full run (compare/campaign/stored_parts.py):
+    # None runs everything (report --full); these three choose no number of a job that runs.
+    stored: str | None = None  # a stored summary.json: its other threshold points are shown
+    stored_jobs: tuple[str, ...] = ()  # job kinds shown from ``stored`` instead of run ("jump")
+    reverify: bool = False  # re-measure one point of every stored engine spectrum
+
+    # Fields that only choose which jobs run: left out of job keys, so the default
+    # report and report --full share the run store.
+    SELECTION = ("workers", "stored", "stored_jobs", "reverify")
 
     def __post_init__(self) -> None:
         for name in self.engines:
@@ -108,6 +117,9 @@ class CampaignConfig:
             if case not in ("pendulum", "no_pendulum"):
                 raise ValueError(f"spectrum_cases: unknown case {case!r}; allowed: pendulum, "
                                  "no_pendulum")
+        for kind in self.stored_jobs:
+            if kind != "jump":
+                raise ValueError(f"stored_jobs: unknown job kind {kind!r}; allowed: jump")
         lo, hi = self.omega_range
         if not 0.0 < lo < hi:
             raise ValueError(f"omega_range must satisfy 0 < lo < hi, got {self.omega_range!r}")
@@ -120,8 +132,23 @@ class CampaignConfig:
         base.update(changes)
         return cls(**base)
 
+    @classmethod
+    def default_report(cls, **changes) -> "CampaignConfig":
+        """What ``trilith report`` runs without ``--full``: the full grids, but the
+        threshold points by :func:`compare.campaign.stored_parts.recompute_omegas`
+        and the jump shifts from the stored validation, and its engine spectra
+        re-verified on a sample (minutes on 2 cores instead of ~40)."""
+        from trilith_xval.compare.campaign.stored_parts import STORED_SUMMARY
+        base = dict(stored=str(STORED_SUMMARY), stored_jobs=("jump",), reverify=True)
+        base.update(changes)
+        return cls(**base)
+
     def to_dict(self) -> dict:
         return plain(self)
+
+    def job_key(self) -> dict:
+        """The config as job keys see it (without :attr:`SELECTION`)."""
+        return {k: v for k, v in self.to_dict().items() if k not in self.SELECTION}
 
 
 def engine_options(name: str, config: CampaignConfig, thresholds: bool = False,

@@ -99,8 +99,14 @@ def _job_long_run(name, label, scene_name, amplitude, omega, config):
                     backend_settings(name, config))
 
 
+def _job_reverify(name, scene, point, source):
+    from trilith_xval.compare.campaign.stored_parts import reverify_one
+    return reverify_one(name, scene, point, source)
+
+
 _JOBS = {"history": _job_history, "restitution": free_rocking_restitution,
-         "threshold": _job_threshold, "jump": _job_jump, "long_run": _job_long_run}
+         "threshold": _job_threshold, "jump": _job_jump, "long_run": _job_long_run,
+         "reverify": _job_reverify}
 
 
 def _run_one(item):
@@ -139,8 +145,7 @@ def _own_cost(value, spent: float) -> float:
 def _job_description(item) -> dict:
     kind, args = item
     config = next((a for a in args if isinstance(a, CampaignConfig)), None)
-    described = None if config is None else {k: v for k, v in config.to_dict().items()
-                                             if k != "workers"}
+    described = None if config is None else config.job_key()
     return {"kind": kind, "args": _describe_args(args), "config": described}
 
 
@@ -169,15 +174,29 @@ def _progress(total: int, lines: bool = False):
                 leave=False)
 
 
+# Submission order: the kinds with the longest single jobs first, so the last jobs
+# are short ones and no core idles at the end (measured: the long runs and the
+# re-verifications, submitted last, took the last 30 % of the default report's wall
+# time on one busy core).  Results come back in job order whatever this order.
+_FIRST = ("long_run", "reverify", "threshold", "jump", "restitution", "history")
+
+
 def _execute(jobs: list, workers: int, lines: bool = False) -> list:
     """Run ``jobs`` ((kind, args) pairs); results in job order."""
+    order = sorted(range(len(jobs)), key=lambda i: _FIRST.index(jobs[i][0])
+                   if jobs[i][0] in _FIRST else len(_FIRST))
     bar = _progress(len(jobs), lines)
     try:
-        return list(runs.run_many(_run_one, jobs, workers=workers, lookup=_lookup,
-                                  on_done=None if bar is None else lambda i, r: bar.update()))
+        out = list(runs.run_many(_run_one, [jobs[i] for i in order], workers=workers,
+                                 lookup=_lookup,
+                                 on_done=None if bar is None else lambda i, r: bar.update()))
     finally:
         if bar is not None:
             bar.close()
+    results = [None] * len(jobs)
+    for k, i in enumerate(order):
+        results[i] = out[k]
+    return results
 
 
 def _memo(kind: str, scene, config: CampaignConfig, compute):
@@ -185,8 +204,7 @@ def _memo(kind: str, scene, config: CampaignConfig, compute):
     store, keyed by the scene and the config (but its worker count: no number
     depends on it)."""
     from trilith_xval.compare.run.keys import scene_dict
-    described = {k: v for k, v in config.to_dict().items() if k != "workers"}
-    return runs.memo(kind, {"scene": scene_dict(scene), "config": described}, compute,
+    return runs.memo(kind, {"scene": scene_dict(scene), "config": config.job_key()}, compute,
                      code=runs.ALL_CODE)
 
 
@@ -223,6 +241,7 @@ class CampaignResult:
     long_runs: list = field(default_factory=list)  # compare.measure.long_runs rows
     threshold_settings: dict = field(default_factory=dict)  # engine -> its threshold searches'
     threshold_domain: dict = field(default_factory=dict)  # engine -> calibration domain, inside
+    sources: dict = field(default_factory=dict)  # what was recomputed, what shown from storage
 
     def to_dict(self) -> dict:
         return {"config": self.config.to_dict(), "scene": self.scene.to_dict(),
@@ -231,7 +250,8 @@ class CampaignResult:
                 "spectra": self.spectra, "verdicts": self.verdicts, "timings": self.timings,
                 "errors": self.errors, "long_runs": self.long_runs,
                 "threshold_settings": self.threshold_settings,
-                "threshold_domain": self.threshold_domain}
+                "threshold_domain": self.threshold_domain,
+                **({"sources": self.sources} if self.sources else {})}
 
 
 def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -> CampaignResult:
@@ -268,16 +288,30 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
                    if _case(pend) in (*config.spectrum_cases, *config.jump_cases)}
     result.timings["reference_spectra"] = time.perf_counter() - t0
 
+    # The default report: a sample of threshold points, the rest from the stored run.
+    from trilith_xval.compare.campaign import stored_parts
+    stored_run, source, unused = None, None, ""
+    if config.stored is not None:
+        stored_run, unused = stored_parts.load_stored(config.stored, scene, config)
+        source = stored_parts.source_of(config.stored, (stored_run or {}).get("provenance"))
+    recomputed = {}
     jobs, labels = [], []
     for pend, spec in ref_spectra.items():
         sc = scenes[pend]
         freqs = _memo("frequencies", sc, config, lambda: choose_frequencies(spec, config, sc)) \
             if _case(pend) in config.spectrum_cases else []
-        for omega, a_ref, mode in freqs:
-            for name in config.engines:
-                jobs.append(("threshold", (name, sc, _case(pend), omega, a_ref, mode, config)))
-                labels.append(("threshold", pend, name))
-        if _case(pend) in config.jump_cases and (spec.get("jump") or {}).get("probe_amplitude"):
+        for name in config.engines:
+            wanted = stored_parts.recompute_omegas(stored_run, name, _case(pend),
+                                                   [f[0] for f in freqs])
+            recomputed[(_case(pend), name)] = wanted
+            for omega, a_ref, mode in freqs:
+                if float(omega) in wanted:
+                    jobs.append(("threshold", (name, sc, _case(pend), omega, a_ref, mode,
+                                               config)))
+                    labels.append(("threshold", pend, name))
+        if stored_run is not None and "jump" in config.stored_jobs:
+            pass  # the jump shifts come from the stored run (stored_parts.merge)
+        elif _case(pend) in config.jump_cases and (spec.get("jump") or {}).get("probe_amplitude"):
             jmp = spec["jump"]
             for name in config.engines:
                 jobs.append(("jump", (name, sc, jmp["probe_amplitude"], jmp["omega_lo"],
@@ -299,6 +333,10 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
                 jobs.append(("restitution", (name, scene.replace(lam=lam), config)))
                 labels.append(("restitution", True, name))
 
+    for name, point, src in (stored_parts.reverify_jobs(config.engines, scene) if config.reverify
+                             else []):
+        jobs.append(("reverify", (name, scene, point, src)))
+        labels.append(("reverify", True, name))
     if config.long_runs:
         from trilith_xval.compare.measure.long_runs import LONG_RUNS
         for name in config.engines:
@@ -314,6 +352,7 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
     cpu: dict[str, float] = {}
     spent: dict[str, float] = {}
     n_stored = 0
+    reverified = []
     for label, job, (out, cpu_s, spent_s, stored) in zip(labels, jobs, outputs):
         kind, pend, name = label[:3]
         cpu[f"{kind}:{name}"] = cpu.get(f"{kind}:{name}", 0.0) + cpu_s
@@ -335,6 +374,8 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
             result.long_runs.append(out)
         elif kind == "jump":
             ref_spectra[pend].setdefault("jump_shifts", {})[name] = out.to_dict()
+        elif kind == "reverify":
+            reverified.append(out)
     # Sorted by the key's text (str of the whole item would print every array).
     for (point, pend, name), traj in sorted(result.histories.items(),
                                             key=lambda kv: str(kv[0])):
@@ -345,7 +386,9 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
         result.comparisons.append({"point": point, "pendulum": pend, "backend": name,
                                    **comp.to_dict()})
     result.spectra = {_case(p): s for p, s in ref_spectra.items()}
-    result.verdicts = build_verdicts(result)
+    if config.stored is not None or config.reverify:
+        stored_parts.merge(result, stored_run, source, recomputed, reverified, unused)
+    result.verdicts = stored_parts.annotate(build_verdicts(result), result.sources)
     result.timings.update(cpu_by_job=cpu, spent_by_job=spent, from_store=n_stored,
                           n_jobs=len(jobs), total=time.perf_counter() - t_start,
                           load_average=[load_start, os.getloadavg()[0]])

@@ -74,6 +74,8 @@ def render_markdown(doc: dict) -> str:
         parts.append(f"**Rendered from the stored run `{doc['rendered_from']['file']}` "
                      f"(measured {prov.get('date', 'on an unknown date')}, commit "
                      f"{str(prov.get('commit', 'unknown'))[:12]}): nothing was recomputed.**")
+    from trilith_xval.compare.report.sources_section import sources_markdown
+    parts += sources_markdown(doc)
     parts += [f"{_headline(doc)}.", "## Recommendation",
               "\n".join(f"- {r}" for r in recommendations(doc)),
               "## Which engine to trust", tables.table(header, rows, md=True),
@@ -140,6 +142,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
         items = [img(d, alt) for d, alt in items if d is not None]
         return f"<div class='figs'>{''.join(items)}</div>" if items else ""
 
+    from trilith_xval.compare.report.sources_section import sources_banner, sources_html
     header, rows = tables.trust_rows(doc)
     body = [f"<h1>Which engine to trust: scene <code>{esc(doc['config']['scene'])}</code></h1>"]
     if doc.get("quick"):
@@ -157,6 +160,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              "<div class='reco'><b>Recommendation</b><ul>",
              *(f"<li>{unbroken(esc(line))}</li>" for line in recommendations(doc)),
              "</ul></div>",
+             sources_banner(doc),
              "<h2>Trust table</h2>", tables.table(header, rows),
              f"<p class='small'>{esc(prov.get('date', 'date unknown'))}, commit "
              f"<code>{esc(prov.get('commit', 'unknown')[:12])}</code>; full provenance at the "
@@ -165,6 +169,7 @@ def render_html(doc: dict, histories: dict | None = None, alphas: dict | None = 
              f"<p class='small'>{esc(AGREEMENT_RULE)}</p>",
              *(f"<p class='conclusion'><b>{esc(r['label'])}.</b> "
                f"{unbroken(esc(r['conclusion']))}</p>" for r in doc["trust"].values()),
+             sources_html(doc),
              "<h2>Verdicts</h2>", tables.table(tables.HEADERS["verdicts"], tables.verdict_rows(doc)),
              "<h2>Overturning thresholds</h2>",
              "<p>Engine thresholds (bisection around the model's) on the model's spectra; "

@@ -36,6 +36,7 @@ def test_the_stored_run_is_rendered_with_its_own_numbers(tmp_path, no_work, caps
     (["--from", "{not_summary}"], "summary"),
     (["--from", str(STORED), "--quick"], "--quick cannot apply"),
     (["--from", str(STORED), "--dt", "1e-4"], "--dt cannot apply"),
+    (["--from", str(STORED), "--full"], "--full cannot apply"),
 ])
 def test_bad_input_is_refused_at_the_door(tmp_path, capsys, no_work, argv, message):
     (tmp_path / "bad.json").write_text("{not json")
