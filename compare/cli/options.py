@@ -349,7 +349,7 @@ def run_spec(engine: str, scene, excitation, loaded=None, *, calibrated: bool = 
     from trilith_xval.compare.run.spec import RunSpec
     return RunSpec.resolve(engine, scene, excitation, calibrated=calibrated,
                            file_options=file_options(loaded, engine),
-                           file_name="" if loaded is None else str(loaded.path),
+                           file_name="" if loaded is None else repr(str(loaded.path)),
                            overrides=overrides)
 
 

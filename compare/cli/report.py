@@ -184,9 +184,10 @@ def run(args: argparse.Namespace) -> int:
           f"{time.perf_counter() - t0:.0f} s)", file=sys.stdout)
     detail(f"{workers} workers; engines {', '.join(engines)}")
     from trilith_xval.compare.campaign.stored_parts import failures, summary_line
-    if result.sources:
-        print(summary_line(result.sources))
-    failed = failures(result.sources)
+    sources = getattr(result, "sources", None)  # a full run has none
+    if sources:
+        print(summary_line(sources))
+    failed = failures(sources) if sources else []
     for line in failed:  # a stored value that no longer holds: the report is wrong
         print(line, file=sys.stderr)
     for v in result.verdicts:

@@ -10,6 +10,8 @@ import io
 import math
 from pathlib import Path
 
+from trilith_xval.compare.report.cells import unbroken
+
 __all__ = ["restitution_map_html", "stored_restitution_map_section"]
 
 _COLS = (("engine", "engine"), ("variant", "variant"), ("scene", "scene"),
@@ -50,7 +52,8 @@ def restitution_map_html(doc: dict, figures: bool = True) -> str:
     imgs = "".join(f'<img alt="restitution map {esc(e)}" src="data:image/png;base64,'
                    f'{_figure_data(doc, e)}">' for e in doc["engines"]) if figures else ""
     head = "".join(f"<th>{esc(t)}</th>" for _, t in _COLS)
-    rows = "".join("<tr>" + "".join(f"<td>{esc(_cell(k, c.get(k)))}</td>" for k, _ in _COLS)
+    rows = "".join("<tr>" + "".join(f"<td>{unbroken(esc(_cell(k, c.get(k))))}</td>"
+                                    for k, _ in _COLS)
                    + "</tr>" for c in doc["cells"])
     return ("<h2 id='restitution-map'>Restitution map</h2>"
             f"<p>Per engine and settings variant: r_eff / r_H (mean of the first "
@@ -59,7 +62,7 @@ def restitution_map_html(doc: dict, figures: bool = True) -> str:
             f"family and the fig5 trilith. Pass: every impact within "
             f"{100 * doc['r_tol']:g} %, threshold within {100 * doc['thr_tol']:g} % "
             f"(docs/restitution-map.md).</p><p>Cheapest passing settings:</p><ul>{picks}</ul>"
-            f"{imgs}<table><tr>{head}</tr>{rows}</table>")
+            f"{imgs}<div class='scroll'><table><tr>{head}</tr>{rows}</table></div>")
 
 
 def stored_restitution_map_section(path=None, figures: bool = True) -> str:

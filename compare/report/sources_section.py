@@ -91,15 +91,15 @@ def sources_html(doc: dict) -> str:
         "(<code>make report-full</code>) remeasures everything.</p>",
         f"<p class='small'>Stored run: {esc(_origin(run)) if run else 'none used'}"
         + (f" — not used: {esc(unused)}" if unused else "") + ".</p>",
-        f"<table><tr><th>part</th><th>source</th></tr>{table}</table>",
+        f"<div class='scroll'><table><tr><th>part</th><th>source</th></tr>{table}</table></div>",
         f"<p class='small'>Threshold sample rule: {esc(rules.get('thresholds', ''))}</p>",
         "<h3>Stored engine spectra, re-verified now</h3>",
         f"<p class='small'>{esc(rules.get('reverify', ''))}. A disagreement fails the "
         "report (exit code 1).</p>",
-        "<table><tr><th>engine</th><th>curve</th><th>Ω [rad/s]</th><th>a stored [m/s²]</th>"
+        "<div class='scroll'><table><tr><th>engine</th><th>curve</th><th>Ω [rad/s]</th><th>a stored [m/s²]</th>"
         "<th>a now [m/s²]</th><th>mode stored / now</th><th>dt stored / now [s]</th>"
         "<th>difference</th><th></th></tr>"
-        f"{rv_rows}</table>"])
+        f"{rv_rows}</table></div>"])
 
 
 def sources_markdown(doc: dict) -> list[str]:

@@ -149,7 +149,7 @@ def test_a_friction_given_below_the_no_sliding_bound_is_refused_at_the_door(
     assert main(COMMANDS[command] + ["--settings", str(path)]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and "friction must be >=" in err[0], err
-    assert f"(from --settings {path})" in err[0]
+    assert f"(from --settings {str(path)!r})" in err[0]
 
 
 def test_a_friction_given_above_the_bound_is_kept_as_given(tmp_path, capsys):
