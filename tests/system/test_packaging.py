@@ -116,8 +116,11 @@ def _fresh_env(tmp: Path, wheel: Path) -> Path:
     site = Path(subprocess.run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                                capture_output=True, text=True, check=True).stdout.strip())
     (site / "borrowed_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    # --force-reinstall: the borrowed site-packages hold the checkout's editable
+    # install of the same version, which pip would otherwise take as installed.
     proc = subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps",
-                           "--no-index", "-q", str(wheel)], capture_output=True, text=True)
+                           "--no-index", "--force-reinstall", "-q", str(wheel)],
+                          capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return env
 
