@@ -115,12 +115,17 @@ def _fresh_env(tmp: Path, wheel: Path) -> Path:
     py = env / "bin" / "python"
     site = Path(subprocess.run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
                                capture_output=True, text=True, check=True).stdout.strip())
-    (site / "borrowed_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
-    # --force-reinstall: the borrowed site-packages hold the checkout's editable
-    # install of the same version, which pip would otherwise take as installed.
+    # The dependencies only: every entry of the running site-packages but the
+    # checkout's own (editable) install, whose metadata would make pip take the
+    # wheel as installed already and whose finder maps the checkout's folders.
+    borrowed = tmp / "borrowed"
+    borrowed.mkdir()
+    for entry in Path(sysconfig.get_paths()["purelib"]).iterdir():
+        if not entry.name.lower().startswith(("trilith", "__editable__")):
+            (borrowed / entry.name).symlink_to(entry)
+    (site / "borrowed_dependencies.pth").write_text(str(borrowed) + "\n")
     proc = subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps",
-                           "--no-index", "--force-reinstall", "-q", str(wheel)],
-                          capture_output=True, text=True)
+                           "--no-index", "-q", str(wheel)], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return env
 
