@@ -124,8 +124,13 @@ def _fresh_env(tmp: Path, wheel: Path) -> Path:
         if not entry.name.lower().startswith(("trilith", "__editable__")):
             (borrowed / entry.name).symlink_to(entry)
     (site / "borrowed_dependencies.pth").write_text(str(borrowed) + "\n")
+    # pip's own settings from the environment (a PIP_*/PYTHON* variable another test
+    # or the CI set) must not send the install elsewhere.
+    clean = {k: v for k, v in os.environ.items()
+             if not k.startswith(("PIP_", "PYTHON")) and k != "VIRTUAL_ENV"}
     proc = subprocess.run([sys.executable, "-m", "pip", "--python", str(py), "install", "--no-deps",
-                           "--no-index", "-q", str(wheel)], capture_output=True, text=True)
+                           "--no-index", "-q", str(wheel)], capture_output=True, text=True,
+                          env=clean)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return env
 
