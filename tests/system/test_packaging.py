@@ -164,7 +164,9 @@ def test_an_installed_wheel_answers_like_the_checkout(wheel, tmp_path):
                             f"import {NAME}.engines as e, importlib.util as u; print(e.__file__); "
                             "print([m for m in ('analytic', 'engines', 'compare', 'scenes', "
                             "'benchmarks') if u.find_spec(m)])"],
-                           cwd=work, capture_output=True, text=True, check=True).stdout.split("\n")
+                           cwd=work, capture_output=True, text=True, check=True,
+                           env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+                           ).stdout.split("\n")
     assert where[0].startswith(str(env)), f"imported from {where[0]}, not the installed wheel"
     assert where[1] == "[]", f"the install adds top-level names {where[1]}"
 
