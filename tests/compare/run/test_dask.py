@@ -22,12 +22,19 @@ from tests.support.paths import ROOT
 
 @pytest.fixture(scope="module")
 def cluster():
-    # The workers import compare/ from this checkout.
-    os.environ["PYTHONPATH"] = os.pathsep.join(
-        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, silence_logs=40) as c:
-        yield c
+    # The workers import compare/ from this checkout; put PYTHONPATH back after,
+    # or every later subprocess of the run sees the checkout (the packaging test).
+    before = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [before])])
+    try:
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                      dashboard_address=None, silence_logs=40) as c:
+            yield c
+    finally:
+        if before is None:
+            os.environ.pop("PYTHONPATH", None)
+        else:
+            os.environ["PYTHONPATH"] = before
 
 
 def _jobs(fig5):
