@@ -49,18 +49,20 @@ def table(doc: dict) -> str:
     """The Markdown table of ``docs/measured-impacts.md`` from a stored document."""
     s = doc["summary"]
     m = s["measured"]
-    lines = ["| ratio theta_dot+/theta_dot- | mean | median | std | p10 | p90 "
-             "| RMS error vs measured |",
-             "|---|---|---|---|---|---|---|",
+    lines = ["| ratio theta_dot+/theta_dot- | mean | median | std | p25 | p75 "
+             "| RMS error vs measured | median abs. error |",
+             "|---|---|---|---|---|---|---|---|",
              f"| measured ({s['impacts']} impacts, {s['files_with_impacts']} drops) | "
-             f"{m['mean']:+.3f} | {m['median']:+.3f} | {m['std']:.3f} | {m['p10']:+.3f} | "
-             f"{m['p90']:+.3f} | |",
+             f"{m['mean']:+.3f} | {m['median']:+.3f} | {m['std']:.3f} | {m['p25']:+.3f} | "
+             f"{m['p75']:+.3f} | | |",
              f"| Housner (Eq. 20, mu = gamma = 0) | {s['housner']:+.3f} | | | | | "
-             f"{s['housner_rms_error']:.3f} |"]
+             f"{s['housner_rms_error']:.3f} | {s['housner_median_abs_error']:.3f} |",
+             f"| best single value (the measured mean / median) | | | | | | "
+             f"{s['floor_any_single_value']:.3f} | {s['floor_any_single_value_mad']:.3f} |"]
     for key, e in s["engines"].items():
         lines.append(f"| {key} replaying each impact | {e['mean']:+.3f} | {e['median']:+.3f} | "
-                     f"{e['std']:.3f} | {e['p10']:+.3f} | {e['p90']:+.3f} | "
-                     f"{e['rms_error']:.3f} |")
+                     f"{e['std']:.3f} | {e['p25']:+.3f} | {e['p75']:+.3f} | "
+                     f"{e['rms_error']:.3f} | {e['median_abs_error']:.3f} |")
     return "\n".join(lines)
 
 
@@ -91,6 +93,7 @@ def main(argv: list[str] | None = None) -> int:
            "angle_noise": res["angle_noise"], "rate_noise": noise,
            "frictions": list(impact_measure.FRICTIONS), "rejected": res["rejected"],
            "summary": impact_measure.summarise(res["rows"], res["housner"], noise),
+           "estimator_sensitivity": impact_measure.estimator_sensitivity(args.data),
            "rows": res["rows"], "load_average_start": list(load0)}
     doc["cpu_s"] = time.process_time() - cpu0
     doc["load_average_end"] = list(os.getloadavg())

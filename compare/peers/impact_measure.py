@@ -20,7 +20,8 @@ import numpy as np
 from . import impact_data as data
 from . import impact_replay as replay
 
-__all__ = ["FRICTIONS", "DATA_SOURCE", "measure", "summarise", "files_digest", "engine_key"]
+__all__ = ["FRICTIONS", "DATA_SOURCE", "measure", "summarise", "files_digest", "engine_key",
+           "estimator_sensitivity"]
 
 # The project's engines' default (no sliding: Housner's assumption) and a low
 # coefficient at which the pivots slide as the measured ones do (the data show
@@ -98,9 +99,23 @@ def measure(folder, flt: data.Filter = data.Filter(), engines=replay.ENGINES,
 
 def _stats(x) -> dict:
     x = np.asarray(x, dtype=float)
+    p10, p25, p75, p90 = (float(v) for v in np.percentile(x, [10, 25, 75, 90]))
     return {"n": int(x.size), "mean": float(np.mean(x)), "median": float(np.median(x)),
-            "std": float(np.std(x)), "p10": float(np.percentile(x, 10)),
-            "p90": float(np.percentile(x, 90))}
+            "std": float(np.std(x)), "p10": p10, "p25": p25, "p75": p75, "p90": p90,
+            "mad": float(np.median(np.abs(x - np.median(x))))}
+
+
+def estimator_sensitivity(folder, windows=(3, 5)) -> dict:
+    """The measured ratios' statistics with other fit windows (no engines): how
+    much the stated numbers owe to the 4-frame choice."""
+    trajectories = data.load_folder(folder)
+    offset = data.theta_offset(trajectories)
+    out = {}
+    for w in windows:
+        flt = data.Filter(window=w)
+        ratios = [imp.ratio for tr in trajectories for imp in data.find_impacts(tr, offset, flt)]
+        out[f"window_{w}"] = _stats(ratios) if ratios else {"n": 0}
+    return out
 
 
 def _rms(x) -> float:
@@ -116,8 +131,10 @@ def summarise(rows: list[dict], housner: float, rate_noise: float) -> dict:
 
     ``floor_any_single_value``: the smallest RMS error any model predicting one
     ratio for this square can have, the measured ratios' standard deviation
-    (attained at their mean); ``spread_beyond_noise``: that spread with the
-    estimator's noise taken out in quadrature.
+    (attained at their mean); ``floor_any_single_value_mad``: its robust twin,
+    the smallest median absolute error (attained at the median);
+    ``spread_beyond_noise``: the standard deviation with the estimator's noise
+    taken out in quadrature.
     """
     measured = np.array([r["ratio"] for r in rows])
     before = np.array([abs(r["rate_before"]) for r in rows])
@@ -132,7 +149,10 @@ def summarise(rows: list[dict], housner: float, rate_noise: float) -> dict:
         "ratio_uncertainty_median": float(np.median(unc)),
         "housner": housner,
         "housner_rms_error": _rms(measured - housner),
+        "housner_median_abs_error": float(np.median(np.abs(measured - housner))),
         "floor_any_single_value": spread,
+        "floor_any_single_value_mad": float(np.median(np.abs(measured - np.median(measured)))),
+        "fraction_above_one": float(np.mean(np.abs(measured) > 1.0)),
         "spread_beyond_noise": float(math.sqrt(max(spread ** 2 - float(np.mean(unc ** 2)), 0.0))),
         "rate_before_median": float(np.median(before)),
         "slip_median": float(np.median([abs(r["slip"]) for r in rows])),
@@ -142,6 +162,7 @@ def summarise(rows: list[dict], housner: float, rate_noise: float) -> dict:
         ratio = np.array([r["engines"][key] for r in rows])
         direct = [r["engines_direct"][key] for r in rows if r["engines_direct"][key] is not None]
         out["engines"][key] = {**_stats(ratio), "rms_error": _rms(measured - ratio),
+                               "median_abs_error": float(np.median(np.abs(measured - ratio))),
                                "direct_median": float(np.median(direct)) if direct else None,
                                "direct_n": len(direct)}
     return out
