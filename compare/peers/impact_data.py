@@ -15,8 +15,9 @@ Conventions (those of the dataset's own reader ``ReadData.m``): ``x``
 horizontal, ``z`` up, the ground at ``z = 0``; a body point ``(ox, oz)`` is at
 ``(x + ox cos(th) - oz sin(th), z + ox sin(th) + oz cos(th))`` (``ReadData.m``
 draws ``-x`` and turns the body by ``-th``, which is the same figure mirrored).
-The rate columns are backward differences of the positions at 250 Hz (measured:
-``vth[k] = (th[k] - th[k-1]) * 250`` to 3e-3 rad/s), so only positions are used.
+The rate columns are backward differences of the positions at 250 Hz (from the
+third row on ``vth[k] = (th[k] - th[k-1]) * 250``, and likewise ``vx``, ``vz``),
+so only positions are used.
 
 Impact rule (``ReadData.m``): a frame ``j`` whose centre height is a strict
 local minimum, ``z[j] < z[j-1]`` and ``z[j] < z[j+1]``; this is ReadData's
