@@ -146,6 +146,10 @@ def summarise(rows: list[dict], housner: float, rate_noise: float) -> dict:
         "measured": _stats(measured),
         "fraction_continuing": float(np.mean(measured > 0.0)),
         "fraction_rebounding": float(np.mean(measured <= 0.0)),
+        "continuing_median": float(np.median(measured[measured > 0.0]))
+        if np.any(measured > 0.0) else None,
+        "rebounding_median": float(np.median(measured[measured <= 0.0]))
+        if np.any(measured <= 0.0) else None,
         "ratio_uncertainty_median": float(np.median(unc)),
         "housner": housner,
         "housner_rms_error": _rms(measured - housner),
