@@ -97,3 +97,11 @@ def test_stored_document_is_derived_numbers_with_the_citation(stored):
         assert row["ratio"] == pytest.approx(row["rate_after"] / row["rate_before"], rel=1e-12)
         assert set(row["engines"]) == {m.engine_key(e, mu) for e in ("pymunk", "mujoco")
                                        for mu in m.FRICTIONS}
+
+
+def test_docs_table_is_generated_from_the_stored_json(stored):
+    from benchmarks.impact_measurement import table
+    text = (ROOT / "docs" / "measured-impacts.md").read_text(encoding="utf-8")
+    assert table(stored) in text, (
+        "docs/measured-impacts.md's table differs from docs/validation/impact_measurement.json; "
+        "print it with: python -m benchmarks.impact_measurement --table")
