@@ -12,7 +12,15 @@ from pathlib import Path
 
 from trilith_xval.compare.report.cells import unbroken
 
-__all__ = ["restitution_map_html", "stored_restitution_map_section"]
+__all__ = ["restitution_map_html", "stored_restitution_map_section", "measurements_html"]
+
+# Published measurements of the rocking restitution against Housner's ratio; the
+# citations are in docs/measured-impacts.md, where each is read.
+_CITED = ("ElGawady et al. (EESD 2011): measured restitution about 0.95 of Housner's on "
+          "concrete and 0.67 on rubber at aspect ratio 5 (0.97 on concrete at 3); "
+          "Kalliontzis, Sritharan &amp; Schultz (J. Struct. Eng. 2016): Housner's value "
+          "consistently below the measured one.")
+_MEASURED = Path(__file__).resolve().parents[2] / "docs" / "validation" / "impact_measurement.json"
 
 _COLS = (("engine", "engine"), ("variant", "variant"), ("scene", "scene"),
          ("equation", "equation"), ("n_impacts", "impacts"), ("r_ratio", "r_eff/r_H"), ("r_worst", "worst impact [%]"),
@@ -65,6 +73,25 @@ def restitution_map_html(doc: dict, figures: bool = True) -> str:
             f"{imgs}<div class='scroll'><table><tr>{head}</tr>{rows}</table></div>")
 
 
+def measurements_html(path=None) -> str:
+    """The paragraph that puts the map beside measurements: the cited published
+    factors and, when the stored impact measurement is present, its square-block
+    numbers (``docs/validation/impact_measurement.json``); empty text never."""
+    import json
+    p = Path(path) if path is not None else _MEASURED
+    text = f"<p><b>Beside measurements.</b> {_CITED}"
+    if p.is_file():
+        s = json.loads(p.read_text())["summary"]
+        m = s["measured"]
+        text += (f" Measured square-block drops (MCube data, {s['impacts']} rocking-like "
+                 f"impacts): post/pre angular-velocity ratio median {m['median']:+.2f} "
+                 f"(quartiles {m['p25']:+.2f} to {m['p75']:+.2f}; "
+                 f"{100 * s['fraction_rebounding']:.0f} % rebound onto the other corner) "
+                 f"against Housner's {s['housner']:+.2f}; no single-valued rigid model "
+                 f"closes the measured scatter (RMS {s['floor_any_single_value']:.2f}).")
+    return text + " (docs/measured-impacts.md)</p>"
+
+
 def stored_restitution_map_section(path=None, figures: bool = True) -> str:
     """The section from the stored map; a line saying it is missing when there is none."""
     from trilith_xval.compare.report.restitution_map_doc import STORED, read_map
@@ -75,4 +102,4 @@ def stored_restitution_map_section(path=None, figures: bool = True) -> str:
                 "docs/validation/restitution_map.json</code> measures it.</p>")
     return ("<p class='small'>From the stored map <code>docs/validation/restitution_map.json"
             "</code> (measured separately from this report's campaign).</p>"
-            + restitution_map_html(read_map(p), figures))
+            + restitution_map_html(read_map(p), figures) + measurements_html())

@@ -54,3 +54,16 @@ def test_report_section_renders_every_cell(doc):
     text = restitution_map_html(doc, figures=False)
     assert text.startswith("<h2 id='restitution-map'>")
     assert text.count("<tr>") == len(doc["cells"]) + 1
+
+
+def test_the_map_stands_beside_the_stored_measurement(tmp_path):
+    """The report's measurement paragraph states the stored measured median and
+    Housner's ratio (not typed numbers), and keeps the cited facts without it."""
+    import json
+    from trilith_xval.compare.report.restitution_map_section import measurements_html, _MEASURED
+    s = json.loads(_MEASURED.read_text())["summary"]
+    text = measurements_html()
+    assert f"median {s['measured']['median']:+.2f}" in text
+    assert f"Housner's {s['housner']:+.2f}" in text
+    bare = measurements_html(tmp_path / "absent.json")
+    assert "ElGawady" in bare and "median" not in bare
