@@ -58,6 +58,9 @@ class AtlasConfig:
     rel_tol: float = 4e-3  # final bracket / A_model: a fifth of the tolerance
     tol: float = 0.02  # agreement tolerance (the report's)
     settings: tuple = ()  # (engine, ((field, value), ...)): a settings file's tables
+    # (scene, case, pulse, omega) of the points to measure; empty: every point of the
+    # grid (a restep remeasures some points of a stored atlas, atlas_restep.py).
+    only: tuple = ()
 
     def __post_init__(self) -> None:
         from trilith_xval.engines import ENGINES
@@ -78,7 +81,8 @@ class AtlasConfig:
                 "omegas": list(self.omegas), "factors": list(self.factors),
                 "cases": list(self.cases), "rel_bracket": self.rel_bracket,
                 "rel_tol": self.rel_tol, "tol": self.tol,
-                "settings": {e: dict(o) for e, o in self.settings}}
+                "settings": {e: dict(o) for e, o in self.settings},
+                **({"only": [list(p) for p in self.only]} if self.only else {})}
 
 
 def _default_engines() -> tuple[str, ...]:
@@ -242,6 +246,9 @@ def run_atlas(config: AtlasConfig, workers: int = 1, budget_s: float | None = No
     deadline = None if budget_s is None else t0 + budget_s
     pairs = atlas_scenes(config)
     ref_jobs = [(n, c, p, w) for n, p in pairs for c in config.cases for w in config.omegas]
+    if config.only:
+        wanted = set(config.only)
+        ref_jobs = [job for job in ref_jobs if job in wanted]
     # Four jobs or points per job slot (a local worker or a cluster thread), at least
     # ten; the cluster is asked once.
     size = max(10, 4 * runs.parallel_slots(workers))

@@ -9,7 +9,9 @@ threshold steps are fine enough that their atlas costs hours of CPU (measured in
 docs/atlas.md): name them (``--engine dart,drake`` or ``--engine all``),
 best with ``--time-budget`` or ``--scheduler``.  ``--from FILE`` renders a
 stored atlas without running anything; repeated, it joins atlases of different engines measured separately
-(``compare/campaign/atlas_merge.py``).
+(``compare/campaign/atlas_merge.py``).  ``--restep FILE --engine E`` brings a
+stored atlas measured before the step rule under it: only the points where the
+rule can act are remeasured (``compare/campaign/atlas_restep.py``).
 """
 from __future__ import annotations
 
@@ -44,6 +46,11 @@ def add_parser(subparsers) -> None:
                    help="a stored atlas JSON; run nothing, write it with --html/--json. "
                         "Repeated: one atlas of the engines of every file (measured "
                         "separately, on the same scenes, grid and model)")
+    p.add_argument("--restep", default=None, metavar="FILE",
+                   help="a stored atlas: remeasure, for each --engine, only the points "
+                        "where it failed at a step coarser than its reference step (the "
+                        "step rule's points), carry every other row, and write the whole "
+                        "atlas with --json")
     p.add_argument("--consensus", default=None, metavar="E1,E2[,...]|all",
                    help="also where the model is invalid: each engine's own first-failure "
                         "amplitude, converged in the step, and the engines' consensus (engine "
@@ -88,7 +95,15 @@ def run(args: argparse.Namespace) -> int:
     if consensus is not None and len(consensus) < 2:
         raise ValueError(f"--consensus needs at least two engines to compare, got "
                          f"{args.consensus!r}")
-    if sources is not None:
+    if args.restep is not None:
+        if sources is not None or consensus is not None:
+            raise ValueError("--restep runs alone: not with --from or --consensus")
+        if args.json is None:
+            raise ValueError("--restep writes the whole atlas: give --json FILE")
+        doc = _restep(args)
+        page = _render(doc, args, f"--restep {args.restep!r}")
+        _write_json(args.json, doc)
+    elif sources is not None:
         if args.html is None and args.json is None:
             raise ValueError("--from reads stored atlases: give --html FILE and/or --json FILE")
         from trilith_xval.compare.campaign.atlas_check import read_atlas
@@ -148,6 +163,32 @@ def run(args: argparse.Namespace) -> int:
         info(f"wrote {args.html}")
     _print(doc)
     return 0
+
+
+def _restep(args: argparse.Namespace) -> dict:
+    """The stored atlas ``--restep`` with each ``--engine``'s step-rule points
+    remeasured (compare/campaign/atlas_restep.py)."""
+    from trilith_xval.compare.campaign.atlas import run_atlas
+    from trilith_xval.compare.campaign.atlas_check import read_atlas
+    from trilith_xval.compare.campaign.atlas_restep import (merge_restep, restep_config,
+                                                            rule_points)
+    from trilith_xval.compare.run.provenance import collect
+    if args.engine is None:
+        raise ValueError("--restep needs --engine E[,E...]: the engines to bring under "
+                         "the step rule")
+    doc = read_atlas(args.restep)
+    engines = parse_engine_list(args.engine)
+    plans = [(e, rule_points(doc, e)) for e in engines]  # every engine checked first
+    workers = resolve_workers(args.workers)
+    use_store(args)
+    for engine, points in plans:
+        info(f"restep {engine}: {len(points)} of {len(doc['points'])} points where the "
+             "step rule can act")
+        part = run_atlas(restep_config(doc, engine, points), workers)
+        part["provenance"] = collect(args)
+        part["command"] = part["provenance"]["command"]
+        doc = merge_restep(doc, part, engine)
+    return doc
 
 
 def _with_consensus(doc: dict, engines, workers: int, args) -> dict:
