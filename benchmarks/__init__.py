@@ -13,6 +13,7 @@ import statistics
 import time
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import NamedTuple
 
 OUT = Path(__file__).resolve().parent / "out"
 
@@ -40,6 +41,39 @@ def write(name: str, payload: dict) -> Path:
     path = OUT / f"{name}.json"
     write_text(path, json.dumps(payload, indent=1, allow_nan=False))
     return path
+
+
+class Timed(NamedTuple):
+    """A child command's exit code, output, CPU seconds (user + system of it and
+    the workers it reaped), wall seconds, the 1-min load average before and
+    after, and the largest resident set [MB] of any process reaped so far (the
+    command's or a worker's: peak memory per process, not their sum)."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+    cpu_s: float
+    wall_s: float
+    load_average: list
+    max_rss_mb: float
+
+
+def timed_trilith(argv: list[str], cwd=None, env=None) -> Timed:
+    """Run ``trilith *argv`` as a user does, in a child process (``python -m
+    trilith_xval.compare.cli.main``), and time it: CPU from ``RUSAGE_CHILDREN``
+    (the command and every worker it waited for), wall beside it."""
+    import resource
+    import subprocess
+    import sys
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    load0, t0 = os.getloadavg()[0], time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", *argv],
+                          cwd=cwd, env=env, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return Timed(proc.returncode, proc.stdout, proc.stderr, cpu, wall,
+                 [load0, os.getloadavg()[0]], after.ru_maxrss / 1024.0)
 
 
 def median_time(fn, repeats: int, warm_up: bool = False) -> tuple[object, float]:

@@ -14,14 +14,11 @@ from __future__ import annotations
 
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from . import machine, write
+from . import machine, timed_trilith, write
 
 TARGET_CPU_S = 600.0
 TARGET_WALL_S = 300.0
@@ -35,23 +32,16 @@ def measure(extra: list[str], name: str, label: str) -> tuple[int, dict]:
     with tempfile.TemporaryDirectory(prefix="bench-report-") as tmp:
         out = Path(tmp) / "report"
         argv = ["report", *extra, "--out", str(out), "--cache", str(Path(tmp) / "store")]
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        load0, t0 = os.getloadavg(), time.perf_counter()
-        proc = subprocess.run([sys.executable, "-m", "trilith_xval.compare.cli.main", *argv],
-                              capture_output=True, text=True, check=False)
-        wall = time.perf_counter() - t0
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        proc = timed_trilith(argv)
+        cpu, wall = proc.cpu_s, proc.wall_s
         doc = (json.loads((out / "summary.json").read_text())
                if (out / "summary.json").is_file() else {})
     timings = doc.get("timings") or {}
     payload = {"command": label, "argv": ["trilith", *extra, "(cold: empty run store)"],
                "engines": ENGINES.split(","), "exit_code": proc.returncode,
                "cpu_s": cpu, "wall_s": wall,
-               # largest resident set of any process reaped so far (Linux: kB), the
-               # report's or a worker's: peak memory per process, not their sum
-               "max_rss_mb": after.ru_maxrss / 1024.0,
-               "load_average": [load0[0], os.getloadavg()[0]],
+               "max_rss_mb": proc.max_rss_mb,
+               "load_average": proc.load_average,
                "target_cpu_s": TARGET_CPU_S, "target_wall_s": TARGET_WALL_S,
                "met": cpu <= TARGET_CPU_S and wall <= TARGET_WALL_S,
                "verdicts": [sum(bool(v["passed"]) for v in doc.get("verdicts", [])),
@@ -68,7 +58,7 @@ def measure(extra: list[str], name: str, label: str) -> tuple[int, dict]:
         write_text(STORED / f"{name}.json", json.dumps(payload, indent=1, allow_nan=False))
     print(f"{payload['command']}: {cpu:.1f} CPU s (target <= {TARGET_CPU_S:g}), {wall:.1f} s "
           f"wall (target <= {TARGET_WALL_S:g}): {'met' if payload['met'] else 'MISSED'}; load "
-          f"{load0[0]:.2f} -> {os.getloadavg()[0]:.2f}; exit {proc.returncode}; {path}")
+          f"{proc.load_average[0]:.2f} -> {proc.load_average[1]:.2f}; exit {proc.returncode}; {path}")
     return proc.returncode, payload
 
 

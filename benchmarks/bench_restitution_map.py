@@ -10,14 +10,11 @@ from __future__ import annotations
 
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from . import machine, write
+from . import machine, timed_trilith, write
 
 TARGET_CPU_S = 1800.0
 WORKERS = os.environ.get("BENCH_RMAP_WORKERS", "2")
@@ -27,29 +24,23 @@ def main(argv: list[str] | None = None) -> int:
     from trilith_xval.compare.measure.restitution_map import GRIDS, LAMS, TRILITH
     with tempfile.TemporaryDirectory(prefix="bench-rmap-") as tmp:
         out = Path(tmp) / "map.json"
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        load0, t0 = os.getloadavg(), time.perf_counter()
-        proc = subprocess.run(
-            [sys.executable, "-m", "trilith_xval.compare.cli.main", "restitution-map",
-             "--workers", WORKERS, "--json", str(out), "--cache", str(Path(tmp) / "store"),
-             "-q"], capture_output=True, text=True, check=False)
-        wall = time.perf_counter() - t0
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        if proc.returncode != 0:
-            print(proc.stderr, file=sys.stderr)
+        run = timed_trilith(["restitution-map", "--workers", WORKERS, "--json", str(out),
+                             "--cache", str(Path(tmp) / "store"), "-q"])
+        cpu, wall = run.cpu_s, run.wall_s
+        if run.returncode != 0:
+            print(run.stderr, file=sys.stderr)
             return 1
         doc = json.loads(out.read_text())
     expected = sum(len(v) for v in GRIDS.values()) * (len(LAMS) + len(TRILITH))
     payload = {"command": f"trilith restitution-map --workers {WORKERS} --no-cache",
-               "cpu_s": cpu, "wall_s": wall, "load_average": [load0[0], os.getloadavg()[0]],
+               "cpu_s": cpu, "wall_s": wall, "load_average": run.load_average,
                "target_cpu_s": TARGET_CPU_S, "met": cpu <= TARGET_CPU_S,
                "cells": len(doc["cells"]), "cells_cpu_s": doc["cells_cpu_s"],
                "machine": machine()}
     path = write("restitution_map", payload)
     print(f"restitution map cold: {cpu:.0f} CPU s (target <= {TARGET_CPU_S:g}: "
           f"{'met' if cpu <= TARGET_CPU_S else 'MISSED'}), {wall:.0f} s wall, load "
-          f"{load0[0]:.2f} -> {os.getloadavg()[0]:.2f}; {path}")
+          f"{run.load_average[0]:.2f} -> {run.load_average[1]:.2f}; {path}")
     return 0 if len(doc["cells"]) == expected else 1
 
 

@@ -12,14 +12,11 @@ from __future__ import annotations
 
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from . import machine, write
+from . import machine, timed_trilith, write
 
 TARGET_CPU_S = 120.0
 ENGINES = os.environ.get("BENCH_TRUST_ENGINES", "pymunk,mujoco")
@@ -28,22 +25,16 @@ ENGINES = os.environ.get("BENCH_TRUST_ENGINES", "pymunk,mujoco")
 def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="bench-trust-") as tmp:
         out = Path(tmp) / "trust"
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        load0, t0 = os.getloadavg(), time.perf_counter()
-        proc = subprocess.run(
-            [sys.executable, "-m", "trilith_xval.compare.cli.main", "trust", "--scene", "fig5", "--engine",
-             ENGINES, "--out", str(out), "--cache", str(Path(tmp) / "store"), "-q"],
-            capture_output=True, text=True, check=False)
-        wall = time.perf_counter() - t0
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        if proc.returncode != 0:
-            print(proc.stderr, file=sys.stderr)
+        run = timed_trilith(["trust", "--scene", "fig5", "--engine", ENGINES, "--out", str(out),
+                             "--cache", str(Path(tmp) / "store"), "-q"])
+        cpu, wall = run.cpu_s, run.wall_s
+        if run.returncode != 0:
+            print(run.stderr, file=sys.stderr)
             return 1
         doc = json.loads((out / "trust.json").read_text())
     points = {e: len(v["thresholds"]) for e, v in doc["engines"].items()}
     payload = {"command": f"trilith trust --scene fig5 --engine {ENGINES} --no-cache",
-               "cpu_s": cpu, "wall_s": wall, "load_average": [load0[0], os.getloadavg()[0]],
+               "cpu_s": cpu, "wall_s": wall, "load_average": run.load_average,
                "target_cpu_s": TARGET_CPU_S, "met": cpu <= TARGET_CPU_S,
                "threshold_points": points,
                # Where the model is invalid, the engines against each other (two engines).
@@ -53,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     path = write("trust", payload)
     print(f"trust cold: {cpu:.1f} CPU s (target <= {TARGET_CPU_S:g}: "
           f"{'met' if cpu <= TARGET_CPU_S else 'MISSED'}), {wall:.1f} s wall, load "
-          f"{load0[0]:.2f} -> {os.getloadavg()[0]:.2f}; {path}")
+          f"{run.load_average[0]:.2f} -> {run.load_average[1]:.2f}; {path}")
     return 0 if all(n == 12 for n in points.values()) else 1
 
 
