@@ -176,7 +176,7 @@ def _restep(args: argparse.Namespace) -> dict:
     if args.engine is None:
         raise ValueError("--restep needs --engine E[,E...]: the engines to bring under "
                          "the step rule")
-    doc = read_atlas(args.restep)
+    doc = read_atlas(args.restep, "--restep")
     engines = parse_engine_list(args.engine)
     plans = [(e, rule_points(doc, e)) for e in engines]  # every engine checked first
     workers = resolve_workers(args.workers)

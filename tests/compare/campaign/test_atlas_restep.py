@@ -117,3 +117,10 @@ def test_the_command_refuses_bad_restep_input_before_any_work(extra, message, tm
     assert main(["atlas", "--restep", str(stored), *args]) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "out.json").exists()
+
+
+def test_a_missing_stored_atlas_is_named_by_its_option(tmp_path, capsys):
+    from trilith_xval.compare.cli.main import main
+    assert main(["atlas", "--restep", str(tmp_path / "none.json"), "--engine", "pymunk",
+                 "--json", str(tmp_path / "out.json")]) == 2
+    assert "--restep" in capsys.readouterr().err
