@@ -27,7 +27,7 @@ from trilith_xval.compare.report.atlas_consensus_page import (CONSENSUS_COLOUR,
 from trilith_xval.compare.report.cells import unbroken
 from trilith_xval.compare.report.trust import label
 
-__all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line",
+__all__ = ["CAUSE_SYMBOL", "step_rows", "reached_text", "trusted_rows", "parts_of", "part_line", "restep_line",
            "cost_rows", "heat_map_png", "atlas_html", "write_page"]
 
 CAUSE_SYMBOL = {"model": "M", "collapse": "C", "no-bracket": "B", "window": "W", "jump": "J",
@@ -152,6 +152,17 @@ def part_line(part: dict, code=("`", "`")) -> str:
             f" ({when}, commit {code[0]}{commit}{code[1]}, {part.get('workers', '?')} worker(s), load average "
             + (" -> ".join(f"{x:.1f}" for x in load) or "?")
             + f", {_cpu_text(part)}, {(part.get('wall_s') or 0) / 60:.0f} min wall)")
+
+
+def restep_line(entry: dict, code=("`", "`")) -> str:
+    """One restep (``atlas --restep``): the engine, how many points it remeasured
+    under the step rule, the causes that changed per step, and its provenance."""
+    changed = ", ".join(f"{float(dt):g} s: {c['changed']}" for dt, c in entry["changes"].items())
+    n = entry["points"]
+    return (f"step rule applied to {label(entry['engine'])}: {n} point{'s' * (n != 1)} "
+            f"where it can act remeasured (the rest carried); causes changed per step: "
+            f"{changed}; "
+            + part_line({**entry, "engines": [entry["engine"]]}, code))
 
 
 def cost_rows(doc: dict) -> list[list]:
@@ -317,6 +328,8 @@ def atlas_html(doc: dict, level: int = 2) -> str:
               f"<{sub}>Cost per engine and step</{sub}>", _table(COST_HEAD, cost_rows(doc)),
               f"<{sub}>How it was measured</{sub}><ul>"
               + "".join(f"<li>{html.escape(part_line(p, ('', '')))}</li>" for p in parts_of(doc))
+              + "".join(f"<li>{html.escape(restep_line(r, ('', '')))}</li>"
+                        for r in doc.get("resteps", ()))
               + "</ul>" + (f"<p>Joined by <code>{html.escape(str(doc.get('command')))}</code>"
                            "</p>" if len(parts_of(doc)) > 1 else "")]
     return "\n".join(parts)

@@ -101,6 +101,9 @@ def test_a_restep_remeasures_the_rules_points_and_reproduces_them(stored, tmp_pa
     assert entry["points"] == 1 and entry["command"] == "restep"
     assert all(c["changed"] == 0 for c in entry["changes"].values())
     json.dumps(merged, allow_nan=False)
+    # The page says which rows were remeasured under the rule, and when.
+    from trilith_xval.compare.report.atlas_page import atlas_html
+    assert "step rule applied to Pymunk: 1 point where it can act" in atlas_html(merged)
 
 
 @pytest.mark.parametrize("extra, message", [
