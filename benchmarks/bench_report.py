@@ -47,6 +47,13 @@ def measure(extra: list[str], name: str, label: str) -> tuple[int, dict]:
                "verdicts": [sum(bool(v["passed"]) for v in doc.get("verdicts", [])),
                             len(doc.get("verdicts", []))],
                "cpu_by_job": timings.get("cpu_by_job"),
+               # Where the wall goes: the serial model part, the engine jobs' wall,
+               # and the jobs' own wall summed (over the jobs' wall: how many
+               # workers were busy on average; 2 when both cores worked throughout).
+               "reference_spectra_wall_s": timings.get("reference_spectra"),
+               "engine_runs_wall_s": timings.get("engine_runs_wall"),
+               "jobs_wall_sum_s": (sum((timings.get("spent_by_job") or {}).values())
+                                   if timings.get("spent_by_job") else None),
                "reverified": [{k: r.get(k) for k in ("engine", "omega", "rel_difference",
                                                       "passed")}
                               for r in (doc.get("sources") or {}).get("reverified", [])],
