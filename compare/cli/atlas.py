@@ -165,6 +165,20 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _restep_command(args: argparse.Namespace, engine: str) -> str:
+    """The command line of one engine's restep: only the options a restep reads
+    (the grid and factors are the stored atlas's)."""
+    import shlex
+
+    words = ["trilith", "atlas", "--restep", str(args.restep), "--engine", engine,
+             "--json", str(args.json), "--workers", str(args.workers)]
+    if getattr(args, "cache", None):
+        words += ["--cache", str(args.cache)]
+    if getattr(args, "no_cache", False):
+        words.append("--no-cache")
+    return shlex.join(words)
+
+
 def _restep(args: argparse.Namespace) -> dict:
     """The stored atlas ``--restep`` with each ``--engine``'s step-rule points
     remeasured (compare/campaign/atlas_restep.py)."""
@@ -184,9 +198,12 @@ def _restep(args: argparse.Namespace) -> dict:
     for engine, points in plans:
         info(f"restep {engine}: {len(points)} of {len(doc['points'])} points where the "
              "step rule can act")
-        part = run_atlas(restep_config(doc, engine, points), workers)
+        # No point to remeasure: nothing runs (an empty selection is not "all").
+        part = (run_atlas(restep_config(doc, engine, points), workers) if points else
+                {"config": doc["config"], "steps": doc["steps"], "points": [],
+                 "wall_s": 0.0, "parent_cpu_s": 0.0, "local_cpu_s": 0.0, "workers": workers})
         part["provenance"] = collect(args)
-        part["command"] = part["provenance"]["command"]
+        part["command"] = part["provenance"]["command"] = _restep_command(args, engine)
         doc = merge_restep(doc, part, engine)
     return doc
 

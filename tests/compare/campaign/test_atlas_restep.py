@@ -127,3 +127,25 @@ def test_a_missing_stored_atlas_is_named_by_its_option(tmp_path, capsys):
     assert main(["atlas", "--restep", str(tmp_path / "none.json"), "--engine", "pymunk",
                  "--json", str(tmp_path / "out.json")]) == 2
     assert "--restep" in capsys.readouterr().err
+
+
+def test_a_restep_records_the_command_that_repeats_it(tmp_path, monkeypatch, capsys):
+    """The stored command names only what a restep reads; no point of a stored
+    atlas already under the rule and at the reference step is rerun."""
+    from trilith_xval.compare.cli.main import main
+    doc = _doc({6.0: [_row(2e-4, "agrees")]})  # agrees: nothing to rerun
+    doc.update(schema_version=1, cost=[], what="atlas")
+    for key, value in (("omegas", [6.0]), ("scenes", [["fig5", "cosine"]]),
+                       ("cases", ["pendulum"])):
+        doc["config"][key] = value
+    doc["points"][0].update(scene="fig5", pulse="cosine")
+    doc["steps"] = {"pymunk": [2e-4, 4e-4]}  # Pymunk's calibrated step and 2x
+    stored = tmp_path / "stored.json"
+    stored.write_text(json.dumps(doc))
+    out = tmp_path / "out.json"
+    assert main(["atlas", "--restep", str(stored), "--engine", "pymunk", "--json", str(out),
+                 "--no-cache", "--workers", "1"]) == 0
+    (entry,) = json.loads(out.read_text())["resteps"]
+    assert entry["points"] == 0
+    assert entry["command"] == (f"trilith atlas --restep {stored} --engine pymunk --json {out} "
+                                "--workers 1 --no-cache")
