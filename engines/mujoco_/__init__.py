@@ -215,6 +215,7 @@ class MujocoEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: the contact time constant (solref),
     # in steps; MuJoCo requires at least 2 for stability (default 3).
     calibration_space = {"timeconst_steps": (2.0, 3.0, 5.0)}
@@ -258,7 +259,9 @@ class MujocoEngine(Engine):
             x, y, angle = box.start
             d.qpos[a:a + 3] = (x - x0, y - y0, angle)
         if self.pendulum is not None:
-            d.qpos[self.pendulum] = s.psi0  # relative to its parent, which starts unrotated
+            # Relative to its parent (the trilith's lintel starts unrotated, a turned
+            # structure's parent by its tilt): the bob starts at psi0 from the vertical.
+            d.qpos[self.pendulum] = s.psi0 - structure.body(structure.bob.parent).start[2]
         if self.moving:
             self._set_ground(0)
         mujoco.mj_forward(m, d)

@@ -108,6 +108,7 @@ class PymunkEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: more iterations, a ten times looser
     # collision slop (defaults first).
     calibration_space = {"iterations": (30, 60), "slop_fraction": (1e-4, 1e-3)}
