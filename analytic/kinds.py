@@ -224,9 +224,9 @@ class Drums(KindScene):
             for i in range(1, len(widths)):
                 most = widths[i - 1] * (1.0 + MAX_WIDENING)
                 if widths[i] > most:
-                    raise ValueError(f"widths[{i}] must be at most {most:.6g} m ({MAX_WIDENING:.0%} "
-                                     f"wider than the drum below, {widths[i - 1]:g} m), got "
-                                     f"{widths[i]!r}")
+                    raise ValueError(f"widths[{i}] must be at most {most:.6g} m "
+                                     f"({MAX_WIDENING:.0%} wider than the drum below, "
+                                     f"{widths[i - 1]:g} m), got {widths[i]!r}")
             checked["widths"] = widths
         checked["b"] = b
         self._store(checked)

@@ -1,4 +1,6 @@
-"""LEGACY COPY (tests only) of the pre-body-list builder. The MJCF model of the trilith, generated from a :class:`~analytic.parameters.Scene`
+"""LEGACY COPY (tests only) of the pre-body-list builder.
+
+The MJCF model of the trilith, generated from a :class:`~analytic.parameters.Scene`
 and :mod:`engines.geometry`, for :mod:`engines.mujoco_`.
 
 The model is an MJCF string generated from the Scene's fields (:func:`mjcf`);

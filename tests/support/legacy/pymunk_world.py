@@ -1,4 +1,6 @@
-"""LEGACY COPY (tests only) of the pre-body-list builder. The trilith as three rigid polygons in a Pymunk space, for :mod:`engines.pymunk_`.
+"""LEGACY COPY (tests only) of the pre-body-list builder.
+
+The trilith as three rigid polygons in a Pymunk space, for :mod:`engines.pymunk_`.
 
 :func:`build_space` builds a fresh :class:`pymunk.Space` from the scene's
 geometry (:mod:`engines.geometry`); :func:`state_reader` reads every body's
