@@ -159,6 +159,11 @@ class Engine:
       :mod:`engines.diagnostics`, the same for every engine.
     * :meth:`close` releases what :meth:`build` took; it is called once, also
       after an error.
+    * Optionally, :meth:`build` turns the body list
+      (:func:`engines.geometry.structure_of`) into the world and the class sets
+      ``structures = True``: it then also runs the scenes of
+      :mod:`analytic.kinds` (judged by :mod:`engines.structure_monitor`), whose
+      :meth:`read` fills ``PlaneState.bodies``; otherwise they are refused.
     * The class is registered by one line in :data:`engines.ENGINES` (or an
       entry point of the group ``trilith_xval.engines``) and must pass
       :func:`engines.testing.check_backend`.
