@@ -132,6 +132,11 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     overrides (their errors name ``--set``), then ``--no-pendulum``."""
     overrides = parse_overrides(args.overrides)
     scene = load_scene(args.scene)
+    kind_fields = getattr(scene, "kind", None) and set(scene.field_names())
+    for name in overrides if kind_fields else ():
+        if name not in kind_fields:
+            raise ValueError(f"--set {name}: not a value of the {scene.kind} kind; allowed: "
+                             f"{', '.join(sorted(kind_fields & set(SETTABLE)))}")
     if overrides:
         try:
             scene = scene.replace(**overrides)

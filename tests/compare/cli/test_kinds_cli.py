@@ -108,3 +108,11 @@ def test_atlas_and_campaign_refuse_a_glob_that_reaches_another_kind(tmp_path):
     path.write_text('[campaign]\nscenes = ["drums"]\nengines = ["pymunk"]\nomega = [8.0]\n')
     with pytest.raises(ValueError, match="'drums' is of the drums kind"):
         load_study(path)
+
+
+def test_set_names_the_kinds_own_values(capsys, no_work):
+    assert main(["simulate", "--scene", "unequal", "--engine", "pymunk", "-A", "1", "-w", "8",
+                 "--set", "lam=3"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1
+    assert "--set lam: not a value of the unequal kind; allowed:" in err and "gap" in err
