@@ -261,11 +261,11 @@ class Engine:
         self._load_end = max(0, math.ceil(excitation.end_time / dt) + 1)
 
     def _init_kind(self, scene, excitation, s) -> None:
-        """The checks of a scene of :mod:`analytic.kinds`: no initial tilt (the
-        trilith's restitution experiments), the run budget; the friction is the
-        engine's calibrated default unless given (the no-sliding bound is the
-        model's, :func:`~analytic.bounds.required_friction`; a body moving with
-        the ground needs ``PGA/g``, which is checked)."""
+        """The checks of a scene of :mod:`analytic.kinds`: an initial tilt only as
+        a plumb error (:data:`engines.geometry.MAX_KIND_TILT`), the run budget;
+        the friction is the engine's calibrated default unless given (the
+        no-sliding bound is the model's, :func:`~analytic.bounds.required_friction`;
+        a body moving with the ground needs ``PGA/g``, which is checked)."""
         name = self.name
         self.structure = geometry.structure_of(scene, s.theta0, s.psi0)
         need = excitation.acceleration_bound() / scene.g
