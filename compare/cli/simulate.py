@@ -159,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
         if r != 1.0:  # absent at 1: the documents of exact-impact runs stay as they were
             inputs["restitution_factor"] = r
         body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
+        if kind != "trilith":  # said, not left to be guessed: there is no model
+            body.update(kind=kind, model=None)
         print_json(plain(envelope("simulate", inputs, body, timings)))
         return 0
     v = traj.verdict

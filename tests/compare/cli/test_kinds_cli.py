@@ -25,6 +25,7 @@ def test_simulate_runs_an_engine_and_says_there_is_no_model(capsys):
                  "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["inputs"]["scene"]["kind"] == "unequal"
+    assert doc["kind"] == "unequal" and doc["model"] is None
     assert doc["status"] == "survived"  # 1 m/s^2: below the frame uplift g b/h = 1.96
 
 
