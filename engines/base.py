@@ -21,12 +21,15 @@ from typing import ClassVar
 
 from trilith_xval.analytic.bounds import required_friction
 from trilith_xval.analytic.excitation import check_excitation
+from trilith_xval.analytic.kinds import KindScene
 from trilith_xval.analytic.options import MAX_ENGINE_DT, MAX_RUN_STEPS, RunOptions, check_real
 from trilith_xval.analytic.parameters import Scene
 from trilith_xval.analytic.trajectory import Trajectory
 
+from . import geometry
 from .diagnostics import Diagnostics, PlaneState
 from .monitor import MonitorSettings, RunMonitor
+from .structure_monitor import StructureMonitor
 
 __all__ = ["Engine", "EngineSettings", "CAPABILITIES", "BASE_MOTIONS", "MAX_RUN_STEPS",
            "FRICTION_MARGIN", "run_steps"]
@@ -156,6 +159,11 @@ class Engine:
       :mod:`engines.diagnostics`, the same for every engine.
     * :meth:`close` releases what :meth:`build` took; it is called once, also
       after an error.
+    * Optionally, :meth:`build` turns the body list
+      (:func:`engines.geometry.structure_of`) into the world and the class sets
+      ``structures = True``: it then also runs the scenes of
+      :mod:`analytic.kinds` (judged by :mod:`engines.structure_monitor`), whose
+      :meth:`read` fills ``PlaneState.bodies``; otherwise they are refused.
     * The class is registered by one line in :data:`engines.ENGINES` (or an
       entry point of the group ``trilith_xval.engines``) and must pass
       :func:`engines.testing.check_backend`.
@@ -194,6 +202,9 @@ class Engine:
     regression_point: ClassVar[tuple[str, float]] = ("fig5", 13.0)
     default_friction: ClassVar[float]
     Settings: ClassVar[type[EngineSettings]]
+    # Builds any body list (engines.geometry.Structure: the kinds of analytic.kinds),
+    # not only the parametric trilith; read() then fills PlaneState.bodies.
+    structures: ClassVar[bool] = False
 
     @classmethod
     def version(cls) -> str:
@@ -207,13 +218,21 @@ class Engine:
 
     def __init__(self, scene, excitation, settings=None) -> None:
         name = self.name
-        if not isinstance(scene, Scene):
+        if isinstance(scene, KindScene):
+            if not self.structures:
+                raise ValueError(f"{name} runs the parametric trilith only, not the "
+                                 f"{scene.kind!r} kind (engines that run it: "
+                                 f"{', '.join(geometry.STRUCTURE_ENGINES)})")
+        elif not isinstance(scene, Scene):
             raise TypeError(f"{name}: scene must be a Scene, got {type(scene).__name__}")
         check_excitation(excitation, where=name)
         s = settings if settings is not None else self.Settings()
         if not isinstance(s, self.Settings):
             raise TypeError(f"{name} settings must be {type(self).__module__}.Settings, "
                             f"got {type(s).__name__}")
+        if isinstance(scene, KindScene):
+            self._init_kind(scene, excitation, s)
+            return
         if scene.mu == 0.0 and scene.has_pendulum:
             raise ValueError(f"{name}: mu must be > 0 when gamma > 0 (a massless lintel, which "
                              "the analytic model allows, cannot carry the pendulum hinge in an "
@@ -240,6 +259,30 @@ class Engine:
         dt = s.dt
         # The d'Alembert load is evaluated mid-step; from this step on it is 0.
         self._load_end = max(0, math.ceil(excitation.end_time / dt) + 1)
+
+    def _init_kind(self, scene, excitation, s) -> None:
+        """The checks of a scene of :mod:`analytic.kinds`: an initial tilt only as
+        a plumb error (:data:`engines.geometry.MAX_KIND_TILT`), the run budget;
+        the friction is the engine's calibrated default unless given (the
+        no-sliding bound is the model's, :func:`~analytic.bounds.required_friction`;
+        a body moving with the ground needs ``PGA/g``, which is checked)."""
+        name = self.name
+        self.structure = geometry.structure_of(scene, s.theta0, s.psi0)
+        need = excitation.acceleration_bound() / scene.g
+        friction = (max(self.default_friction, FRICTION_MARGIN * need) if s.friction is None
+                    else check_real(type(s).__name__, "friction", s.friction, 0.0, 1e3))
+        if friction < need:
+            raise ValueError(f"{type(s).__name__}: friction must be >= {need:.4g} (the peak "
+                             f"ground acceleration over g) for this excitation, got "
+                             f"{s.friction!r}")
+        steps = run_steps(s, excitation)
+        if steps > MAX_RUN_STEPS:
+            raise ValueError(f"{name}: a run of {steps * s.dt:.4g} s at dt = {s.dt:g} s is "
+                             f"{steps:.3g} steps, over the budget of {MAX_RUN_STEPS:.0e}")
+        self.scene, self.excitation, self.settings = scene, excitation, s
+        self.friction, self.required_friction = friction, need
+        self.step_index = 0
+        self._load_end = max(0, math.ceil(excitation.end_time / s.dt) + 1)
 
     # ------------------------------------------------------------------ the hooks
     def build(self) -> None:
@@ -291,6 +334,8 @@ class Engine:
         this process's CPU seconds for the run, which a load on the machine does
         not inflate as it does the wall time)."""
         s = self.settings
+        if isinstance(self.scene, KindScene):
+            return self._run_structure()
         wall0, cpu0 = time.perf_counter(), time.process_time()
         monitor = RunMonitor(self.scene, self.excitation, s)
         # Kept on the run: an engine's own extra readings may consult the window.
@@ -317,3 +362,22 @@ class Engine:
                     cpu_time=time.process_time() - cpu0,
                     required_friction=self.required_friction)
         return monitor.finish(self.name, self.describe(), diag, wall)
+
+    def _run_structure(self) -> Trajectory:
+        """:meth:`run` for a scene of :mod:`analytic.kinds`: the same loop, judged
+        by :class:`~engines.structure_monitor.StructureMonitor` (the model's rules
+        do not apply)."""
+        s = self.settings
+        wall0, cpu0 = time.perf_counter(), time.process_time()
+        monitor = StructureMonitor(self.scene, self.structure, self.excitation, s)
+        try:
+            self.build()
+            while not monitor.record(self.step_index * s.dt, self.read()):
+                self.advance(s.sample_every)
+        finally:
+            self.close()
+        wall = time.perf_counter() - wall0
+        diag = dict(steps=self.step_index, wall_time=wall, cpu_time=time.process_time() - cpu0,
+                    required_friction=self.required_friction)
+        return monitor.finish(self.name, self.describe(), diag, wall)
+

@@ -211,6 +211,12 @@ def threshold_choice(engine: str, scene) -> StepChoice:
     cal = calibrated(engine, "thresholds")
     if not cal.options:
         return StepChoice(engine, {}, True)
+    kind = getattr(scene, "kind", "trilith")  # a Scene has no kind: the trilith
+    if kind != "trilith":  # calibrated on parametric triliths only
+        return StepChoice(engine, {}, False,
+                          f"{engine}: {scene.name} is of the {kind} kind, outside the domain "
+                          f"of its calibrated threshold step (parametric triliths); the "
+                          f"reference step dt = {reference_dt(engine):g} s runs")
     why = cal.domain.outside(scene)
     if why is None:
         return StepChoice(engine, dict(cal.options), True)

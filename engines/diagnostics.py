@@ -57,7 +57,9 @@ class PlaneState(NamedTuple):
     ``out_of_plane``: largest drift [m] of a body out of the plane and
     ``out_of_plane_rotation`` its largest rotation [rad] out of it (3D engines);
     ``problem``: an engine's own report that its state is invalid (e.g. a
-    solver reset), or None.
+    solver reset), or None; ``bodies``: every box of a structure that is not
+    the parametric trilith (:mod:`analytic.kinds`), in its structure's order
+    (``columns`` is then empty).
     """
 
     columns: tuple[Pose, Pose]
@@ -68,7 +70,7 @@ class PlaneState(NamedTuple):
     out_of_plane: float = 0.0
     out_of_plane_rotation: float = 0.0
     problem: str | None = None
-
+    bodies: tuple[Pose, ...] = ()
 
 
 def joint_plane_state(states, pendulum=None) -> PlaneState:

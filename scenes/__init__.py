@@ -9,7 +9,10 @@ paper's Fig. 8, 9 and 11 grids (``fig8_lam5_gamma0.1``, ``fig9_lam3_b0.4``,
 ``block_lam1.5``, ``block_lam2``, ``block_lam3``, ``block_lam5``, ``block_lam8``,
 ``block_lam10`` (mu = gamma = 0, b = 0.6 m) and ``no_pendulum``;
 each file's header comment says where its numbers come from and how sure
-they are.
+they are.  A ``kind`` key (``"drums"``, ``"unequal"``, ``"block_on_block"``)
+describes a scene beyond the parametric trilith (:mod:`scenes.kind_files`,
+``docs/geometry.md``); the shipped examples are ``drums``, ``unequal`` and
+``block_on_block``.
 """
 from __future__ import annotations
 
@@ -113,8 +116,11 @@ def _short(value) -> str:
     return text if len(text) <= 60 else f"{text[:57]}... ({type(value).__name__})"
 
 
-def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
+def load_scene(name_or_path: str | Path = "fig5", **overrides):
     """Read a scene file and apply ``overrides`` (field name -> value).
+
+    Returns a :class:`~analytic.parameters.Scene`, or a scene of
+    :mod:`analytic.kinds` when the file has a ``kind`` other than ``'trilith'``.
 
     Raises ``TypeError`` when ``name_or_path`` is neither a str nor a Path,
     ``ValueError`` naming the file and the key for unknown keys or bad values
@@ -127,6 +133,10 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides) -> Scene:
     if not isinstance(table, dict) or set(data) - {"scene"}:
         raise ValueError(f"{path}: expected exactly one [scene] table, found "
                          f"{_short(', '.join(data)) or 'none'}")
+    if table.get("kind", "trilith") != "trilith":
+        from .kind_files import load_kind
+        return load_kind(path, table, overrides, _check_value)
+    table = {k: v for k, v in table.items() if k != "kind"}
     fields = set(Scene.field_names())
     allowed = ", ".join(sorted(fields | {"h"}))
     for key in table:

@@ -99,6 +99,12 @@ def atlas_scenes(config: AtlasConfig) -> list[tuple[str, str]]:
         if not hits:
             raise ValueError(f"scenes: {pattern!r} matches no scene")
         out += [(n, pulse) for n in hits if (n, pulse) not in out]
+    from trilith_xval.scenes import load_scene
+    for n in {n for n, _ in out}:  # the atlas measures engines against the model
+        kind = getattr(load_scene(n), "kind", "trilith")
+        if kind != "trilith":
+            raise ValueError(f"scenes: {n!r} is of the {kind} kind, which the analytic model "
+                             f"does not cover (docs/geometry.md)")
     return out
 
 

@@ -130,6 +130,11 @@ def load_study(path) -> Study:
             raise ValueError(f"{where}: scenes: {pattern!r} matches no scene; allowed: "
                              f"{', '.join(scene_names())} (or globs)")
         names += [n for n in hits if n not in names]
+    for n in names:  # a campaign measures engines against the model
+        kind = getattr(load_scene(n), "kind", "trilith")
+        if kind != "trilith":
+            raise ValueError(f"{where}: scenes: {n!r} is of the {kind} kind, which the analytic "
+                             f"model does not cover (docs/geometry.md)")
     engines = [str(e) for e in _list(table, "engines", where)]
     engines = list(ENGINES) if engines == ["all"] else engines
     for e in engines:

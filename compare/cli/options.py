@@ -132,6 +132,11 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     overrides (their errors name ``--set``), then ``--no-pendulum``."""
     overrides = parse_overrides(args.overrides)
     scene = load_scene(args.scene)
+    kind_fields = getattr(scene, "kind", None) and set(scene.field_names())
+    for name in overrides if kind_fields else ():
+        if name not in kind_fields:
+            raise ValueError(f"--set {name}: not a value of the {scene.kind} kind; allowed: "
+                             f"{', '.join(sorted(kind_fields & set(SETTABLE)))}")
     if overrides:
         try:
             scene = scene.replace(**overrides)
@@ -140,7 +145,26 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
             raise ValueError(f"--set {shown}: {exc}") from None
     if getattr(args, "no_pendulum", False):
         scene = scene.without_pendulum()
+    check_kind(scene, getattr(args, "command", None))
     return scene
+
+
+# The commands that run a scene of another kind (analytic.kinds), which the model
+# does not cover: the engines alone (simulate), their consensus (spectrum
+# --consensus), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes")
+
+
+def check_kind(scene, command: str | None) -> None:
+    """One line refusing a scene of another kind than the trilith in a command that
+    needs the analytic model (``command``: the subcommand's name; None, e.g. a
+    function called from Python, checks nothing)."""
+    kind = getattr(scene, "kind", "trilith")
+    if kind == "trilith" or command is None or command in KIND_COMMANDS:
+        return
+    raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
+                     f"analytic model does not cover; 'trilith simulate' and 'trilith spectrum "
+                     f"--consensus E1,E2' run it (docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:

@@ -25,7 +25,7 @@ from trilith_xval.scenes import load_scene
 
 from trilith_xval.compare.cli.options import (add_engine_list_arg, add_settings_arg, add_workers_arg,
                                  check_output_path, detail, format_quantity, parse_engine_list,
-                                 resolve_workers, scene_group, settings_from_args)
+                                 resolve_workers, scene_group, settings_from_args, check_kind)
 
 # --dt: below 1e-5 s a campaign costs over 10x the calibrated 1e-4 s (and PyBullet's
 # contacts creep, engines/pybullet_/__init__.py); above 1e-2 s the campaign refuses it.
@@ -130,7 +130,8 @@ def run(args: argparse.Namespace) -> int:
 
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
-    load_scene(args.scene)  # the file's errors name the file
+    # The file's errors name the file; another kind than the trilith has no model.
+    check_kind(load_scene(args.scene), "report")
     engines = parse_engines(args.engine)
     workers = resolve_workers(args.workers)
     if args.dt is not None and not (math.isfinite(args.dt)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from trilith_xval.analytic.kinds import KindScene
 from trilith_xval.analytic.parameters import GLOSSARY, glossary_text
 from trilith_xval.scenes import SCENE_DIR, load_scene, scene_names
 
@@ -45,7 +46,17 @@ def source(path) -> str:
 
 def values(scene) -> dict:
     """Every value of ``scene`` named as in :data:`analytic.parameters.GLOSSARY`, the
-    defaults resolved; ``l`` is None without a pendulum (there is none to measure)."""
+    defaults resolved; ``l`` is None without a pendulum (there is none to measure).
+    A scene of another kind (:mod:`analytic.kinds`) gives its outline's values
+    where it has them (a column of drums: its monolithic trilith's), None
+    elsewhere, ``alpha`` its smallest body's, and its ``kind``."""
+    if isinstance(scene, KindScene):
+        out = dict.fromkeys(UNITS)
+        if hasattr(scene, "base"):  # drums: the outline is a parametric trilith
+            out.update(values(scene.base))
+            out["column_mass"] = out["J_G"] = None  # the drums', not the monolith's
+        out.update(depth=scene.depth, g=scene.g, alpha=scene.alpha, kind=scene.kind)
+        return out
     return {"lam": scene.lam, "b": scene.b, "h": scene.h, "mu": scene.mu,
             "gamma": scene.gamma, "l": scene.pendulum_length if scene.has_pendulum else None,
             "gap": scene.d, "lintel_height": scene.lintel_thickness, "alpha": scene.alpha,
@@ -94,6 +105,8 @@ def _detail(args: argparse.Namespace) -> list[dict]:
         path = _file(scene, args.scene or [])
         out.append({"name": scene.name, "file": _shown(path) if path else None,
                     "source": source(path) if path else "", **values(scene)})
+        if isinstance(scene, KindScene):
+            out[-1]["bodies"] = [r._asdict() for r in scene.layout()]
     return out
 
 
@@ -110,9 +123,14 @@ def run(args: argparse.Namespace) -> int:
         for i, r in enumerate(chosen):
             print(("\n" if i else "") + f"{r['name']}: {r['file']}"
                   + (f" ({r['source']})" if r["source"] else ""))
+            if "kind" in r:  # another kind: its bodies, then the outline's values
+                print(f"  kind {r['kind']} (docs/geometry.md); bodies, upright at rest:")
+                for body in r["bodies"]:
+                    print(f"    {body['name']:<16} b {body['b']:.4g} m, h {body['h']:.4g} m, "
+                          f"centre ({body['x']:.4g}, {body['y']:.4g}) m, {body['mass']:.4g} kg")
             for key, unit in UNITS.items():
-                shown = ("-  (no pendulum)" if r[key] is None
-                         else f"{r[key]:.6g} {unit}".rstrip())
+                missing = "-  (see the bodies)" if "kind" in r else "-  (no pendulum)"
+                shown = missing if r[key] is None else f"{r[key]:.6g} {unit}".rstrip()
                 print(f"  {key:<{width}}  {shown:<18}  {GLOSSARY[key]}")
         return 0
     table = rows()

@@ -16,6 +16,7 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_engine_arg, add
 from trilith_xval.compare.cli.model_options import (add_restitution_arg, restitution_factor,
                                                     restitution_text)
 from trilith_xval.compare.run.jsonable import plain
+from trilith_xval.engines.geometry import STRUCTURE_ENGINES
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -104,6 +105,15 @@ def run(args: argparse.Namespace) -> int:
     scene = scene_from_args(args)
     excitation = excitation_from_args(args)
     r = restitution_factor(args)
+    kind = getattr(scene, "kind", "trilith")
+    if kind != "trilith":  # analytic.kinds: the engines alone, no model
+        if args.engine.startswith("analytic"):
+            raise ValueError(f"trilith simulate: there is no model of the {kind} kind "
+                             f"(scene {scene.name!r}); run an engine: "
+                             f"{', '.join(STRUCTURE_ENGINES)} (docs/geometry.md)")
+        if r != 1.0:
+            raise ValueError(f"--restitution-factor scales the model's impacts; there is no "
+                             f"model of the {kind} kind")
     model_run = args.engine.startswith("analytic") or args.plot is not None
     if r != 1.0 and not model_run:
         raise ValueError(f"--restitution-factor scales the model's impacts, and --engine "
@@ -119,7 +129,8 @@ def run(args: argparse.Namespace) -> int:
     check_run_budget(name, settings, excitation)
     # An engine's plot shows the model's run beside it (same scene, excitation,
     # criterion and window): what a cross-validation is read from.
-    overlay = args.plot is not None and not args.engine.startswith("analytic")
+    overlay = (args.plot is not None and not args.engine.startswith("analytic")
+               and kind == "trilith")
     if overlay:
         model_name = model_backend("analytic", excitation)
         model_settings = run_spec(model_name, scene, excitation, overrides=_overrides(
@@ -148,9 +159,13 @@ def run(args: argparse.Namespace) -> int:
         if r != 1.0:  # absent at 1: the documents of exact-impact runs stay as they were
             inputs["restitution_factor"] = r
         body = {"engine": summary.pop("engine"), "engine_version": backend.version(), **summary}
+        if kind != "trilith":  # said, not left to be guessed: there is no model
+            body.update(kind=kind, model=None)
         print_json(plain(envelope("simulate", inputs, body, timings)))
         return 0
     v = traj.verdict
+    if kind != "trilith":
+        return _print_kind(traj, scene, excitation, backend, args, loaded)
     print(f"{traj.backend}: scene {scene.name} (lam = {sig(scene.lam)}, b = {sig(scene.b)} m, "
           f"mu = {sig(scene.mu)}, gamma = {sig(scene.gamma)}), {_describe_excitation(excitation)}"
           + (f"; model {restitution_text(r, scene.has_pendulum)}" if r != 1.0 else ""))
@@ -177,6 +192,33 @@ def run(args: argparse.Namespace) -> int:
     if traj.diagnostics.get("model_valid") is False:  # analytic backend: docs/model.md
         info(f"warning: the analytic model is not valid along this run: "
              f"{'; '.join(violations(traj.diagnostics))}; engines may disagree for that reason")
+    if args.csv is not None:
+        info(f"wrote {args.csv}")
+    if args.plot is not None:
+        info(f"wrote {args.plot}")
+    return 0
+
+
+def _print_kind(traj, scene, excitation, backend, args, loaded) -> int:
+    """The text answer for a scene of another kind (:mod:`analytic.kinds`): the
+    engine's verdict by the failure rule of :mod:`engines.structure_monitor`, each
+    body's largest rotation over its own alpha, and that there is no model."""
+    v = traj.verdict
+    bodies = len(scene.layout())
+    print(f"{traj.backend}: scene {scene.name} ({scene.kind}, {bodies} bodies), "
+          f"{_describe_excitation(excitation)}")
+    line = f"verdict: {v.status}"
+    if v.time is not None:
+        line += f" at t = {v.time:.4f} s"
+    print(line + (f" -- {v.reason}" if v.reason else ""))
+    ratios = {k.split(".", 1)[1]: x for k, x in traj.diagnostics.items()
+              if k.startswith("max_angle_over_alpha.")}
+    print("max |angle| / own alpha: " + ", ".join(f"{k} {sig(x)}" for k, x in ratios.items()))
+    info(f"no model: the analytic model does not cover the {scene.kind} kind; compare engines "
+         f"with 'trilith spectrum --scene ... --consensus E1,E2' (docs/geometry.md)")
+    detail(f"engine {backend.version()}, wall time {traj.wall_time:.3f} s")
+    if loaded is not None:
+        info(settings_line(loaded, args.engine))
     if args.csv is not None:
         info(f"wrote {args.csv}")
     if args.plot is not None:

@@ -62,11 +62,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--convergence", action="store_true",
                         help="rerun disagreeing engine points at dt/2, dt/4 and doubled "
                              "solver iterations to classify the cause")
-    parser.add_argument("--consensus", action="store_true",
+    parser.add_argument("--consensus", nargs="?", const=True, default=False,
+                        metavar="E1,E2",
                         help="where the model cannot judge an engine point (cause 'model'), "
                              "the engines against each other: each one's own first failure, "
                              "converged in the step, their median and outliers (two engines "
-                             "or more; docs/atlas.md)")
+                             "or more, from --engine or given here; docs/atlas.md); on a "
+                             "scene the model does not cover (drums, unequal, block_on_block) "
+                             "the engines' answer at every --omega (docs/geometry.md)")
     parser.add_argument("--json", action="store_true", help="print a JSON object")
     parser.add_argument("--csv", metavar="FILE", help="write the spectrum as CSV")
     parser.add_argument("--plot", metavar="FILE.png", help="write a Fig. 5-style plot")
@@ -190,6 +193,9 @@ def run(args: argparse.Namespace) -> int:
     from trilith_xval.compare.run import atomic
 
     scene = scene_from_args(args)
+    if getattr(scene, "kind", "trilith") != "trilith":  # no model: the engines' consensus
+        from trilith_xval.compare.cli.spectrum_kinds import kind_spectrum
+        return kind_spectrum(args, scene, parse_omega_range, settings_from_args)
     if args.record is not None:
         if restitution_factor(args) != 1.0:  # the record search runs the exact model
             raise ValueError("--restitution-factor is not supported with --record yet "
@@ -297,7 +303,13 @@ def _record_spectrum(args: argparse.Namespace, scene) -> int:
 
 
 def _engines(args: argparse.Namespace) -> tuple[str, ...]:
-    """The engines asked for (empty for the analytic spectrum); checked up front."""
+    """The engines asked for (empty for the analytic spectrum); checked up front;
+    ``--consensus E1,E2`` names them as ``--engine E1,E2 --consensus`` does."""
+    if isinstance(args.consensus, str):
+        if args.engine.strip() != "analytic":
+            raise ValueError("give the engines once: --engine E1,E2 --consensus, or "
+                             "--consensus E1,E2")
+        args.engine = args.consensus
     if args.engine.strip() == "analytic":
         if args.dt is not None or args.convergence:
             raise ValueError("--dt and --convergence need --engine NAME (an engine)")

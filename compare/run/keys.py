@@ -106,9 +106,14 @@ def excitation_dict(excitation) -> dict:
 
 
 def scene_dict(scene) -> dict:
-    """Every Scene field but ``name`` (a label: it does not change a run)."""
+    """Every Scene field but ``name`` (a label: it does not change a run); a scene of
+    another kind (:mod:`analytic.kinds`) adds its ``kind`` (a Scene's dict, hence
+    every stored key, stays as it was)."""
     out = dataclasses.asdict(scene)
     out.pop("name", None)
+    kind = getattr(scene, "kind", None)
+    if kind is not None:
+        out["kind"] = kind
     return out
 
 

@@ -150,7 +150,12 @@ def _friction_rule(backend, scene, excitation, settings, origin: dict):
     friction = getattr(settings, "friction", None)
     if friction is None:  # the engine's own default, which follows the same rule per run
         return settings, origin
-    need = required_friction(scene, excitation)
+    if getattr(scene, "kind", "trilith") != "trilith":
+        # Another kind (analytic.kinds): no model, so no no-sliding bound; a body moving
+        # with the ground needs PGA/g, as engines.base checks.
+        need = excitation.acceleration_bound() / scene.g
+    else:
+        need = required_friction(scene, excitation)
     where = origin.get("friction", "")
     if not where.startswith("the calibration of"):  # the user's own value: kept, checked
         if friction < need:

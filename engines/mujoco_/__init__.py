@@ -215,6 +215,7 @@ class MujocoEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: the contact time constant (solref),
     # in steps; MuJoCo requires at least 2 for stability (default 3).
     calibration_space = {"timeconst_steps": (2.0, 3.0, 5.0)}
@@ -227,7 +228,8 @@ class MujocoEngine(Engine):
 
     def build(self) -> None:
         scene, s = self.scene, self.settings
-        self.xml = mjcf(scene, s, self.friction)
+        self.structure = geometry.structure_of(scene, s.theta0, s.psi0)
+        self.xml = mjcf(self.structure, s, self.friction)
         try:
             self.model = m = mujoco.MjModel.from_xml_string(self.xml)
         except ValueError as exc:  # e.g. a body below MuJoCo's mass/inertia floor (1e-15)
@@ -241,21 +243,25 @@ class MujocoEngine(Engine):
             return int(m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)])
 
         # Slide/hinge joints only: qpos and qvel share their addresses.
-        self.columns = (adr("column_left_x"), adr("column_right_x"))
-        self.lintel = adr("lintel_x") if scene.mu > 0.0 else None
-        self.pendulum = adr("pendulum_psi") if scene.has_pendulum else None
+        structure = self.structure
+        self.boxes = [adr(f"{box.name}_x") for box in structure.bodies]
+        self.pendulum = adr("pendulum_psi") if structure.bob is not None else None
+        self.parent = (self.boxes[structure.index(structure.bob.parent)]
+                       if structure.bob is not None else None)
+        # The trilith's bodies by role (columns first, then the lintel if mu > 0).
+        trilith = structure.is_trilith
+        self.columns = tuple(self.boxes[:2]) if trilith else ()
+        self.lintel = self.boxes[2] if trilith and len(self.boxes) > 2 else None
         self.ground = adr("ground_x") if self.moving else None
         # Joint coordinates are offsets from the upright MJCF pose.
-        b, h, t_l = scene.b, scene.h, scene.lintel_thickness
-        self.centres0 = [(x + 0.5 * b, 0.5 * h) for x in geometry.column_lefts(scene)]
-        self.centres0.append((0.5 * scene.lintel_length, h + 0.5 * t_l))
-        poses = geometry.rest_poses(scene, s.theta0, s.psi0)
-        for a, (x, y), (x0, y0), angle in zip(
-                self.columns + ((self.lintel,) if self.lintel is not None else ()),
-                poses.columns + (poses.lintel,), self.centres0, (s.theta0, s.theta0, 0.0)):
+        self.centres0 = [box.upright for box in structure.bodies]
+        for a, box, (x0, y0) in zip(self.boxes, structure.bodies, self.centres0):
+            x, y, angle = box.start
             d.qpos[a:a + 3] = (x - x0, y - y0, angle)
         if self.pendulum is not None:
-            d.qpos[self.pendulum] = s.psi0  # relative to the lintel, which starts unrotated
+            # Relative to its parent (the trilith's lintel starts unrotated, a turned
+            # structure's parent by its tilt): the bob starts at psi0 from the vertical.
+            d.qpos[self.pendulum] = s.psi0 - structure.body(structure.bob.parent).start[2]
         if self.moving:
             self._set_ground(0)
         mujoco.mj_forward(m, d)
@@ -302,10 +308,13 @@ class MujocoEngine(Engine):
             return Pose(self.centres0[k][0] + qpos[a], self.centres0[k][1] + qpos[a + 1],
                         qpos[a + 2], qvel[a], qvel[a + 1], qvel[a + 2])
 
-        (al, ar), li, pe = self.columns, self.lintel, self.pendulum
-        lintel = pose(li, 2) if li is not None else None
+        poses = tuple(pose(a, k) for k, a in enumerate(self.boxes))
+        pe, pa = self.pendulum, self.parent
         psi = psi_dot = 0.0
-        if pe is not None:  # absolute angle: relative hinge angle plus the lintel's rotation
-            psi, psi_dot = qpos[pe] + qpos[li + 2], qvel[pe] + qvel[li + 2]
+        if pe is not None:  # absolute angle: relative hinge angle plus the parent's rotation
+            psi, psi_dot = qpos[pe] + qpos[pa + 2], qvel[pe] + qvel[pa + 2]
         gx = float(qpos[self.ground]) if self.moving else 0.0
-        return PlaneState((pose(al, 0), pose(ar, 1)), lintel, psi, psi_dot, gx, problem=problem)
+        if not self.structure.is_trilith:
+            return PlaneState((), None, psi, psi_dot, gx, problem=problem, bodies=poses)
+        lintel = poses[2] if len(poses) > 2 else None
+        return PlaneState(poses[:2], lintel, psi, psi_dot, gx, problem=problem)

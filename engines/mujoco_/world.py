@@ -1,5 +1,6 @@
-"""The MJCF model of the trilith, generated from a :class:`~analytic.parameters.Scene`
-and :mod:`engines.geometry`, for :mod:`engines.mujoco_`.
+"""The MJCF model of a scene's body list (:class:`~engines.geometry.Structure`:
+the trilith, the block, or another kind of :mod:`analytic.kinds`), for
+:mod:`engines.mujoco_`.
 
 The model is an MJCF string generated from the Scene's fields (:func:`mjcf`);
 nothing is typed twice.  The analytic plane (x right, y up) is MuJoCo's x-z
@@ -10,7 +11,7 @@ rotation in the analytic plane, so a column's hinge coordinate *is* its
 ``theta`` (and the pendulum's is ``psi`` relative to the lintel).  Out-of-plane
 motion is impossible by construction (the collision geometry stays 3D boxes).
 
-Bodies:
+Bodies of the trilith (the other kinds: each box a planar body, the same way):
 
 * ground: a static plane ``z = 0`` ("gravity" base motion), or a heavy box on a
   slide joint whose position and velocity are set to the ground's motion before
@@ -70,16 +71,21 @@ def _planar_body(name: str, pos: tuple[float, float], mass: float, inertia, geom
 
 
 def mjcf(scene, s, friction: float) -> str:
-    """The MJCF text of ``scene`` (upright, at rest) with the MuJoCo Settings ``s``.
+    """The MJCF text of ``scene`` (a scene or its
+    :class:`~engines.geometry.Structure`; upright, at rest) with the MuJoCo
+    Settings ``s``.
 
-    Every geom gets ``friction`` explicitly: MuJoCo combines two geoms'
-    coefficients by their maximum (PyBullet and Pymunk multiply), so equal
-    values give exactly ``friction`` at every contact.
+    Every box is a planar body of the world (boxes stack by contact, not by
+    joints); the bob is a child body of its parent box.  Every geom gets
+    ``friction`` explicitly: MuJoCo combines two geoms' coefficients by their
+    maximum (PyBullet and Pymunk multiply), so equal values give exactly
+    ``friction`` at every contact.
     """
-    b, h, d, depth = scene.b, scene.h, scene.d, scene.depth
-    span, t_l = scene.lintel_length, scene.lintel_thickness
+    structure = (scene if isinstance(scene, geometry.Structure)
+                 else geometry.structure_of(scene))
+    depth = structure.depth
     timeconst = s.timeconst if s.timeconst is not None else s.timeconst_steps * s.dt
-    option = (f'<option timestep="{_f(s.dt)}" gravity="{_vec(0.0, 0.0, -scene.g)}" '
+    option = (f'<option timestep="{_f(s.dt)}" gravity="{_vec(0.0, 0.0, -structure.g)}" '
               f'integrator="{s.integrator}" cone="{s.cone}" impratio="{_f(s.impratio)}" '
               f'iterations="{s.iterations}" solver="{s.solver}"/>')
     # margin 0 (a margin without gap makes contacts act at a distance) and
@@ -87,37 +93,34 @@ def mjcf(scene, s, friction: float) -> str:
     default = (f'<default><geom condim="3" margin="0" gap="0" '
                f'friction="{_vec(friction, 0.0, 0.0)}" '
                f'solref="{_vec(timeconst, s.dampratio)}" solimp="{_vec(*s.solimp)}"/></default>')
-    total = scene.m1 * (2.0 + scene.mu + scene.gamma)
-    g_half = geometry.ground_box(scene)
+    total = structure.total_mass
+    centre_x, *g_half = structure.ground
     if s.base_motion == "ground":
         # A box, since planes must be static; its top face is z = 0.
-        ground = (f'<body name="ground" pos="{_vec(0.5 * span, 0.0, -g_half[2])}">'
+        ground = (f'<body name="ground" pos="{_vec(centre_x, 0.0, -g_half[2])}">'
                   f'<joint name="ground_x" type="slide" axis="1 0 0"/>'
                   f'<inertial pos="0 0 0" mass="{_f(GROUND_MASS_FACTOR * total)}" '
                   f'diaginertia="{_vec(*geometry.box_inertia(GROUND_MASS_FACTOR * total, *g_half))}"/>'
                   f'<geom type="box" size="{_vec(*g_half)}"/></body>')
     else:
         ground = f'<geom name="ground" type="plane" size="{_vec(g_half[0], g_half[1], 1.0)}" ' \
-                 f'pos="{_vec(0.5 * span, 0.0, 0.0)}"/>'
-    col_geom = f'<geom type="box" size="{_vec(0.5 * b, 0.5 * depth, 0.5 * h)}"/>'
-    # J_G comes from the scene (it may differ from the uniform box's value).  Only
-    # the hinge axis (y) turns, so the other two principal inertias never enter
-    # the dynamics: equal to J_G, they satisfy MuJoCo's triangle inequality for any J_G.
-    col_inertia = (scene.inertia_J_G,) * 3
-    bodies = [_planar_body(name, (x_left + 0.5 * b, 0.5 * h), scene.m1, col_inertia, col_geom)
-              for name, x_left in (("column_left", 0.0), ("column_right", b + d))]
-    if scene.mu > 0.0:
+                 f'pos="{_vec(centre_x, 0.0, 0.0)}"/>'
+    # A column's inertia comes from the scene's J_G (it may differ from the uniform
+    # box's value): Structure gives it on all three axes.  Only the hinge axis (y)
+    # turns, so the other two never enter the dynamics: equal to J_G, they satisfy
+    # MuJoCo's triangle inequality for any J_G.
+    bob = structure.bob
+    bodies = []
+    for box in structure.bodies:
+        geom = f'<geom type="box" size="{_vec(0.5 * box.b, 0.5 * depth, 0.5 * box.h)}"/>'
         pendulum = ""
-        if scene.has_pendulum:
-            l, m4 = scene.pendulum_length, scene.m4
+        if bob is not None and bob.parent == box.name:
+            l, m4 = bob.length, bob.mass
             bob_i = NEGLIGIBLE_INERTIA_FRACTION * m4 * l * l
-            pendulum = (f'<body name="pendulum" pos="{_vec(scene.hinge_x, 0.0, -0.5 * t_l)}">'
+            pendulum = (f'<body name="pendulum" pos="{_vec(bob.anchor[0], 0.0, bob.anchor[1])}">'
                         f'<joint name="pendulum_psi" type="hinge" axis="0 -1 0"/>'
                         f'<inertial pos="{_vec(0.0, 0.0, -l)}" mass="{_f(m4)}" '
                         f'diaginertia="{_vec(bob_i, bob_i, bob_i)}"/></body>')
-        lintel_geom = f'<geom type="box" size="{_vec(0.5 * span, 0.5 * depth, 0.5 * t_l)}"/>'
-        bodies.append(_planar_body("lintel", (0.5 * span, h + 0.5 * t_l), scene.m3,
-                                   geometry.box_inertia(scene.m3, span, depth, t_l), lintel_geom,
-                                   pendulum))
+        bodies.append(_planar_body(box.name, box.upright, box.mass, box.inertia, geom, pendulum))
     return ('<mujoco model="trilith"><compiler angle="radian" inertiafromgeom="false"/>'
             f'{option}{default}<worldbody>{ground}{"".join(bodies)}</worldbody></mujoco>')

@@ -108,6 +108,7 @@ class PymunkEngine(Engine):
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: more iterations, a ten times looser
     # collision slop (defaults first).
     calibration_space = {"iterations": (30, 60), "slop_fraction": (1e-4, 1e-3)}
@@ -140,13 +141,16 @@ class PymunkEngine(Engine):
         self.step_index = n + steps
 
     def read(self) -> PlaneState:
-        st = self._read_state()  # per body: x, y, angle, vx, vy, omega (columns first)
-        columns = (Pose(*st[0:6]), Pose(*st[6:12]))
-        lintel = Pose(*st[12:18]) if self.world.lintel is not None else None
+        st = self._read_state()  # per body: x, y, angle, vx, vy, omega (structure order)
+        n = len(self.world.boxes)
+        poses = tuple(Pose(*st[6 * k:6 * k + 6]) for k in range(n))
         psi = psi_dot = 0.0
         if self.world.bob is not None:
-            i = 6 * (2 + (lintel is not None))
+            i = 6 * n
             psi, psi_dot = self.settings.psi0 + st[i + 2], st[i + 5]
         gx = (0.0 if self.settings.base_motion == "gravity"
               else self.excitation.displacement(self.step_index * self.settings.dt))
-        return PlaneState(columns, lintel, psi, psi_dot, gx)
+        if not self.world.structure.is_trilith:
+            return PlaneState((), None, psi, psi_dot, gx, bodies=poses)
+        lintel = poses[2] if n > 2 else None
+        return PlaneState(poses[:2], lintel, psi, psi_dot, gx)

@@ -1,8 +1,9 @@
-"""The trilith as three rigid polygons in a Pymunk space, for :mod:`engines.pymunk_`.
+"""A scene's body list as rigid polygons in a Pymunk space, for :mod:`engines.pymunk_`.
 
 :func:`build_space` builds a fresh :class:`pymunk.Space` from the scene's
-geometry (:mod:`engines.geometry`); :func:`state_reader` reads every body's
-state in one call per sample.
+:class:`~engines.geometry.Structure` (the trilith, the block, or another kind
+of :mod:`analytic.kinds`); :func:`state_reader` reads every body's state in
+one call per sample.
 """
 from __future__ import annotations
 
@@ -18,30 +19,49 @@ __all__ = ["Space", "build_space", "state_reader"]
 
 @dataclass
 class Space:
-    """A built space and its bodies (columns first, then lintel and bob if any)."""
+    """A built space and its bodies in the structure's order (for the trilith:
+    columns first, then lintel), the bob last if any; ``columns``/``lintel``
+    name the trilith's bodies (empty/None for the other kinds)."""
 
     space: pymunk.Space
     ground: pymunk.Body
-    columns: list
-    lintel: pymunk.Body | None
+    boxes: list
     bob: pymunk.Body | None
+    structure: geometry.Structure
+
+    @property
+    def columns(self) -> list:
+        names = [x.name for x in self.structure.bodies]
+        return [self.boxes[names.index(n)] for n in ("column_left", "column_right")
+                if n in names] if self.structure.is_trilith else []
+
+    @property
+    def lintel(self) -> pymunk.Body | None:
+        if self.structure.is_trilith and len(self.boxes) > 2:
+            return self.boxes[2]
+        return None
 
     @property
     def bodies(self) -> list:
-        return self.columns + [x for x in (self.lintel, self.bob) if x is not None]
+        return self.boxes + ([self.bob] if self.bob is not None else [])
 
 
 def build_space(scene, s, friction: float) -> Space:
-    """A fresh space holding ``scene`` at rest at ``s.theta0`` / ``s.psi0``, every
-    contact with the Coulomb coefficient ``friction`` (``s``: the Pymunk Settings)."""
-    b, h = scene.b, scene.h
-    t_l = scene.lintel_thickness
+    """A fresh space holding ``scene`` (a scene, or its
+    :class:`~engines.geometry.Structure`) at rest at ``s.theta0`` / ``s.psi0``,
+    every contact with the Coulomb coefficient ``friction`` (``s``: the Pymunk
+    Settings).
+
+    Bodies are added in the structure's order after the ground (Chipmunk keeps
+    insertion order; :func:`state_reader` relies on it)."""
+    structure = (scene if isinstance(scene, geometry.Structure)
+                 else geometry.structure_of(scene, s.theta0, s.psi0))
     space = pymunk.Space()
     space.iterations = s.iterations
-    space.collision_slop = s.slop_fraction * b
+    space.collision_slop = s.slop_fraction * structure.width_scale
     if s.collision_bias is not None:
         space.collision_bias = s.collision_bias
-    space.gravity = (0.0, -scene.g)
+    space.gravity = (0.0, -structure.g)
     shape_friction = math.sqrt(friction)  # Pymunk multiplies the pair's values
 
     def add_box(body, w, hh):
@@ -53,42 +73,39 @@ def build_space(scene, s, friction: float) -> Space:
 
     kind = pymunk.Body.KINEMATIC if s.base_motion == "ground" else pymunk.Body.STATIC
     ground = pymunk.Body(body_type=kind)
-    half_w, _, half_t = geometry.ground_box(scene)
-    ground.position = (0.5 * scene.lintel_length, -half_t)
+    centre_x, half_w, _, half_t = structure.ground
+    ground.position = (centre_x, -half_t)
     space.add(ground)
     add_box(ground, 2.0 * half_w, 2.0 * half_t)
 
-    poses = geometry.rest_poses(scene, s.theta0, s.psi0)
-    columns = []
-    for centre in poses.columns:
-        body = pymunk.Body(scene.m1, scene.inertia_J_G)
-        body.position = centre
-        body.angle = s.theta0
+    boxes = []
+    for box in structure.bodies:
+        # The in-plane principal inertia (the depth axis) is the one that turns.
+        body = pymunk.Body(box.mass, box.inertia[1])
+        x, y, angle = box.start
+        body.position = (x, y)
+        if angle != 0.0:
+            body.angle = angle
         space.add(body)
-        add_box(body, b, h)
-        columns.append(body)
-    lintel = bob = None
-    if scene.mu > 0.0:
-        length = scene.lintel_length
-        lintel = pymunk.Body(scene.m3, geometry.box_inertia(scene.m3, length, scene.depth, t_l)[1])
-        lintel.position = poses.lintel
-        space.add(lintel)
-        add_box(lintel, length, t_l)
-    if scene.has_pendulum:
-        l = scene.pendulum_length
-        radius = s.pendulum_radius_fraction * l
-        bob = pymunk.Body(scene.m4, scene.m4 * radius ** 2)
-        bob.position = poses.bob
+        add_box(body, box.b, box.h)
+        boxes.append(body)
+    bob = None
+    if structure.bob is not None:
+        spec = structure.bob
+        parent = boxes[structure.index(spec.parent)]
+        radius = s.pendulum_radius_fraction * spec.length
+        bob = pymunk.Body(spec.mass, spec.mass * radius ** 2)
+        bob.position = spec.start
         space.add(bob)
         dot = pymunk.Circle(bob, radius)
         dot.filter = pymunk.ShapeFilter(categories=0, mask=0)  # collides with nothing
         space.add(dot)
-        anchor_bob = (poses.hinge[0] - poses.bob[0], poses.hinge[1] - poses.bob[1])
+        anchor_bob = (spec.hinge[0] - spec.start[0], spec.hinge[1] - spec.start[1])
         # The bob's body is the rod: its rotation is the pendulum's (psi - psi0).
-        joint = pymunk.PivotJoint(lintel, bob, (scene.hinge_x, -0.5 * t_l), anchor_bob)
+        joint = pymunk.PivotJoint(parent, bob, spec.anchor, anchor_bob)
         joint.collide_bodies = False
         space.add(joint)
-    return Space(space, ground, columns, lintel, bob)
+    return Space(space, ground, boxes, bob, structure)
 
 
 def state_reader(world: Space):

@@ -1,0 +1,82 @@
+"""Pymunk and MuJoCo engines whose build and read hooks are the pre-body-list code,
+verbatim (builders in :mod:`.pymunk_world` and :mod:`.mujoco_world`)."""
+from __future__ import annotations
+
+import mujoco
+
+from trilith_xval.engines import geometry
+from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines.mujoco_ import MujocoEngine
+from trilith_xval.engines.pymunk_ import PymunkEngine
+
+from . import mujoco_world, pymunk_world
+
+
+class LegacyPymunk(PymunkEngine):
+    def build(self) -> None:
+        self.world = pymunk_world.build_space(self.scene, self.settings, self.friction)
+        self._read_state = pymunk_world.state_reader(self.world)
+
+    def read(self) -> PlaneState:
+        st = self._read_state()
+        columns = (Pose(*st[0:6]), Pose(*st[6:12]))
+        lintel = Pose(*st[12:18]) if self.world.lintel is not None else None
+        psi = psi_dot = 0.0
+        if self.world.bob is not None:
+            i = 6 * (2 + (lintel is not None))
+            psi, psi_dot = self.settings.psi0 + st[i + 2], st[i + 5]
+        gx = (0.0 if self.settings.base_motion == "gravity"
+              else self.excitation.displacement(self.step_index * self.settings.dt))
+        return PlaneState(columns, lintel, psi, psi_dot, gx)
+
+
+class LegacyMujoco(MujocoEngine):
+    def build(self) -> None:
+        scene, s = self.scene, self.settings
+        self.xml = mujoco_world.mjcf(scene, s, self.friction)
+        self.model = m = mujoco.MjModel.from_xml_string(self.xml)
+        self.data = d = mujoco.MjData(m)
+        self.moving = s.base_motion == "ground"
+
+        def adr(joint: str) -> int:
+            return int(m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)])
+
+        self.columns = (adr("column_left_x"), adr("column_right_x"))
+        self.lintel = adr("lintel_x") if scene.mu > 0.0 else None
+        self.pendulum = adr("pendulum_psi") if scene.has_pendulum else None
+        self.ground = adr("ground_x") if self.moving else None
+        b, h, t_l = scene.b, scene.h, scene.lintel_thickness
+        self.centres0 = [(x + 0.5 * b, 0.5 * h) for x in geometry.column_lefts(scene)]
+        self.centres0.append((0.5 * scene.lintel_length, h + 0.5 * t_l))
+        poses = geometry.rest_poses(scene, s.theta0, s.psi0)
+        for a, (x, y), (x0, y0), angle in zip(
+                self.columns + ((self.lintel,) if self.lintel is not None else ()),
+                poses.columns + (poses.lintel,), self.centres0, (s.theta0, s.theta0, 0.0)):
+            d.qpos[a:a + 3] = (x - x0, y - y0, angle)
+        if self.pendulum is not None:
+            d.qpos[self.pendulum] = s.psi0
+        if self.moving:
+            self._set_ground(0)
+        mujoco.mj_forward(m, d)
+        self._warnings = [int(getattr(mujoco.mjtWarning, w)) for w in mujoco_world.BAD_WARNINGS]
+
+    def read(self) -> PlaneState:
+        d = self.data
+        qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
+        problem = None
+        for w in self._warnings:
+            if d.warning[w].number:
+                problem = f"MuJoCo warning {mujoco.mjtWarning(w).name} (state reset or invalid)"
+                break
+
+        def pose(a: int, k: int) -> Pose:
+            return Pose(self.centres0[k][0] + qpos[a], self.centres0[k][1] + qpos[a + 1],
+                        qpos[a + 2], qvel[a], qvel[a + 1], qvel[a + 2])
+
+        (al, ar), li, pe = self.columns, self.lintel, self.pendulum
+        lintel = pose(li, 2) if li is not None else None
+        psi = psi_dot = 0.0
+        if pe is not None:
+            psi, psi_dot = qpos[pe] + qpos[li + 2], qvel[pe] + qvel[li + 2]
+        gx = float(qpos[self.ground]) if self.moving else 0.0
+        return PlaneState((pose(al, 0), pose(ar, 1)), lintel, psi, psi_dot, gx, problem=problem)
