@@ -58,17 +58,8 @@ def load_kind(path: Path, table: dict, overrides: dict, check_value):
     values.setdefault("name", path.stem)
     if kind == "drums" and len(values.get("heights", ())) == 1:
         return _one_drum(where, values, overrides)
-    try:
-        scene = cls(**values)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{where}: {exc}") from None
-    if not overrides:
-        return scene
-    try:
-        return scene.replace(**overrides)
-    except (TypeError, ValueError) as exc:
-        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
-        raise ValueError(f"override {shown}: {exc}") from None
+    from . import build_scene
+    return build_scene(cls, values, overrides, f"{where}: ")
 
 
 def _one_drum(where: str, values: dict, overrides: dict):
