@@ -9,7 +9,8 @@ per engine and per *metric*, on a stated validation set:
 ``restitution``
     free rocking from ``alpha/2``: the worst relative error of the first impacts'
     velocity ratios against Eq. 20 (no pendulum) and Eq. 19 (with it), over
-    slenderness ``lam`` and lintel mass ratio ``mu`` (:func:`measure_restitution`).
+    slenderness ``lam`` and lintel mass ratio ``mu``
+    (:func:`compare.measure.restitution.free_rocking`).
 ``thresholds``
     the first-overturning amplitude under one-sine pulses (Eq. 22) at a few
     frequencies, both curves: the worst relative error against the analytic
@@ -197,7 +198,7 @@ def _candidates(space: dict) -> list[dict]:
 
 # ------------------------------------------------------------------ the three metrics
 def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
-    from trilith_xval.compare.measure.restitution import measure_restitution
+    from trilith_xval.compare.measure.restitution import free_rocking
     cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
              for lam, mu in vs.releases]
     if scene.has_pendulum:
@@ -206,8 +207,7 @@ def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
     for label, sc in cases:
         run = RunSpec.resolve(engine, sc, overrides=options,
                               overrides_from="the candidate settings")
-        r = measure_restitution(engine, sc, settings=run.settings, n_impacts=vs.n_impacts,
-                                restitution_factor=rf)
+        r = free_rocking(run, n_impacts=vs.n_impacts, restitution_factor=rf)
         errors.append((label, r.max_rel_error if r.complete else math.nan))
         engine_cpu += r.diagnostics["cpu_time"]
         simulated += r.diagnostics["steps"] * r.settings["dt"]

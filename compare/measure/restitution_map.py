@@ -11,7 +11,7 @@ Eq. 20 with the lintel and no pendulum, Eq. 19 with the pendulum), one *cell*:
   model's (Eq. 20, which for a block is Housner's ``1 - 1.5 sin^2 alpha``; Eq. 19
   at the measured psi with the pendulum), and ``r_worst`` the largest
   ``|measured / predicted - 1|`` of those impacts
-  (:func:`compare.measure.restitution.measure_restitution`: free rocking from
+  (:func:`compare.measure.restitution.free_rocking`: free rocking from
   ``alpha / 2``, the run ends halfway to impact ``N_IMPACTS + 1``, before rest);
 * ``thr_error``: the engine's first-overturning one-sine amplitude at
   ``Omega = OMEGA_RATIO p`` (``p = sqrt(3 g / (4 R))`` of one column, ``R``
@@ -177,7 +177,7 @@ def measure_cell(job: tuple) -> dict:
     store_dir)``; a dict (plain data).  Module-level: workers pickle it."""
     engine, variant_name, scene_name, w, a_model, mode = job[:6]
     from trilith_xval.compare.measure.engine_spectrum import threshold_spec
-    from trilith_xval.compare.measure.restitution import measure_restitution
+    from trilith_xval.compare.measure.restitution import free_rocking
     from trilith_xval.compare.measure.thresholds import engine_threshold
     from trilith_xval.compare.run.spec import RunSpec
     variant = next(v for v in GRIDS[engine] if v.name == variant_name)
@@ -190,7 +190,7 @@ def measure_cell(job: tuple) -> dict:
     try:
         run = RunSpec.resolve(engine, scene, overrides=dict(variant.options),
                               overrides_from=f"the variant {variant.name}")
-        res = measure_restitution(engine, scene, settings=run.settings, n_impacts=N_IMPACTS)
+        res = free_rocking(run, n_impacts=N_IMPACTS)
         ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
         r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
         out.update(equation=res.equation, n_impacts=res.n_impacts, complete=res.complete,
