@@ -130,11 +130,22 @@ def test_campaign_jobs_carry_the_file_into_their_keys():
 
 
 def test_recordings_run_with_the_file_options():
-    from trilith_xval.compare.show.record import RecordSettings, backend_settings
-    settings = RecordSettings(engine_options=(("pymunk", (("dt", 1e-3),)),))
-    assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
-    run = backend_settings("pymunk", 2.0, settings.options("pymunk"))
-    assert (run.dt, run.t_max, run.early_stop) == (1e-3, 2.0, False)
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.compare.show.record import RecordSettings, recording_run
+    from trilith_xval.engines import configure
+    from trilith_xval.scenes import load_scene
+    fig5, pulse = load_scene("fig5"), Pulse(19.0, 15.0)
+    filed = RunSpec.resolve("pymunk", fig5, pulse, file_options={"dt": 1e-3}, file_name="f.toml")
+    settings = RecordSettings(runs=(filed,))
+    assert settings.run_of("pymunk") is filed and settings.run_of("mujoco") is None
+    run = recording_run("pymunk", fig5, pulse, 2.0, settings.run_of("pymunk"))
+    assert (run.settings.dt, run.settings.t_max, run.settings.early_stop) == (1e-3, 2.0, False)
+    assert dict(run.origin) == {"dt": "--settings f.toml", "t_max": "the recorded span",
+                                "early_stop": "the recorded span"}
+    # Without a given run: the backend's defaults over the span, as before.
+    plain = recording_run("mujoco", fig5, pulse, 2.0)
+    assert plain.settings == configure("mujoco", t_max=2.0, early_stop=False)
 
 
 @pytest.mark.parametrize("command", ["simulate", "map"])
