@@ -120,11 +120,16 @@ def test_campaign_jobs_carry_the_file_into_their_keys():
     filed_job, = threshold_jobs(study, refs, {"pymunk": {"dt": 1e-3}})
     assert threshold_description(filed_job)["settings"]["dt"] == 1e-3
     assert digest(threshold_description(plain_job)) != digest(threshold_description(filed_job))
+    from trilith_xval.compare.campaign.validation_jobs import RestitutionJob
+    from trilith_xval.compare.campaign.config import campaign_run
+    from trilith_xval.scenes import load_scene
     a = CampaignConfig(engines=("pymunk",))
     b = CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"dt": 1e-3}})
-    job = ("restitution", ("pymunk", None))
-    assert digest(_job_description((job[0], (*job[1], a)))) != \
-        digest(_job_description((job[0], (*job[1], b))))
+    fig5 = load_scene("fig5")
+    job_a = RestitutionJob(campaign_run("pymunk", a, fig5), a)
+    job_b = RestitutionJob(campaign_run("pymunk", b, fig5), b)
+    assert job_b.run.settings.dt == 1e-3 != job_a.run.settings.dt
+    assert digest(_job_description(job_a)) != digest(_job_description(job_b))
     with pytest.raises(ValueError, match="iterations"):
         CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"iterations": 0}})
 
