@@ -161,17 +161,19 @@ def _histories(engine, scene, band, tol) -> list[dict]:
     return out
 
 
-def _records(engine, scene, records, options) -> list[dict]:
+def _records(run, records) -> list[dict]:
     """Each record's first overturning intensity: the model's (window-aware IDA,
-    the accurate model) against the engine's robust one under the step rule."""
+    the accurate model) against the robust one of ``run`` (the engine's
+    threshold-search :class:`~compare.run.spec.RunSpec` on the scene) under the
+    step rule."""
     from trilith_xval.analytic.ida import IDASettings, first_overturn_intensity, model_verdict
     from trilith_xval.compare.measure.record_threshold import STEP_TOL, engine_intensity
     st = IDASettings()
     out = []
     for rec in records:
-        model = first_overturn_intensity(rec, model_verdict(scene, st.tail), st)
+        model = first_overturn_intensity(rec, model_verdict(run.scene, st.tail), st)
         im_model = model.im_overturn if math.isfinite(model.im_overturn) else None
-        res = engine_intensity(engine, scene, rec, st, im_model, options)
+        res = engine_intensity(run, rec, st, im_model)
         im = res["im_overturn"]
         err = (im - im_model) / im_model if (im is not None and im_model) else None
         out.append({"record": res["label"], "im": st.im, "im_model": im_model, "im_engine": im,
@@ -243,7 +245,7 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
         entry["histories"] = _histories(e, scene, band, tol)
         if records:
             progress.next(f"{e} records", len(records))
-            entry["records"] = _records(e, scene, records, choice.options)
+            entry["records"] = _records(runs[e], records)
         entry["cost"] = _cost(entry)
         doc["engines"][e] = entry
     if len(engines) >= 2:
