@@ -176,7 +176,7 @@ def measure_cell(job: tuple) -> dict:
     """One cell: ``job = (engine, variant_name, scene_name, omega, a_model, mode,
     store_dir)``; a dict (plain data).  Module-level: workers pickle it."""
     engine, variant_name, scene_name, w, a_model, mode = job[:6]
-    from trilith_xval.compare.measure.engine_spectrum import threshold_spec
+    from trilith_xval.compare.measure.engine_spectrum import point_spec
     from trilith_xval.compare.measure.restitution import free_rocking
     from trilith_xval.compare.measure.thresholds import engine_threshold
     from trilith_xval.compare.run.spec import RunSpec
@@ -185,11 +185,11 @@ def measure_cell(job: tuple) -> dict:
     c0 = time.process_time()
     out = {"engine": engine, "variant": variant_name, "scene": scene_name, "lam": scene.lam,
            "omega": w, "a_model": a_model, "mode_model": mode, "error": None}
+    run = RunSpec.resolve(engine, scene, overrides=dict(variant.options),
+                          overrides_from=f"the variant {variant.name}")
     # An engine that fails a run (Drake's SAP not converging) fails its cell, not
     # the map: the cell is kept with the engine's message and counts as failing.
     try:
-        run = RunSpec.resolve(engine, scene, overrides=dict(variant.options),
-                              overrides_from=f"the variant {variant.name}")
         res = free_rocking(run, n_impacts=N_IMPACTS)
         ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
         r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
@@ -204,7 +204,7 @@ def measure_cell(job: tuple) -> dict:
                mode_engine=None, thr_runs=0, thr_cpu_s=0.0)
     if math.isfinite(a_model):
         try:
-            spec = threshold_spec(engine, scene, w, a_model, options=dict(variant.options))
+            spec = point_spec(run, scene, w, a_model)  # at the search's largest pulse
             p = engine_threshold(engine, scene, w, a_model, spec.settings, mode_reference=mode)
             out.update(a_engine=p.a_engine, a_survives=p.a_survives, thr_error=p.rel_error,
                        mode_engine=p.mode_engine, thr_runs=p.n_runs, thr_cpu_s=p.cpu_s)
