@@ -120,14 +120,17 @@ def _thresholds(run, band, progress) -> list[dict]:
     return out
 
 
-def _restitution(engine, scene, tol) -> list[dict]:
-    from trilith_xval.compare.measure.restitution import measure_restitution
+def _restitution(run, tol) -> list[dict]:
+    """Free rocking of ``run`` (the engine at its defaults, which are calibrated for
+    restitution) on its scene without and with the pendulum."""
+    from trilith_xval.compare.measure.restitution import free_rocking
+    scene = run.scene
     cases = [("Eq. 20", scene.without_pendulum(), tol.restitution)]
     if scene.has_pendulum:
         cases.append(("Eq. 19", scene, tol.restitution_pendulum))
     out = []
     for eq, sc, t in cases:
-        r = measure_restitution(engine, sc)
+        r = free_rocking(run.at(scene=sc))
         err = r.max_rel_error if r.complete else None
         out.append({"equation": eq, "max_rel_error": err, "tolerance": t,
                     "passed": err is not None and abs(err) <= t, "impacts": len(r.impacts),
@@ -135,12 +138,14 @@ def _restitution(engine, scene, tol) -> list[dict]:
     return out
 
 
-def _histories(engine, scene, band, tol) -> list[dict]:
+def _histories(run, band, tol) -> list[dict]:
+    """Time histories of ``run`` (the engine at its defaults) against the model's,
+    at multiples of the band's thresholds."""
     from trilith_xval import engines
     from trilith_xval.analytic.excitation import Pulse
     from trilith_xval.compare.measure.trajectories import compare_trajectories
     from trilith_xval.compare.run import runs
-    out = []
+    scene, out = run.scene, []
     for case, rows in band["curves"].items():
         picked = _spread(rows, 3)
         if not picked:
@@ -150,7 +155,7 @@ def _histories(engine, scene, band, tol) -> list[dict]:
         for f in HISTORY_FACTORS:
             pulse = Pulse(f * r["a_model"], r["omega"])
             ref = runs.simulate("analytic", sc, pulse, engines.configure("analytic"))
-            test = runs.simulate(engine, sc, pulse, engines.configure(engine))
+            test = runs.simulate(run.backend, sc, pulse, run.at(sc, pulse).settings)
             c = compare_trajectories(ref, test)
             rms = c.theta_rms_first if math.isfinite(c.theta_rms_first) else None
             out.append({"case": case, "omega": r["omega"], "amplitude": pulse.amplitude,
@@ -230,6 +235,7 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.run.spec import RunSpec
     runs = {e: RunSpec.resolve(e, scene, Still(), calibrated=True) for e in engines}
+    defaults = {e: RunSpec.resolve(e, scene) for e in engines}  # restitution, histories
     for e in engines:
         choice = threshold_choice(e, scene)
         settings = runs[e].settings
@@ -240,9 +246,9 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
         entry["thresholds"] = _thresholds(runs[e], band, progress)
         entry["threshold_verdict"] = _verdict(entry["thresholds"])
         progress.next(f"{e} restitution")
-        entry["restitution"] = _restitution(e, scene, tol)
+        entry["restitution"] = _restitution(defaults[e], tol)
         progress.next(f"{e} time histories")
-        entry["histories"] = _histories(e, scene, band, tol)
+        entry["histories"] = _histories(defaults[e], band, tol)
         if records:
             progress.next(f"{e} records", len(records))
             entry["records"] = _records(runs[e], records)
