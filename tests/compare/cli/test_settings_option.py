@@ -177,3 +177,30 @@ def test_a_friction_given_above_the_bound_is_kept_as_given(tmp_path, capsys):
     path.write_text(f"[pymunk]\nfriction = {1.05 * need!r}\n")  # below the 1.2x margin
     doc = _simulate_json(COMMANDS["simulate"] + ["--settings", str(path)], capsys)
     assert doc["settings"]["friction_used"] == 1.05 * need
+
+
+def test_record_resolves_each_backends_run_from_the_file(tmp_path):
+    """trilith record / view hand each backend's RunSpec (defaults, then the
+    --settings table) to the recording: the run a panel shows is that spec with
+    the recorded span over it."""
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.cli.main import build_parser
+    from trilith_xval.compare.cli.record import watch_inputs
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.compare.show.record import recording_run
+    from trilith_xval.scenes import load_scene
+    path = tmp_path / "s.toml"
+    path.write_text("[pymunk]\ndt = 0.0005\n")
+    parser, _ = build_parser()
+    args = parser.parse_args(["record", "--engine", "analytic,pymunk", "--settings", str(path),
+                              "--duration", "1", "--out", str(tmp_path / "x.gif")])
+    scene, excitation, settings = watch_inputs(args)
+    assert excitation == Pulse(19.0, 15.0) and scene == load_scene("fig5")
+    assert [r.backend for r in settings.runs] == ["analytic", "pymunk"]
+    filed = RunSpec.resolve("pymunk", scene, excitation, file_options={"dt": 5e-4},
+                            file_name=repr(str(path)))
+    assert settings.run_of("pymunk").key() == filed.key()
+    assert settings.run_of("analytic").key() == RunSpec.resolve("analytic", scene,
+                                                                excitation).key()
+    shown = recording_run("pymunk", scene, excitation, 1.0, settings.run_of("pymunk"))
+    assert (shown.settings.dt, shown.settings.t_max) == (5e-4, 1.0)
