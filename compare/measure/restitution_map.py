@@ -30,9 +30,9 @@ import os
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["Variant", "MapCell", "GRIDS", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO", "N_IMPACTS",
-           "R_TOL", "THR_TOL", "cell_scene", "measure_cell", "restitution_map", "cheapest",
-           "not_exposed"]
+__all__ = ["Variant", "MapCell", "GRIDS", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO",
+           "N_IMPACTS", "R_TOL", "THR_TOL", "cell_scene", "measure_cell", "restitution_map",
+           "cheapest", "not_exposed"]
 
 LAMS = (1.5, 2.0, 3.0, 5.0, 8.0, 10.0)
 # The paper's trilith (fig5, lam 5, mu 1): without the pendulum Eq. 20 holds
