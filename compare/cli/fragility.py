@@ -75,14 +75,12 @@ def _im_range(args) -> tuple[float, float]:
                          f"--im-range: {args.im_range!r} is not LO:HI") from None
 
 
-def intensities(scene, suite, backends, st: IDASettings, workers: int, scheduler,
-                loaded=None) -> list:
-    """The model's IDA of every record, then each engine's robust bracket around
-    it (its run with its ``--settings`` table from ``loaded``); backend-major, in
-    the order of ``suite``."""
+def intensities(scene, suite, runs, st: IDASettings, workers: int, scheduler) -> list:
+    """The model's IDA of every record, then the robust bracket around it of each
+    engine's run in ``runs`` (:func:`engine_runs`); backend-major (the model
+    first), in the order of ``suite``."""
     from trilith_xval.compare.measure.record_jobs import IDAJob, RobustJob, model_run
     model = _run_all([IDAJob(model_run(scene), r, st) for r in suite], workers, scheduler)
-    runs = engine_runs(scene, [b for b in backends if b != "analytic"], loaded)
     jobs = [RobustJob(run, r, st, None if m["censored"] else m["im_overturn"])
             for run in runs for r, m in zip(suite, model)]
     return model + (_run_all(jobs, workers, scheduler) if jobs else [])
@@ -102,6 +100,7 @@ def run(args: argparse.Namespace) -> int:
     engines_ = parse_engine_list(args.engine, none_ok=True)
     st = ida_settings(args)
     loaded = settings_from_args(args, engines_)
+    runs = engine_runs(scene, engines_, loaded)
     workers = resolve_workers(args.workers)
     # Built beside --out and swapped in whole, so that nothing exists until the
     # results do, and only a folder this tool wrote (or an empty one) is replaced.
@@ -114,10 +113,10 @@ def run(args: argparse.Namespace) -> int:
                          "FILE)")
     store = use_store(args)
     backends = ("analytic",) + engines_
-    results = intensities(scene, suite, backends, st, workers, args.scheduler, loaded)
+    results = intensities(scene, suite, runs, st, workers, args.scheduler)
     doc = _summarise(scene, suite, backends, st, results)
     if stripes:
-        _add_msa(doc, scene, suite, backends, st, stripes, workers, args.scheduler, loaded)
+        _add_msa(doc, scene, suite, runs, st, stripes, workers, args.scheduler)
     doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
     print_fragility(doc, st)
@@ -143,16 +142,16 @@ def _stripes(text, im: str) -> tuple[float, ...]:
     return check_stripes(values, "--stripes")
 
 
-def _add_msa(doc, scene, suite, backends, st, stripes, workers, scheduler, loaded) -> None:
-    """Each backend's multiple-stripe fit into ``doc['backends'][b]['msa']``."""
+def _add_msa(doc, scene, suite, runs, st, stripes, workers, scheduler) -> None:
+    """Each backend's multiple-stripe fit into ``doc['backends'][b]['msa']``: the
+    model's, then that of each engine's run in ``runs``."""
     from trilith_xval.compare.measure.msa import msa_fragility
     from trilith_xval.compare.measure.record_jobs import StripeJob, model_run
-    runs = [model_run(scene), *engine_runs(scene, [b for b in backends if b != "analytic"],
-                                           loaded)]
+    runs = [model_run(scene), *runs]
     jobs = [StripeJob(run, r, stripes, st.im, st.tail) for run in runs for r in suite]
     verdicts = _run_all(jobs, workers, scheduler)
     n = len(suite)
-    for i, b in enumerate(backends):
+    for i, b in enumerate(run.backend for run in runs):
         doc["backends"][b]["msa"] = {
             **msa_fragility(verdicts[i * n:(i + 1) * n], stripes).describe(),
             "verdicts": {r.label: v for r, v in zip(suite, verdicts[i * n:(i + 1) * n])}}
@@ -269,7 +268,7 @@ def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int
     given = load_record(args.record, option="--record")
     record = scaled_record(given, args)
     from trilith_xval.compare.measure.record_jobs import IDAJob, model_run
-    runs = [model_run(scene), *engine_runs(scene, backends[1:], loaded)]
+    runs = [model_run(scene), *engine_runs(scene, backends[1:], loaded)]  # before any work
     use_store(args)
     results = _run_all([IDAJob(run, record, st) for run in runs], workers, args.scheduler)
     # The factor on the record as the file gives it (--scale included), whatever the

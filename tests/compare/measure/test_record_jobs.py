@@ -80,7 +80,8 @@ def test_fragility_builds_its_record_runs_from_run_specs(monkeypatch, tmp_path):
         batches.append(jobs)
         return [{"censored": False, "im_overturn": 5.0}] * len(jobs)
     monkeypatch.setattr(fragility, "_run_all", answer)
-    fragility.intensities(scene, suite, ("analytic", "pymunk"), ST, 1, None, loaded)
+    fragility.intensities(scene, suite, fragility.engine_runs(scene, ["pymunk"], loaded), ST, 1,
+                          None)
     model, robust = batches
     assert all(isinstance(j, IDAJob) and j.run.backend == "analytic" for j in model)
     want = RunSpec.resolve("pymunk", scene, file_options={"dt": 5e-4},
@@ -101,3 +102,17 @@ def test_a_bad_record_run_is_refused_at_the_door(tmp_path):
     with pytest.raises(ValueError, match=r"friction must be >= .*\(from --settings .*slide"):
         engine_runs(load_scene("fig5"), ["pymunk"], read_settings_file(path))
     assert record_jobs.run_job(lambda: 3) == 3
+
+
+def test_fragility_refuses_a_bad_run_before_any_job(tmp_path, monkeypatch, capsys):
+    from trilith_xval.compare.cli import fragility
+    from trilith_xval.compare.cli.main import main
+    path = tmp_path / "slide.toml"
+    path.write_text("[pymunk]\nfriction = 0.01\n")
+    monkeypatch.setattr(fragility, "_run_all", lambda *a: pytest.fail("a job ran"))
+    argv = ["fragility", "--records", "synthetic", "--engine", "pymunk", "--settings", str(path),
+            "--out", str(tmp_path / "out"), "--no-cache"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: friction must be >=") and "slide.toml" in err
+    assert err.count("\n") == 1
