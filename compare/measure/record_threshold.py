@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["engine_intensity", "record_run", "STEP_TOL"]
+__all__ = ["engine_intensity", "record_run", "search_centre", "STEP_TOL"]
 
 # Agreement with the model's intensity that ends the step rule: the threshold
 # tolerance of the pulse spectra (2 %).
