@@ -9,7 +9,8 @@ per engine and per *metric*, on a stated validation set:
 ``restitution``
     free rocking from ``alpha/2``: the worst relative error of the first impacts'
     velocity ratios against Eq. 20 (no pendulum) and Eq. 19 (with it), over
-    slenderness ``lam`` and lintel mass ratio ``mu`` (:func:`measure_restitution`).
+    slenderness ``lam`` and lintel mass ratio ``mu``
+    (:func:`compare.measure.restitution.free_rocking`).
 ``thresholds``
     the first-overturning amplitude under one-sine pulses (Eq. 22) at a few
     frequencies, both curves: the worst relative error against the analytic
@@ -196,18 +197,26 @@ def _candidates(space: dict) -> list[dict]:
 
 
 # ------------------------------------------------------------------ the three metrics
-def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
-    from trilith_xval.compare.measure.restitution import measure_restitution
+def _candidate_run(engine: str, scene, base: dict, varied: dict) -> RunSpec:
+    """One candidate's run of ``engine`` on ``scene`` (no base motion): the
+    engine's defaults, ``base`` (e.g. a settings file's table), then the
+    candidate's own values; each metric resolves it again on its scenes and
+    excitations (:meth:`RunSpec.at`)."""
+    from trilith_xval.analytic.excitation import Still
+    return RunSpec.resolve(engine, scene, Still(), overrides={**base, **varied},
+                           overrides_from="the candidate settings")
+
+
+def _restitution(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
+    from trilith_xval.compare.measure.restitution import free_rocking
+    scene = run.scene
     cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
              for lam, mu in vs.releases]
     if scene.has_pendulum:
         cases.append((f"lam {scene.lam:g} mu {scene.mu:g} gamma {scene.gamma:g}", scene))
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for label, sc in cases:
-        run = RunSpec.resolve(engine, sc, overrides=options,
-                              overrides_from="the candidate settings")
-        r = measure_restitution(engine, sc, settings=run.settings, n_impacts=vs.n_impacts,
-                                restitution_factor=rf)
+        r = free_rocking(run.at(scene=sc), n_impacts=vs.n_impacts, restitution_factor=rf)
         errors.append((label, r.max_rel_error if r.complete else math.nan))
         engine_cpu += r.diagnostics["cpu_time"]
         simulated += r.diagnostics["steps"] * r.settings["dt"]
@@ -215,11 +224,8 @@ def _restitution(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
     return errors, engine_cpu, simulated, runs
 
 
-def _thresholds(engine, scene, reference, options, workers):
-    from trilith_xval.analytic.excitation import Still
+def _thresholds(run: RunSpec, reference, workers):
     from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
-    run = RunSpec.resolve(engine, scene, Still(), overrides=options,
-                          overrides_from="the candidate settings")
     es = engine_spectrum(run, reference, workers=workers)
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for curve, points in es.curves.items():
@@ -236,19 +242,18 @@ def _thresholds(engine, scene, reference, options, workers):
     return errors, engine_cpu, simulated, runs
 
 
-def _histories(engine, scene, vs: ValidationSet, options, rf: float = 1.0):
+def _histories(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
     from trilith_xval import engines
     from trilith_xval.compare.measure.trajectories import compare_trajectories
     from trilith_xval.scenes import point_pulse
+    scene = run.scene
     errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
     for sc in (scene, scene.without_pendulum()) if scene.has_pendulum else (scene,):
         for point in vs.points:
             pulse = point_pulse(point)
             model = {} if rf == 1.0 else {"restitution_factor": rf}
             ref = engines.simulate("analytic", sc, pulse, **model)
-            test = engines.simulate(engine, sc, pulse, RunSpec.resolve(
-                engine, sc, pulse, overrides=options,
-                overrides_from="the candidate settings").settings)
+            test = engines.simulate(run.backend, sc, pulse, run.at(sc, pulse).settings)
             c = compare_trajectories(ref, test)
             err = c.theta_rms_first if c.verdict_agrees else 1.0
             label = f"{point} {'pendulum' if sc.has_pendulum else 'no pendulum'}"
@@ -333,9 +338,9 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     reference: dict = {}  # the model's spectra, once, only if a candidate needs them
 
     def one_scene(sc, varied: dict):
-        cand = {**base, **varied}
+        run = _candidate_run(engine, sc, base, varied)
         if metric == "restitution":
-            return _restitution(engine, sc, vs, cand, rf)
+            return _restitution(run, vs, rf)
         if metric == "thresholds":
             if id(sc) not in reference:
                 from trilith_xval.analytic.spectrum import overturning_spectrum
@@ -349,8 +354,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
                         fast=search_run_settings(restitution_factor=rf))}
                 reference[id(sc)] = overturning_spectrum(
                     sc, list(vs.omegas) if vs.omegas else scene_omegas(sc), **model)
-            return _thresholds(engine, sc, reference[id(sc)], cand, workers)
-        return _histories(engine, sc, vs, cand, rf)
+            return _thresholds(run, reference[id(sc)], workers)
+        return _histories(run, vs, rf)
 
     def evaluate(cand: dict) -> Evaluation:
         with runs.using(None):  # measured costs: no run inside served from a store

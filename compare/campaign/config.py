@@ -2,9 +2,9 @@
 
 :class:`CampaignConfig` names the scene, engines, grids and budgets; its
 :class:`Tolerances` are the acceptance limits of the verdict table, each with its
-reason; :func:`engine_options` and :func:`backend_settings` are the settings
-every backend runs with in the campaign (calibrated, then the settings file, then
-``engine_dt``).
+reason; :func:`campaign_run` is the one place a campaign's run of a backend is
+built (:class:`compare.run.spec.RunSpec`: calibrated for threshold searches, then
+the config's settings table, then ``engine_dt``).
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from trilith_xval.scenes import POINTS
 
 from trilith_xval.compare.run.jsonable import plain
 
-__all__ = ["Tolerances", "CampaignConfig", "engine_options", "backend_settings"]
+__all__ = ["Tolerances", "CampaignConfig", "campaign_run"]
 
 
 @dataclass(frozen=True)
@@ -151,26 +151,35 @@ class CampaignConfig:
         return {k: v for k, v in self.to_dict().items() if k not in self.SELECTION}
 
 
-def engine_options(name: str, config: CampaignConfig, thresholds: bool = False,
-                   scene=None) -> dict:
-    """The options the campaign sets for backend ``name``: for a threshold search
-    (``thresholds``) on ``scene`` (default the campaign's) the engine's calibrated
-    threshold settings where the scene lies in their domain
-    (:func:`compare.campaign.settings_file.threshold_options`) first, then its
-    settings-file table, then ``engine_dt`` (engines only)."""
-    from trilith_xval.compare.campaign.settings_file import threshold_options
-    options = {}
-    if thresholds and name in ENGINES:
-        from trilith_xval.scenes import load_scene
-        options = threshold_options(name, scene if scene is not None
-                                    else load_scene(config.scene))
-    options.update(config.engine_settings.get(name, {}))
-    if config.engine_dt is not None and name in ENGINES:
-        options["dt"] = config.engine_dt
-    return options
+def campaign_run(name: str, config: CampaignConfig, scene, excitation=None, *,
+                 thresholds: bool = False):
+    """Backend ``name``'s run in the campaign, resolved once.
 
+    Parameters
+    ----------
+    name : str
+        A registered backend.
+    config : CampaignConfig
+    scene, excitation
+        The run's scene and ground motion (default
+        :class:`~analytic.excitation.Still`); for a threshold search, the
+        largest pulse it may try (the friction rule's excitation).
+    thresholds : bool
+        A threshold search: the engine's calibrated threshold settings first,
+        where ``scene`` lies in their domain (:func:`engines.calibration.threshold_choice`).
 
-def backend_settings(name: str, config: CampaignConfig, **options):
-    """``name``'s calibrated settings (:func:`engines.configure`) with
-    :func:`engine_options` applied, then ``options``."""
-    return configure(name, **{**engine_options(name, config), **options})
+    Returns
+    -------
+    compare.run.spec.RunSpec
+        Layers, each over the one before: the backend's defaults, the
+        calibration (``thresholds``), the config's ``engine_settings`` table, then
+        ``engine_dt`` (engines only).
+    """
+    from trilith_xval.compare.run.spec import RunSpec
+    engine = name in ENGINES
+    run = RunSpec.resolve(name, scene, excitation, calibrated=thresholds and engine,
+                          overrides=config.engine_settings.get(name),
+                          overrides_from="the campaign's engine_settings")
+    if config.engine_dt is not None and engine:
+        run = run.with_options("the campaign's engine_dt", dt=config.engine_dt)
+    return run

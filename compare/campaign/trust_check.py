@@ -120,14 +120,17 @@ def _thresholds(run, band, progress) -> list[dict]:
     return out
 
 
-def _restitution(engine, scene, tol) -> list[dict]:
-    from trilith_xval.compare.measure.restitution import measure_restitution
+def _restitution(run, tol) -> list[dict]:
+    """Free rocking of ``run`` (the engine at its defaults, which are calibrated for
+    restitution) on its scene without and with the pendulum."""
+    from trilith_xval.compare.measure.restitution import free_rocking
+    scene = run.scene
     cases = [("Eq. 20", scene.without_pendulum(), tol.restitution)]
     if scene.has_pendulum:
         cases.append(("Eq. 19", scene, tol.restitution_pendulum))
     out = []
     for eq, sc, t in cases:
-        r = measure_restitution(engine, sc)
+        r = free_rocking(run.at(scene=sc))
         err = r.max_rel_error if r.complete else None
         out.append({"equation": eq, "max_rel_error": err, "tolerance": t,
                     "passed": err is not None and abs(err) <= t, "impacts": len(r.impacts),
@@ -135,12 +138,14 @@ def _restitution(engine, scene, tol) -> list[dict]:
     return out
 
 
-def _histories(engine, scene, band, tol) -> list[dict]:
+def _histories(run, band, tol) -> list[dict]:
+    """Time histories of ``run`` (the engine at its defaults) against the model's,
+    at multiples of the band's thresholds."""
     from trilith_xval import engines
     from trilith_xval.analytic.excitation import Pulse
     from trilith_xval.compare.measure.trajectories import compare_trajectories
     from trilith_xval.compare.run import runs
-    out = []
+    scene, out = run.scene, []
     for case, rows in band["curves"].items():
         picked = _spread(rows, 3)
         if not picked:
@@ -150,7 +155,7 @@ def _histories(engine, scene, band, tol) -> list[dict]:
         for f in HISTORY_FACTORS:
             pulse = Pulse(f * r["a_model"], r["omega"])
             ref = runs.simulate("analytic", sc, pulse, engines.configure("analytic"))
-            test = runs.simulate(engine, sc, pulse, engines.configure(engine))
+            test = runs.simulate(run.backend, sc, pulse, run.at(sc, pulse).settings)
             c = compare_trajectories(ref, test)
             rms = c.theta_rms_first if math.isfinite(c.theta_rms_first) else None
             out.append({"case": case, "omega": r["omega"], "amplitude": pulse.amplitude,
@@ -161,17 +166,19 @@ def _histories(engine, scene, band, tol) -> list[dict]:
     return out
 
 
-def _records(engine, scene, records, options) -> list[dict]:
+def _records(run, records) -> list[dict]:
     """Each record's first overturning intensity: the model's (window-aware IDA,
-    the accurate model) against the engine's robust one under the step rule."""
+    the accurate model) against the robust one of ``run`` (the engine's
+    threshold-search :class:`~compare.run.spec.RunSpec` on the scene) under the
+    step rule."""
     from trilith_xval.analytic.ida import IDASettings, first_overturn_intensity, model_verdict
     from trilith_xval.compare.measure.record_threshold import STEP_TOL, engine_intensity
     st = IDASettings()
     out = []
     for rec in records:
-        model = first_overturn_intensity(rec, model_verdict(scene, st.tail), st)
+        model = first_overturn_intensity(rec, model_verdict(run.scene, st.tail), st)
         im_model = model.im_overturn if math.isfinite(model.im_overturn) else None
-        res = engine_intensity(engine, scene, rec, st, im_model, options)
+        res = engine_intensity(run, rec, st, im_model)
         im = res["im_overturn"]
         err = (im - im_model) / im_model if (im is not None and im_model) else None
         out.append({"record": res["label"], "im": st.im, "im_model": im_model, "im_engine": im,
@@ -228,6 +235,7 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.run.spec import RunSpec
     runs = {e: RunSpec.resolve(e, scene, Still(), calibrated=True) for e in engines}
+    defaults = {e: RunSpec.resolve(e, scene) for e in engines}  # restitution, histories
     for e in engines:
         choice = threshold_choice(e, scene)
         settings = runs[e].settings
@@ -238,12 +246,12 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
         entry["thresholds"] = _thresholds(runs[e], band, progress)
         entry["threshold_verdict"] = _verdict(entry["thresholds"])
         progress.next(f"{e} restitution")
-        entry["restitution"] = _restitution(e, scene, tol)
+        entry["restitution"] = _restitution(defaults[e], tol)
         progress.next(f"{e} time histories")
-        entry["histories"] = _histories(e, scene, band, tol)
+        entry["histories"] = _histories(defaults[e], band, tol)
         if records:
             progress.next(f"{e} records", len(records))
-            entry["records"] = _records(e, scene, records, choice.options)
+            entry["records"] = _records(runs[e], records)
         entry["cost"] = _cost(entry)
         doc["engines"][e] = entry
     if len(engines) >= 2:

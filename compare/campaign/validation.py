@@ -23,25 +23,23 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from trilith_xval.analytic.excitation import Pulse
-from trilith_xval.engines import configure
-from trilith_xval.scenes import POINTS, load_scene
-
+from trilith_xval.scenes import load_scene
 
 from trilith_xval.compare.measure import trajectories as metrics
 
-
-from trilith_xval.compare.campaign.config import CampaignConfig, backend_settings, engine_options
+from trilith_xval.compare.campaign.config import CampaignConfig, campaign_run
 from trilith_xval.compare.campaign.config import Tolerances  # noqa: F401  (in __all__)
+from trilith_xval.compare.campaign.validation_jobs import (JumpJob, RestitutionJob, ReverifyJob,
+                                                           ThresholdPointJob,
+                                                           free_rocking_restitution, history_job,
+                                                           long_run_job)
 from trilith_xval.compare.run import runs
 from trilith_xval.compare.run.jsonable import plain
 from trilith_xval.compare.run.keys import backend_version
-from trilith_xval.compare.measure.restitution import RestitutionResult, measure_restitution
 from trilith_xval.compare.measure.reference_spectra import choose_frequencies, reference_spectrum
-from trilith_xval.compare.measure.jump_shift import engine_jump_frequency
 
-__all__ = ["Tolerances", "CampaignConfig", "run_campaign", "backend_settings",
-           "engine_options", "free_rocking_restitution"]
+__all__ = ["Tolerances", "CampaignConfig", "run_campaign", "campaign_run",
+           "free_rocking_restitution"]
 
 
 # ----------------------------------------------------------------------- jobs
@@ -55,74 +53,20 @@ def _domain_entry(engine: str, scene) -> dict:
             "calibration": dict(cal.record), "source": cal.command}
 
 
-def _job_history(name, scene, point, config):
-    amp, omega = POINTS[point]
-    settings = backend_settings(name, config)
-    return runs.simulate(name, scene, Pulse(amp, omega), settings)
-
-
-def free_rocking_restitution(name: str, scene, config: CampaignConfig | None = None
-                             ) -> RestitutionResult:
-    """Release ``scene`` at rest from ``theta0_fraction * alpha`` in backend ``name``
-    (no base motion) and measure the first ``n_impacts`` impacts against Eq. 19/20."""
-    config = config or CampaignConfig()
-    return measure_restitution(name, scene, config.theta0_fraction * scene.alpha,
-                               backend_settings(name, config), n_impacts=config.n_impacts)
-
-
-def _pulse_settings(name: str, config: CampaignConfig, scene, a_max: float, omega: float):
-    """Calibrated settings (with the campaign's ``engine_dt``) and the friction raised
-    for the largest pulse of the job (:func:`compare.measure.engine_spectrum.pulse_settings`)."""
-    from trilith_xval.compare.measure.engine_spectrum import pulse_settings
-    return pulse_settings(name, scene, a_max, omega, options=engine_options(name, config))
-
-
-def _job_threshold(name, scene, case, omega, a_ref, mode_ref, config):
-    """The one threshold measurement (:func:`compare.measure.engine_spectrum.measure_point`)."""
-    from trilith_xval.compare.measure.engine_spectrum import measure_point, threshold_spec
-    spec = threshold_spec(name, scene, omega, a_ref,
-                          options=engine_options(name, config, thresholds=True, scene=scene))
-    return measure_point(spec, omega, a_ref, mode_ref, case=case,
-                         tol=config.tolerances.threshold, rel_tol=config.rel_tol,
-                         convergence=True)
-
-
-def _job_jump(name, scene, amplitude, w_lo, w_hi, config):
-    return engine_jump_frequency(name, scene, amplitude, w_lo, w_hi,
-                                 _pulse_settings(name, config, scene, amplitude, w_hi),
-                                 reference_backend=config.spectrum_backend)
-
-
-def _job_long_run(name, label, scene_name, amplitude, omega, config):
-    from trilith_xval.compare.measure.long_runs import long_run
-    return long_run(name, label, scene_name, amplitude, omega, config.long_run_t_max,
-                    backend_settings(name, config))
-
-
-def _job_reverify(name, scene, point, source):
-    from trilith_xval.compare.campaign.stored_parts import reverify_one
-    return reverify_one(name, scene, point, source)
-
-
-_JOBS = {"history": _job_history, "restitution": free_rocking_restitution,
-         "threshold": _job_threshold, "jump": _job_jump, "long_run": _job_long_run,
-         "reverify": _job_reverify}
-
-
-def _run_one(item):
-    """Run one job: ``(result, cpu_s when computed, cpu_s spent now, from_store)``.
-    An exception becomes an error record (one bad engine run must not sink a
-    10-minute campaign; the verdict table then reports it unmeasured)."""
-    kind, args = item
+def _run_one(job):
+    """Run one job (:mod:`compare.campaign.validation_jobs`): ``(result, cpu_s when
+    computed, cpu_s spent now, from_store)``.  An exception becomes an error record
+    (one bad engine run must not sink a 10-minute campaign; the verdict table then
+    reports it unmeasured)."""
     c0 = time.process_time()
 
     def compute():  # stored with its CPU cost, so a store hit can say what it cost
         t0 = time.process_time()
-        value = _JOBS[kind](*args)
+        value = job()
         return {"value": value, "cpu_s": _own_cost(value, time.process_time() - t0)}
     try:  # through the store: a finished job is not redone (compare/ code in its key)
         hits = runs.STATS["hits"]
-        out = runs.memo("campaign-job", _job_description(item), compute, code=runs.ALL_CODE)
+        out = runs.memo("campaign-job", _job_description(job), compute, code=runs.ALL_CODE)
         stored = runs.STATS["hits"] > hits
         return out["value"], out["cpu_s"], time.process_time() - c0, stored
     except Exception as exc:  # noqa: BLE001 - reported in summary.json "errors"
@@ -142,16 +86,16 @@ def _own_cost(value, spent: float) -> float:
     return float(own) if own is not None and math.isfinite(float(own)) else spent
 
 
-def _job_description(item) -> dict:
-    kind, args = item
-    config = next((a for a in args if isinstance(a, CampaignConfig)), None)
-    described = None if config is None else config.job_key()
-    return {"kind": kind, "args": _describe_args(args), "config": described}
+def _job_description(job) -> dict:
+    """What a job's stored result is keyed by: its kind, :meth:`args` and the
+    config (but :attr:`CampaignConfig.SELECTION`)."""
+    described = None if job.config is None else job.config.job_key()
+    return {"kind": job.kind, "args": _describe_args(job.args()), "config": described}
 
 
-def _lookup(item):
+def _lookup(job):
     """A finished job from the store (nothing spent now), or None."""
-    out = runs.lookup("campaign-job", _job_description(item), code=runs.ALL_CODE)
+    out = runs.lookup("campaign-job", _job_description(job), code=runs.ALL_CODE)
     return None if out is None else (out["value"], out["cpu_s"], 0.0, True)
 
 
@@ -182,9 +126,9 @@ _FIRST = ("long_run", "reverify", "threshold", "jump", "restitution", "history")
 
 
 def _execute(jobs: list, workers: int, lines: bool = False) -> list:
-    """Run ``jobs`` ((kind, args) pairs); results in job order."""
-    order = sorted(range(len(jobs)), key=lambda i: _FIRST.index(jobs[i][0])
-                   if jobs[i][0] in _FIRST else len(_FIRST))
+    """Run ``jobs`` (:mod:`compare.campaign.validation_jobs`); results in job order."""
+    order = sorted(range(len(jobs)), key=lambda i: _FIRST.index(jobs[i].kind)
+                   if jobs[i].kind in _FIRST else len(_FIRST))
     bar = _progress(len(jobs), lines)
     try:
         out = list(runs.run_many(_run_one, [jobs[i] for i in order], workers=workers,
@@ -213,13 +157,8 @@ def _case(pendulum: bool) -> str:
 
 
 def _describe_args(args) -> list:
-    """Job arguments for the error record (scenes and configs by name)."""
-    out = []
-    for a in args:
-        if isinstance(a, CampaignConfig):
-            continue
-        out.append(a.to_dict() if hasattr(a, "to_dict") else a)
-    return plain(out)
+    """Job arguments for the store key and the error record (scenes as their fields)."""
+    return plain([a.to_dict() if hasattr(a, "to_dict") else a for a in args])
 
 
 # ------------------------------------------------------------------ campaign
@@ -272,9 +211,8 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
     backends = tuple(dict.fromkeys((config.reference, config.spectrum_backend, *config.engines)))
     result = CampaignResult(
         config=config, scene=scene,
-        settings={b: plain(backend_settings(b, config)) for b in backends},
-        threshold_settings={e: plain(configure(e, **engine_options(e, config, thresholds=True,
-                                                                  scene=scene)))
+        settings={b: plain(campaign_run(b, config, scene).settings) for b in backends},
+        threshold_settings={e: plain(campaign_run(e, config, scene, thresholds=True).settings)
                             for e in config.engines},
         versions={b: backend_version(b) for b in (*backends, config.spectrum_backend)},
         threshold_domain={e: _domain_entry(e, scene) for e in config.engines})
@@ -306,42 +244,44 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
             recomputed[(_case(pend), name)] = wanted
             for omega, a_ref, mode in freqs:
                 if float(omega) in wanted:
-                    jobs.append(("threshold", (name, sc, _case(pend), omega, a_ref, mode,
-                                               config)))
+                    jobs.append(ThresholdPointJob.at(name, sc, _case(pend), omega, a_ref, mode,
+                                                     config))
                     labels.append(("threshold", pend, name))
         if stored_run is not None and "jump" in config.stored_jobs:
             pass  # the jump shifts come from the stored run (stored_parts.merge)
         elif _case(pend) in config.jump_cases and (spec.get("jump") or {}).get("probe_amplitude"):
             jmp = spec["jump"]
             for name in config.engines:
-                jobs.append(("jump", (name, sc, jmp["probe_amplitude"], jmp["omega_lo"],
-                                      jmp["omega_hi"], config)))
+                jobs.append(JumpJob.at(name, sc, jmp["probe_amplitude"], jmp["omega_lo"],
+                                       jmp["omega_hi"], config))
                 labels.append(("jump", pend, name))
     for pend, sc in scenes.items():
         for point in config.points:
             for name in backends:
-                jobs.append(("history", (name, sc, point, config)))
+                jobs.append(history_job(name, sc, point, config))
                 labels.append(("history", pend, name, point))
     base = scene.without_pendulum()
     for name in config.engines:
         for lam in config.restitution_lams:
             for mu in config.restitution_mus:
-                jobs.append(("restitution", (name, base.replace(lam=lam, mu=mu), config)))
+                jobs.append(RestitutionJob(campaign_run(name, config, base.replace(lam=lam, mu=mu)),
+                                           config))
                 labels.append(("restitution", False, name))
         if scene.has_pendulum:
             for lam in config.pendulum_lams:
-                jobs.append(("restitution", (name, scene.replace(lam=lam), config)))
+                jobs.append(RestitutionJob(campaign_run(name, config, scene.replace(lam=lam)),
+                                           config))
                 labels.append(("restitution", True, name))
 
     for name, point, src in (stored_parts.reverify_jobs(config.engines, scene) if config.reverify
                              else []):
-        jobs.append(("reverify", (name, scene, point, src)))
+        jobs.append(ReverifyJob(name, scene, point, src))
         labels.append(("reverify", True, name))
     if config.long_runs:
         from trilith_xval.compare.measure.long_runs import LONG_RUNS
         for name in config.engines:
             for label, scene_name, amplitude, omega in LONG_RUNS:
-                jobs.append(("long_run", (name, label, scene_name, amplitude, omega, config)))
+                jobs.append(long_run_job(name, label, scene_name, amplitude, omega, config))
                 labels.append(("long_run", False, name))
     t0 = time.perf_counter()
     if progress and not sys.stderr.isatty():
@@ -361,7 +301,7 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
         if isinstance(out, _JobError):
             result.errors.append({"job": kind, "backend": name, "pendulum": pend,
                                   "label": [str(x) for x in label[3:]],
-                                  "args": _describe_args(job[1]), "error": out.message})
+                                  "args": _describe_args(job.args()), "error": out.message})
             continue
         if kind == "history":
             result.histories[(label[3], pend, name)] = out

@@ -17,22 +17,28 @@ def record_rows(study, workers: int) -> tuple[list[dict], list[dict]]:
     ratio minus one (NaN when either is censored), resolved to the model's IDA
     bracket ``rtol`` (``a_reference_safe`` its surviving end)."""
     from trilith_xval.compare.campaign.study import _scene
-    from trilith_xval.compare.cli.fragility import ida_job, robust_job
+    from trilith_xval.compare.measure.record_jobs import IDAJob, RobustJob, model_run, run_job
     from trilith_xval.compare.run.runs import run_many
+    from trilith_xval.compare.run.spec import RunSpec
 
     axis, st = study.records, study.records.ida
     records = axis.records()
     cells = [(n, c, r) for n in study.scenes for c in study.cases for r in records]
-    model = list(run_many(ida_job, [("analytic", _scene(n, c), r, st) for n, c, r in cells],
+    model = list(run_many(run_job, [IDAJob(model_run(_scene(n, c)), r, st) for n, c, r in cells],
                           workers=workers))
-    items, meta = [], []
+    # Each engine's run per scene, case and step, resolved before any work.
+    runs = {(n, c, e, dt): RunSpec.resolve(e, _scene(n, c), overrides={"dt": dt} if dt else None,
+                                           overrides_from="the study's steps")
+            for n in study.scenes for c in study.cases for e in study.engines
+            for dt in study.steps}
+    jobs, meta = [], []
     for (n, c, r), m in zip(cells, model):
         ref = None if m["censored"] else m["im_overturn"]
         for e in study.engines:
             for dt in study.steps:
-                items.append((e, _scene(n, c), r, st, ref, {"dt": dt} if dt else {}))
+                jobs.append(RobustJob(runs[(n, c, e, dt)], r, st, ref))
                 meta.append((n, c, r.label, e, dt, ref, m["im_safe"]))
-    done = list(run_many(robust_job, items, workers=workers)) if items else []
+    done = list(run_many(run_job, jobs, workers=workers)) if jobs else []
     rows = []
     for (n, c, label, e, dt, ref, ref_safe), res in zip(meta, done):
         eng = res["im_overturn"]

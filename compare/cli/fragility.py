@@ -25,8 +25,8 @@ from trilith_xval.analytic.ida import IM_UNITS, IDASettings
 from trilith_xval.compare.report.fragility_plot import IM_TEXT, plot_fragility
 from trilith_xval.compare.cli.fragility_text import print_fragility
 from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args,
-                                 add_workers_arg, check_output_path, file_options, info,
-                                 parse_engine_list, resolve_workers, scene_from_args,
+                                 add_workers_arg, check_output_path, info, parse_engine_list,
+                                 resolve_workers, run_spec, scene_from_args,
                                  settings_from_args, use_store)
 
 
@@ -75,69 +75,22 @@ def _im_range(args) -> tuple[float, float]:
                          f"--im-range: {args.im_range!r} is not LO:HI") from None
 
 
-def ida_job(item):
-    """One record, one backend (with ``options``, a ``--settings`` table): its
-    :class:`analytic.ida.IDAResult` as plain data, the whole search memoised.
-    The model's runs are compiled (:func:`analytic.ida.model_verdict`: verdicts
-    only, milliseconds each, not stored); an engine's go through the run store."""
-    from trilith_xval import engines
-
-    from trilith_xval.analytic.ida import first_overturn_intensity, model_verdict
-    from trilith_xval.compare.run import runs
-    from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, st, *rest = item
-    options = rest[0] if rest else {}
-    model = backend == "analytic"
-    name = "analytic-fast" if model else backend
-
-    def settings_for(motion):
-        return engines.configure(name, t_max=motion.end_time + st.tail,
-                                 **({} if model else dict(options)))
-
-    def engine_overturns(motion) -> bool:
-        return runs.simulate(backend, scene, motion, settings_for(motion)).verdict.overturned
-    overturns = model_verdict(scene, st.tail) if model else engine_overturns
-
-    def compute():
-        res = first_overturn_intensity(record, overturns, st)
-        return {**res.describe(), "runs": [[v, o] for v, o in res.runs]}
-    what = {"backend": backend, "scene": scene_dict(scene),
-            "record": digest(excitation_dict(record)), "ida": st.describe(),
-            "settings": settings_dict(settings_for(record))}
-    return runs.memo("ida", what, compute, label=f"ida {backend} {record.label}")
+def intensities(scene, suite, runs, st: IDASettings, workers: int, scheduler) -> list:
+    """The model's IDA of every record, then the robust bracket around it of each
+    engine's run in ``runs`` (:func:`engine_runs`); backend-major (the model
+    first), in the order of ``suite``."""
+    from trilith_xval.compare.measure.record_jobs import IDAJob, RobustJob, model_run
+    model = _run_all([IDAJob(model_run(scene), r, st) for r in suite], workers, scheduler)
+    jobs = [RobustJob(run, r, st, None if m["censored"] else m["im_overturn"])
+            for run in runs for r, m in zip(suite, model)]
+    return model + (_run_all(jobs, workers, scheduler) if jobs else [])
 
 
-def robust_job(item):
-    """One record, one engine: its robust first overturning intensity around the
-    model's (:func:`compare.measure.record_threshold.engine_intensity`), through
-    the run store (each run stored, the whole search memoised)."""
-    from trilith_xval import engines
-
-    from trilith_xval.compare.measure.record_threshold import engine_intensity
-    from trilith_xval.compare.run import runs
-    from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, st, im_model, *rest = item
-    options = rest[0] if rest else {}  # e.g. {"dt": ...}: a campaign's time step
-    what = {"backend": backend, "scene": scene_dict(scene),
-            "record": digest(excitation_dict(record)), "ida": st.describe(),
-            "im_model": im_model,
-            "settings": settings_dict(engines.configure(backend, t_max=record.end_time
-                                                        + st.tail, **options))}
-    return runs.memo("robust-ida", what, lambda: engine_intensity(backend, scene, record, st,
-                                                                  im_model, options),
-                     label=f"robust ida {backend} {record.label}", code=runs.ALL_CODE)
-
-
-def intensities(scene, suite, backends, st: IDASettings, workers: int, scheduler,
-                loaded=None) -> list:
-    """The model's IDA of every record, then each engine's robust bracket around
-    it (with its ``--settings`` table from ``loaded``); backend-major, in the order
-    of ``suite``."""
-    model = _run_all([("analytic", scene, r, st) for r in suite], workers, scheduler)
-    engines_ = [b for b in backends if b != "analytic"]
-    items = [(b, scene, r, st, None if m["censored"] else m["im_overturn"],
-              file_options(loaded, b)) for b in engines_ for r, m in zip(suite, model)]
-    return model + (_run_all(items, workers, scheduler, robust_job) if items else [])
+def engine_runs(scene, engines_, loaded=None) -> list:
+    """Each engine's run on ``scene`` (:class:`compare.run.spec.RunSpec`: its
+    defaults, then its ``--settings`` table from ``loaded``), resolved before any
+    work: a bad value stops the command at the door."""
+    return [run_spec(e, scene, None, loaded) for e in engines_]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -147,6 +100,7 @@ def run(args: argparse.Namespace) -> int:
     engines_ = parse_engine_list(args.engine, none_ok=True)
     st = ida_settings(args)
     loaded = settings_from_args(args, engines_)
+    runs = engine_runs(scene, engines_, loaded)
     workers = resolve_workers(args.workers)
     # Built beside --out and swapped in whole, so that nothing exists until the
     # results do, and only a folder this tool wrote (or an empty one) is replaced.
@@ -159,10 +113,10 @@ def run(args: argparse.Namespace) -> int:
                          "FILE)")
     store = use_store(args)
     backends = ("analytic",) + engines_
-    results = intensities(scene, suite, backends, st, workers, args.scheduler, loaded)
+    results = intensities(scene, suite, runs, st, workers, args.scheduler)
     doc = _summarise(scene, suite, backends, st, results)
     if stripes:
-        _add_msa(doc, scene, suite, backends, st, stripes, workers, args.scheduler, loaded)
+        _add_msa(doc, scene, suite, runs, st, stripes, workers, args.scheduler)
     doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
     print_fragility(doc, st)
@@ -188,25 +142,29 @@ def _stripes(text, im: str) -> tuple[float, ...]:
     return check_stripes(values, "--stripes")
 
 
-def _add_msa(doc, scene, suite, backends, st, stripes, workers, scheduler, loaded) -> None:
-    """Each backend's multiple-stripe fit into ``doc['backends'][b]['msa']``."""
-    from trilith_xval.compare.measure.msa import msa_fragility, stripe_job
-    items = [(b, scene, r, stripes, st.im, st.tail, file_options(loaded, b))
-             for b in backends for r in suite]
-    verdicts = _run_all(items, workers, scheduler, stripe_job)
+def _add_msa(doc, scene, suite, runs, st, stripes, workers, scheduler) -> None:
+    """Each backend's multiple-stripe fit into ``doc['backends'][b]['msa']``: the
+    model's, then that of each engine's run in ``runs``."""
+    from trilith_xval.compare.measure.msa import msa_fragility
+    from trilith_xval.compare.measure.record_jobs import StripeJob, model_run
+    runs = [model_run(scene), *runs]
+    jobs = [StripeJob(run, r, stripes, st.im, st.tail) for run in runs for r in suite]
+    verdicts = _run_all(jobs, workers, scheduler)
     n = len(suite)
-    for i, b in enumerate(backends):
+    for i, b in enumerate(run.backend for run in runs):
         doc["backends"][b]["msa"] = {
             **msa_fragility(verdicts[i * n:(i + 1) * n], stripes).describe(),
             "verdicts": {r.label: v for r, v in zip(suite, verdicts[i * n:(i + 1) * n])}}
 
 
-def _run_all(items, workers: int, scheduler, job=None):
+def _run_all(jobs, workers: int, scheduler):
+    """Each job (:mod:`compare.measure.record_jobs`) called, in order."""
+    from trilith_xval.compare.measure.record_jobs import run_job
     from trilith_xval.compare.run.progress import bar as progress_bar
     from trilith_xval.compare.run.runs import run_many
-    bar = progress_bar(len(items), "fragility", "records")
+    bar = progress_bar(len(jobs), "fragility", "records")
     try:
-        return list(run_many(job or ida_job, items, workers=workers, scheduler=scheduler,
+        return list(run_many(run_job, jobs, workers=workers, scheduler=scheduler,
                              on_done=lambda i, r: bar.update(1)))
     finally:
         bar.close()
@@ -309,9 +267,10 @@ def record_spectrum(args, scene, backends: tuple[str, ...], workers: int) -> int
     loaded = settings_from_args(args, backends[1:])
     given = load_record(args.record, option="--record")
     record = scaled_record(given, args)
+    from trilith_xval.compare.measure.record_jobs import IDAJob, model_run
+    runs = [model_run(scene), *engine_runs(scene, backends[1:], loaded)]  # before any work
     use_store(args)
-    results = _run_all([(b, scene, record, st, file_options(loaded, b)) for b in backends],
-                       workers, args.scheduler)
+    results = _run_all([IDAJob(run, record, st) for run in runs], workers, args.scheduler)
     # The factor on the record as the file gives it (--scale included), whatever the
     # intensity measure searched: one number a user multiplies the file by.
     per_im = (record.pga / given.pga if given.pga > 0 else 1.0) / intensity_of(record, st.im)

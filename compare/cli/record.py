@@ -12,7 +12,7 @@ from trilith_xval.compare.show.record import (ALL_ENGINES, DEFAULT_AMPLITUDE, DE
 from trilith_xval.compare.cli.excitation_args import (add_pulse_args, add_record_arg, check_run_budget,
                                          excitation_from_args)
 from trilith_xval.compare.cli.options import add_scene_args, check_output_path, scene_from_args
-from trilith_xval.compare.cli.options import add_settings_arg, file_options, settings_from_args
+from trilith_xval.compare.cli.options import add_settings_arg, run_spec, settings_from_args
 
 
 def add_watch_args(parser: argparse.ArgumentParser) -> None:
@@ -39,21 +39,20 @@ def add_watch_args(parser: argparse.ArgumentParser) -> None:
 def watch_inputs(args: argparse.Namespace) -> tuple:
     """``(scene, excitation, settings)``, all checked, and the run budget of each
     backend over the recorded span."""
-    from trilith_xval.engines import configure, engine_names
+    from trilith_xval.engines import engine_names
 
     scene = scene_from_args(args)
     excitation = excitation_from_args(args, default=(DEFAULT_AMPLITUDE, DEFAULT_OMEGA))
     names = resolve_engines(args.engine)
     loaded = settings_from_args(args, tuple(n for n in names if n in engine_names()))
+    runs = tuple(run_spec(n, scene, excitation, loaded) for n in names)
     settings = RecordSettings(fps=args.fps, duration=args.duration,
                               panel_width=getattr(args, "width", 480),
-                              panel_height=getattr(args, "height", 360),
-                              engine_options=tuple((n, tuple(file_options(loaded, n).items()))
-                                                   for n in names if file_options(loaded, n)))
+                              panel_height=getattr(args, "height", 360), runs=runs)
     duration = args.duration if args.duration is not None else default_duration(excitation)
-    for name in names:
-        check_run_budget(name, configure(name, **settings.options(name)), excitation,
-                         option="--duration", length=duration)
+    for run in runs:
+        check_run_budget(run.backend, run.settings, excitation, option="--duration",
+                         length=duration)
     return scene, excitation, settings
 
 

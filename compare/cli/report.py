@@ -76,14 +76,15 @@ def _check_budget(config, loaded=None) -> None:
     message names where the step came from: ``--dt``, the ``--settings`` file
     (``loaded``) or the engine's calibrated step."""
     from trilith_xval.analytic.excitation import Pulse
-    from trilith_xval.scenes import POINTS
+    from trilith_xval.scenes import POINTS, load_scene
 
-    from trilith_xval.compare.campaign.config import backend_settings
+    from trilith_xval.compare.campaign.config import campaign_run
     from trilith_xval.compare.cli.excitation_args import check_run_budget
 
     omega = min(config.omega_range[0], *(POINTS[p][1] for p in config.points))
+    scene = load_scene(config.scene)
     for name in config.engines:
-        settings = backend_settings(name, config)
+        settings = campaign_run(name, config, scene).settings
         if config.engine_dt is not None:
             option = "--dt"
         elif loaded is not None and "dt" in loaded.options(name):

@@ -7,7 +7,7 @@ import math
 from trilith_xval.engines import engine_names
 
 from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, add_store_args, detail,
-                                 envelope, file_options, info, print_json, scene_from_args,
+                                 envelope, info, print_json, run_spec, scene_from_args,
                                  settings_from_args, settings_line, sig, use_store)
 from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.run.jsonable import plain
@@ -42,7 +42,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from trilith_xval.compare.measure.restitution import DEFAULT_N_IMPACTS, MAX_N_IMPACTS, measure_restitution
+    from trilith_xval.analytic.excitation import Still
+    from trilith_xval.compare.measure.restitution import (DEFAULT_N_IMPACTS, MAX_N_IMPACTS,
+                                                          free_rocking)
 
     scene = scene_from_args(args)
     theta0 = args.theta0 if args.theta0 is not None else DEFAULT_THETA0_FRACTION * scene.alpha
@@ -51,9 +53,9 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"--n-impacts must be in [1, {MAX_N_IMPACTS}], got {n}")
     rf = restitution_factor(args)
     loaded = settings_from_args(args, (args.engine,))
+    run = run_spec(args.engine, scene, Still(), loaded)
     use_store(args)
-    result = measure_restitution(args.engine, scene, theta0, n_impacts=n, psi0=args.psi0,
-                                 restitution_factor=rf, **file_options(loaded, args.engine))
+    result = free_rocking(run, theta0, n_impacts=n, psi0=args.psi0, restitution_factor=rf)
     if args.json:
         body = result.to_dict()
         diagnostics = dict(body.get("diagnostics") or {})

@@ -22,5 +22,5 @@ def add_parser(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     scene, excitation, settings = watch_inputs(args)
     view(scene, excitation, args.engine, fps=args.fps, duration=args.duration,
-         scene_arg=args.scene, engine_options=settings.engine_options)
+         scene_arg=args.scene, runs=settings.runs)
     return 0

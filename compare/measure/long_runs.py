@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["LONG_RUNS", "LONG_T_MAX", "MAX_CREEP", "long_run"]
+__all__ = ["LONG_RUNS", "LONG_T_MAX", "MAX_CREEP", "long_run", "long_run_excitation"]
 
 # (label, scene, amplitude [m/s^2], omega [rad/s]): the trilith at rest, and the
 # README's Fig. 8 record (lam 3, gamma 0.1) after a 19 m/s^2, 15 rad/s pulse.
@@ -24,21 +24,27 @@ LONG_T_MAX = 20.0  # s: ~30 rocking periods of the Fig. 8 frame's small swings a
 MAX_CREEP = 1e-3
 
 
-def long_run(backend: str, label: str, scene_name: str, amplitude: float, omega: float,
-             t_max: float = LONG_T_MAX, settings=None) -> dict:
-    """One fixed-window run of ``backend`` and of the model; the row of the trust
-    table's long-run line (:class:`compare.campaign.summary.LongRun`)."""
+def long_run_excitation(amplitude: float, omega: float):
+    """The ground motion of a long run: a sine pulse, or none (:class:`Still`) at
+    zero amplitude."""
     from trilith_xval.analytic.excitation import Pulse, Still
+    return Pulse(amplitude, omega) if amplitude > 0.0 else Still()
+
+
+def long_run(run, label: str, scene_name: str, t_max: float = LONG_T_MAX) -> dict:
+    """One fixed-window run of ``run`` (a :class:`compare.run.spec.RunSpec` on the
+    scene named ``scene_name``, under :func:`long_run_excitation`) and of the
+    model; the row of the trust table's long-run line
+    (:class:`compare.campaign.summary.LongRun`)."""
     from trilith_xval.engines import configure
-    from trilith_xval.scenes import load_scene
     from trilith_xval.compare.run import runs
-    scene = load_scene(scene_name)
-    exc = Pulse(amplitude, omega) if amplitude > 0.0 else Still()
-    s = configure(backend, settings, t_max=t_max, early_stop=False)
+    backend, scene, exc = run.backend, run.scene, run.excitation
+    s = run.with_options("the long run's window", t_max=t_max, early_stop=False).settings
     tr = runs.simulate(backend, scene, exc, s)
     # The scipy path: the compiled one always stops once its verdict is certain.
     model = runs.simulate("analytic", scene, exc,
                           configure("analytic", t_max=t_max, early_stop=False))
+    amplitude, omega = float(getattr(exc, "amplitude", 0.0)), float(getattr(exc, "omega", 0.0))
     slide = tr.diagnostics.get("pivot_sliding_max")
     slide = float(slide) if slide is not None else math.nan
     passed = tr.verdict.status == model.verdict.status and slide < MAX_CREEP

@@ -35,8 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special, stats
 
-__all__ = ["MSAFit", "fit_stripes", "msa_fragility", "check_stripes", "stripe_job",
-           "MAX_STRIPES"]
+__all__ = ["MSAFit", "fit_stripes", "msa_fragility", "check_stripes", "MAX_STRIPES"]
 
 MAX_STRIPES = 100  # stripes per analysis: Baker uses about ten
 
@@ -206,33 +205,3 @@ def msa_fragility(verdicts, stripes, n_boot: int = 400, level: float = 0.9,
     return MSAFit(stripes, tuple(int(k) for k in n), tuple(int(k) for k in z), median, beta,
                   (float(m_lo), float(m_hi)), (float(b_lo), float(b_hi)), float(level),
                   int(n_boot), len(params), int(seed))
-
-
-def stripe_job(item) -> list[bool]:
-    """One record, one backend: its verdict at every stripe, the whole set
-    memoised (an engine's runs each through the run store; the model's compiled,
-    verdict only).  ``item`` is ``(backend, scene,
-    record, stripes, im, tail, options)``; each run lasts the record plus
-    ``tail`` seconds (the window of :mod:`analytic.ida`, so a stripe's run is the
-    IDA's run at that intensity)."""
-    from trilith_xval import engines
-    from trilith_xval.analytic.ida import model_verdict, scale_to
-    from trilith_xval.compare.run import runs
-    from trilith_xval.compare.run.keys import digest, excitation_dict, scene_dict, settings_dict
-    backend, scene, record, stripes, im, tail, options = item
-    model = backend == "analytic"
-    # The model runs compiled, as in the IDA jobs (analytic.ida.model_verdict):
-    # the same verdict of the same window; an engine through the run store.
-    settings = engines.configure("analytic-fast" if model else backend,
-                                 t_max=record.end_time + tail,
-                                 **({} if model else dict(options or {})))
-    overturns = model_verdict(scene, tail) if model else (
-        lambda motion: runs.simulate(backend, scene, motion, settings).verdict.overturned)
-
-    def compute():
-        return [bool(overturns(scale_to(record, im, s))) for s in stripes]
-    what = {"backend": backend, "scene": scene_dict(scene),
-            "record": digest(excitation_dict(record)), "stripes": list(stripes), "im": im,
-            "settings": settings_dict(settings)}
-    code = runs.MODEL_CODE if backend == "analytic" else runs.ALL_CODE
-    return runs.memo("msa", what, compute, label=f"msa {backend} {record.label}", code=code)

@@ -35,29 +35,44 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["engine_intensity", "STEP_TOL"]
+__all__ = ["engine_intensity", "record_run", "search_centre", "STEP_TOL"]
 
 # Agreement with the model's intensity that ends the step rule: the threshold
 # tolerance of the pulse spectra (2 %).
 STEP_TOL = 0.02
 
 
-def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
-                     options: dict | None = None) -> dict:
-    """The robust first overturning intensity of ``backend`` under ``motion``.
+def record_run(run, motion, st, top: float):
+    """``run`` (a :class:`compare.run.spec.RunSpec` of an engine on its scene) for
+    runs under ``motion`` scaled up to intensity ``top``: the friction rule at the
+    motion scaled to ``top`` (the largest a search may try), then one more layer,
+    the fixed window ``t_max = end_time + st.tail`` of every run of the record."""
+    from trilith_xval.analytic.ida import scale_to
+    return run.at(excitation=scale_to(motion, st.im, top)).with_options(
+        "the record's window", t_max=motion.end_time + st.tail)
+
+
+def search_centre(st, im_model: float | None) -> float:
+    """The intensity the robust search is centred on: the model's, or ``im_hi``
+    when the model never overturned up to it."""
+    return im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
+
+
+def engine_intensity(run, motion, st, im_model: float | None) -> dict:
+    """The robust first overturning intensity of ``run``'s engine under ``motion``.
 
     Parameters
     ----------
-    backend : str
-        An engine name.
-    scene : Scene
+    run : compare.run.spec.RunSpec
+        The engine on its scene, with its settings (e.g. a ``dt``); resolved
+        again here for the record (:func:`record_run`, up to the largest
+        intensity the search may try, :attr:`~compare.measure.thresholds.Search.widest`
+        times its centre).
     motion : SampledRecord or any motion with ``scaled``, ``pga``, ``pgv``
     st : analytic.ida.IDASettings
         The intensity measure, ``im_hi`` (censoring) and ``tail`` (the window).
     im_model : float or None
         The model's first overturning intensity (None: censored at ``im_hi``).
-    options : dict, optional
-        Engine settings beside the window (:func:`engines.configure`, e.g. ``dt``).
 
     Returns
     -------
@@ -76,10 +91,11 @@ def engine_intensity(backend: str, scene, motion, st, im_model: float | None,
     from trilith_xval import engines
     from trilith_xval.analytic.ida import scale_to
     from trilith_xval.compare.measure.step_rule import rule_out_step
-    from trilith_xval.compare.measure.thresholds import engine_threshold
+    from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
-    settings = engines.configure(backend, t_max=motion.end_time + st.tail, **(options or {}))
-    centre = im_model if im_model is not None and math.isfinite(im_model) else st.im_hi
+    centre = search_centre(st, im_model)
+    backend, scene = run.backend, run.scene
+    settings = record_run(run, motion, st, SEARCH.widest * centre).settings
     scaled = lambda v: scale_to(motion, st.im, v)  # noqa: E731
     p = engine_threshold(backend, scene, math.nan, centre, settings, motion=scaled)
     step = None

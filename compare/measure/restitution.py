@@ -15,6 +15,7 @@ released from the same tilt): a backend runs to halfway between impacts ``n`` an
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -22,7 +23,7 @@ from trilith_xval.analytic import equations as eq
 from trilith_xval.analytic.excitation import Still
 from trilith_xval.analytic.trajectory import Trajectory
 
-__all__ = ["ImpactRestitution", "RestitutionResult", "measure_restitution",
+__all__ = ["ImpactRestitution", "RestitutionResult", "measure_restitution", "free_rocking",
            "restitution_from_trajectory", "analytic_impact_times", "DEFAULT_N_IMPACTS",
            "MAX_N_IMPACTS"]
 
@@ -161,7 +162,8 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
                         n_impacts: int = DEFAULT_N_IMPACTS, psi0: float = 0.0,
                         restitution_factor: float = 1.0, **options) -> RestitutionResult:
     """Release ``scene`` from tilt ``theta0`` in ``backend`` and compare each
-    impact's velocity ratio with Eq. 19/20.
+    impact's velocity ratio with Eq. 19/20: :func:`free_rocking` of the run these
+    arguments make (:class:`compare.run.spec.RunSpec`, built once here).
 
     Parameters
     ----------
@@ -172,8 +174,62 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
         Initial tilt [rad], ``0 < |theta0| < alpha`` (released at rest; sign =
         side).  Default ``alpha / 2``: well inside the well, fast impacts.
     settings : the backend's Settings, optional
-        Base settings; ``theta0``, ``psi0``, ``t_max`` and ``early_stop=False``
-        are set here, ``options`` are applied through :func:`engines.configure`.
+        Base settings (every field a layer of the run, "the settings given");
+        ``options`` go over them, as :func:`engines.configure` would apply them.
+    n_impacts, psi0, restitution_factor
+        As :func:`free_rocking`.
+
+    Returns
+    -------
+    RestitutionResult
+
+    Raises
+    ------
+    ValueError
+        Unknown backend or one without free-rocking releases, ``theta0`` outside
+        ``(-alpha, alpha)`` or zero, ``n_impacts`` out of range, a setting the
+        backend refuses (naming it); before any run.
+
+    Examples
+    --------
+    >>> from trilith_xval.scenes import load_scene
+    >>> r = measure_restitution("pymunk", load_scene("fig5", gamma=0.0), n_impacts=2)
+    >>> r.equation, r.n_impacts, r.max_rel_error < 0.005
+    ('Eq. 20', 2, True)
+    """
+    from trilith_xval.compare.run.spec import RunSpec
+    _check_tilt_backend(backend)
+    given = {} if settings is None else {f.name: getattr(settings, f.name)
+                                         for f in dataclasses.fields(settings)}
+    run = RunSpec.resolve(backend, scene, Still(), overrides={**given, **options},
+                          overrides_from="the options given")
+    return free_rocking(run, theta0, n_impacts=n_impacts, psi0=psi0,
+                        restitution_factor=restitution_factor)
+
+
+def _check_tilt_backend(backend: str) -> None:
+    """ValueError unless ``backend`` is registered and can release from a tilt."""
+    from trilith_xval.engines import get_backend, supports
+    get_backend(backend)
+    if not supports(backend, "initial_tilt"):
+        raise ValueError(f"engine {backend!r} cannot release the trilith from a tilt "
+                         f"(no 'initial_tilt' capability)")
+
+
+def free_rocking(run, theta0: float | None = None, n_impacts: int = DEFAULT_N_IMPACTS,
+                 psi0: float = 0.0, restitution_factor: float = 1.0) -> RestitutionResult:
+    """Release ``run``'s scene from tilt ``theta0`` in its backend and compare each
+    impact's velocity ratio with Eq. 19/20.
+
+    Parameters
+    ----------
+    run : compare.run.spec.RunSpec
+        The backend, the scene and the settings, under no base motion
+        (:class:`~analytic.excitation.Still`); ``theta0``, ``psi0``, ``t_max`` and
+        ``early_stop=False`` are set here, one more layer over its own.
+    theta0 : float, optional
+        Initial tilt [rad], ``0 < |theta0| < alpha`` (released at rest; sign =
+        side).  Default ``alpha / 2``: well inside the well, fast impacts.
     n_impacts : int
         Impacts to measure, in [1, 50].
     psi0 : float
@@ -191,22 +247,16 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
     Raises
     ------
     ValueError
-        Unknown backend or one without free-rocking releases, ``theta0`` outside
-        ``(-alpha, alpha)`` or zero, ``n_impacts`` out of range; before any run.
-
-    Examples
-    --------
-    >>> from trilith_xval.scenes import load_scene
-    >>> r = measure_restitution("pymunk", load_scene("fig5", gamma=0.0), n_impacts=2)
-    >>> r.equation, r.n_impacts, r.max_rel_error < 0.005
-    ('Eq. 20', 2, True)
+        A backend without free-rocking releases, a run under a base motion,
+        ``theta0`` outside ``(-alpha, alpha)`` or zero, ``n_impacts`` out of
+        range; before any run.
     """
-    from trilith_xval.engines import configure, get_backend, supports
-
-    module = get_backend(backend)
-    if not supports(backend, "initial_tilt"):
-        raise ValueError(f"engine {backend!r} cannot release the trilith from a tilt "
-                         f"(no 'initial_tilt' capability)")
+    from trilith_xval.engines import get_backend
+    backend, scene = run.backend, run.scene
+    _check_tilt_backend(backend)
+    if not isinstance(run.excitation, Still):
+        raise ValueError(f"free rocking has no base motion: the run's excitation must be "
+                         f"Still, got {type(run.excitation).__name__}")
     alpha = scene.alpha
     theta0 = 0.5 * alpha if theta0 is None else theta0
     for name, value in (("theta0", theta0), ("psi0", psi0)):
@@ -220,8 +270,6 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
         raise ValueError(f"psi0 must be in [-pi, pi] rad, got {psi0!r}")
     from trilith_xval.analytic.options import check_restitution_factor
     restitution_factor = check_restitution_factor("measure_restitution", restitution_factor)
-    if restitution_factor != 1.0 and backend.startswith("analytic"):
-        options = {**options, "restitution_factor": restitution_factor}
     if isinstance(n_impacts, bool) or not isinstance(n_impacts, int) or not (
             1 <= n_impacts <= MAX_N_IMPACTS):
         raise ValueError(f"n_impacts must be an integer in [1, {MAX_N_IMPACTS}], got {n_impacts!r}")
@@ -231,12 +279,14 @@ def measure_restitution(backend: str, scene, theta0: float | None = None, settin
                          f"theta0 = {theta0:g} rad; ask for n_impacts <= {len(times)}")
     t_max = (0.5 * (times[n_impacts - 1] + times[n_impacts]) if len(times) > n_impacts
              else times[-1] + 0.5)
-    run = configure(backend, settings, **options)
-    run = configure(backend, run, theta0=theta0, psi0=psi0, t_max=t_max, early_stop=False)
+    release = {"theta0": theta0, "psi0": psi0, "t_max": t_max, "early_stop": False}
+    if restitution_factor != 1.0 and backend.startswith("analytic"):
+        release["restitution_factor"] = restitution_factor  # the model runs it too
+    settings = run.with_options("the free-rocking release", **release).settings
     from trilith_xval.compare.run.runs import simulate  # through the run store
-    traj = simulate(backend, scene, Still(), run)
+    traj = simulate(backend, scene, Still(), settings)
     return RestitutionResult(
-        engine=backend, version=module.version(), lam=scene.lam, mu=scene.mu,
+        engine=backend, version=get_backend(backend).version(), lam=scene.lam, mu=scene.mu,
         gamma=scene.gamma, theta0=theta0, psi0=psi0, n_requested=n_impacts,
         impacts=restitution_from_trajectory(traj, scene, n_impacts, restitution_factor),
         status=traj.verdict.status, settings=dict(traj.settings),

@@ -11,7 +11,7 @@ Eq. 20 with the lintel and no pendulum, Eq. 19 with the pendulum), one *cell*:
   model's (Eq. 20, which for a block is Housner's ``1 - 1.5 sin^2 alpha``; Eq. 19
   at the measured psi with the pendulum), and ``r_worst`` the largest
   ``|measured / predicted - 1|`` of those impacts
-  (:func:`compare.measure.restitution.measure_restitution`: free rocking from
+  (:func:`compare.measure.restitution.free_rocking`: free rocking from
   ``alpha / 2``, the run ends halfway to impact ``N_IMPACTS + 1``, before rest);
 * ``thr_error``: the engine's first-overturning one-sine amplitude at
   ``Omega = OMEGA_RATIO p`` (``p = sqrt(3 g / (4 R))`` of one column, ``R``
@@ -30,9 +30,9 @@ import os
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["Variant", "GRIDS", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO", "N_IMPACTS",
-           "R_TOL", "THR_TOL", "cell_scene", "measure_cell", "restitution_map", "cheapest",
-           "not_exposed"]
+__all__ = ["Variant", "MapCell", "GRIDS", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO",
+           "N_IMPACTS", "R_TOL", "THR_TOL", "cell_scene", "measure_cell", "restitution_map",
+           "cheapest", "not_exposed"]
 
 LAMS = (1.5, 2.0, 3.0, 5.0, 8.0, 10.0)
 # The paper's trilith (fig5, lam 5, mu 1): without the pendulum Eq. 20 holds
@@ -172,25 +172,54 @@ def model_point(scene_name: str) -> tuple[float, float, str | None]:
     return w, float(a), mode
 
 
-def measure_cell(job: tuple) -> dict:
-    """One cell: ``job = (engine, variant_name, scene_name, omega, a_model, mode,
-    store_dir)``; a dict (plain data).  Module-level: workers pickle it."""
-    engine, variant_name, scene_name, w, a_model, mode = job[:6]
-    from trilith_xval.compare.measure.engine_spectrum import threshold_spec
-    from trilith_xval.compare.measure.restitution import measure_restitution
+@dataclass(frozen=True)
+class MapCell:
+    """One cell: ``engine`` with its variant named ``variant`` (of :data:`GRIDS`) on
+    the scene named ``scene`` (:func:`cell_scene`), the one-sine pulse at
+    ``omega`` [rad/s] where the model's threshold is ``a_model`` [m/s^2] (mode
+    ``mode``)."""
+
+    engine: str
+    variant: str
+    scene: str
+    omega: float
+    a_model: float
+    mode: str | None
+
+    def values(self) -> list:
+        """The cell's fields, in order (its store key's ``cell``)."""
+        return [self.engine, self.variant, self.scene, self.omega, self.a_model, self.mode]
+
+    def grid_variant(self) -> Variant:
+        return next(v for v in GRIDS[self.engine] if v.name == self.variant)
+
+    def run(self):
+        """The cell's run (:class:`compare.run.spec.RunSpec`): the engine's
+        defaults, then the variant's options, on the cell's scene with no base
+        motion; its threshold search resolves it again at its largest pulse."""
+        from trilith_xval.compare.run.spec import RunSpec
+        variant = self.grid_variant()
+        return RunSpec.resolve(self.engine, cell_scene(self.scene),
+                               overrides=dict(variant.options),
+                               overrides_from=f"the variant {variant.name}")
+
+
+def measure_cell(cell: MapCell) -> dict:
+    """One cell (:class:`MapCell`) measured: a dict (plain data).  Module-level:
+    workers pickle it."""
+    from trilith_xval.compare.measure.engine_spectrum import point_spec
+    from trilith_xval.compare.measure.restitution import free_rocking
     from trilith_xval.compare.measure.thresholds import engine_threshold
-    from trilith_xval.compare.run.spec import RunSpec
-    variant = next(v for v in GRIDS[engine] if v.name == variant_name)
-    scene = cell_scene(scene_name)
+    engine, variant_name, scene_name, w, a_model, mode = cell.values()
     c0 = time.process_time()
+    run = cell.run()
+    scene = run.scene
     out = {"engine": engine, "variant": variant_name, "scene": scene_name, "lam": scene.lam,
            "omega": w, "a_model": a_model, "mode_model": mode, "error": None}
     # An engine that fails a run (Drake's SAP not converging) fails its cell, not
     # the map: the cell is kept with the engine's message and counts as failing.
     try:
-        run = RunSpec.resolve(engine, scene, overrides=dict(variant.options),
-                              overrides_from=f"the variant {variant.name}")
-        res = measure_restitution(engine, scene, settings=run.settings, n_impacts=N_IMPACTS)
+        res = free_rocking(run, n_impacts=N_IMPACTS)
         ratios = [i.measured / i.predicted for i in res.impacts if i.predicted]
         r_cpu = float(res.diagnostics.get("cpu_time", math.nan))
         out.update(equation=res.equation, n_impacts=res.n_impacts, complete=res.complete,
@@ -204,7 +233,7 @@ def measure_cell(job: tuple) -> dict:
                mode_engine=None, thr_runs=0, thr_cpu_s=0.0)
     if math.isfinite(a_model):
         try:
-            spec = threshold_spec(engine, scene, w, a_model, options=dict(variant.options))
+            spec = point_spec(run, scene, w, a_model)  # at the search's largest pulse
             p = engine_threshold(engine, scene, w, a_model, spec.settings, mode_reference=mode)
             out.update(a_engine=p.a_engine, a_survives=p.a_survives, thr_error=p.rel_error,
                        mode_engine=p.mode_engine, thr_runs=p.n_runs, thr_cpu_s=p.cpu_s)
@@ -217,8 +246,8 @@ def measure_cell(job: tuple) -> dict:
     return out
 
 
-def _jobs(engines, scenes, models, variants=None) -> list[tuple]:
-    return [(e, v.name, s, *models[s]) for e in engines for v in GRIDS[e]
+def _cells(engines, scenes, models, variants=None) -> list[MapCell]:
+    return [MapCell(e, v.name, s, *models[s]) for e in engines for v in GRIDS[e]
             if variants is None or v.name in variants for s in scenes]
 
 
@@ -267,7 +296,7 @@ def restitution_map(engines=tuple(GRIDS), lams=LAMS, *, trilith: bool = True,
         for s in scenes:
             models[s] = model_point(s)
             b.update()
-    jobs = _jobs(engines, scenes, models, variants)
+    jobs = _cells(engines, scenes, models, variants)
     cells = []
     with bar(len(jobs), "restitution map", "cell") as b:
         for out in runs.run_many(_cell_memo, jobs, workers=workers,
@@ -297,15 +326,14 @@ def _children_cpu() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
-def _cell_memo(job: tuple) -> dict:
+def _cell_memo(cell: MapCell) -> dict:
     """:func:`measure_cell` through the store (whole cells: a warm rerun is instant)."""
     from trilith_xval.compare.run import runs
-    variant = next(v for v in GRIDS[job[0]] if v.name == job[1])
-    key = {"cell": list(job[:6]), "options": {k: list(v) if isinstance(v, tuple) else v
-                                              for k, v in variant.options.items()},
+    key = {"cell": cell.values(), "options": {k: list(v) if isinstance(v, tuple) else v
+                                              for k, v in cell.grid_variant().options.items()},
            "n_impacts": N_IMPACTS}
-    return runs.memo("restitution_map_cell", key, lambda: measure_cell(job),
-                     label=f"{job[0]} {job[1]} {job[2]}", code=CELL_CODE)
+    return runs.memo("restitution_map_cell", key, lambda: measure_cell(cell),
+                     label=f"{cell.engine} {cell.variant} {cell.scene}", code=CELL_CODE)
 
 
 def passes(cell: dict) -> bool:

@@ -31,22 +31,25 @@ def record_section(scene, suite, engines_: tuple, st, workers: int = 1) -> dict:
     """The section's data: ``ida`` settings, ``rows`` (one per record and engine)."""
     from trilith_xval.analytic.bounds import check_model
     from trilith_xval.analytic.ida import scale_to
-    from trilith_xval.compare.cli.fragility import ida_job, robust_job
+    from trilith_xval.compare.measure.record_jobs import IDAJob, RobustJob, model_run, run_job
     from trilith_xval.compare.run.runs import run_many
+    from trilith_xval.compare.run.spec import RunSpec
 
-    model = list(run_many(ida_job, [("analytic", scene, r, st) for r in suite],
+    model = list(run_many(run_job, [IDAJob(model_run(scene), r, st) for r in suite],
                           workers=workers))
-    items = [(e, scene, r, st, None if m["censored"] else m["im_overturn"])
-             for e in engines_ for r, m in zip(suite, model)]
-    models = [m for _e in engines_ for m in model]  # each item's model result
-    done = list(run_many(robust_job, items, workers=workers)) if items else []
+    runs = [RunSpec.resolve(e, scene) for e in engines_]  # each engine at its defaults
+    jobs = [RobustJob(run, r, st, None if m["censored"] else m["im_overturn"])
+            for run in runs for r, m in zip(suite, model)]
+    models = [m for _e in engines_ for m in model]  # each job's model result
+    done = list(run_many(run_job, jobs, workers=workers)) if jobs else []
     validity = {}
     for r, m in zip(suite, model):
         if not m["censored"]:
             validity[r.label] = check_model(scene, scale_to(r, st.im, m["im_overturn"]))
     rows = []
-    for (e, _s, r, _st, _ref), m, res in zip(items, models, done):
-        rows.append(_row(e, r.label, m, res, validity.get(r.label), st))
+    for job, m, res in zip(jobs, models, done):
+        rows.append(_row(job.run.backend, job.record.label, m, res, validity.get(job.record.label),
+                         st))
     return {"ida": st.describe(), "records": [m for m in model], "rows": rows}
 
 

@@ -30,8 +30,8 @@ from trilith_xval.analytic.trajectory import Trajectory
 from trilith_xval.engines import engine_names
 
 __all__ = ["RecordSettings", "RecordResult", "frame_times", "default_duration", "resolve_engines",
-           "run_backend", "sample_states", "Panels", "render_frames", "write_gif", "write_mp4",
-           "find_ffmpeg", "shown_duration",
+           "recording_run", "run_backend", "sample_states", "Panels", "render_frames",
+           "write_gif", "write_mp4", "find_ffmpeg", "shown_duration",
            "check_output", "record", "ALL_ENGINES", "FORMATS", "DEFAULT_AMPLITUDE",
            "DEFAULT_OMEGA", "HOLD_AFTER_END"]
 
@@ -63,18 +63,20 @@ class RecordSettings:
         (the paper's ``t_max``, Sec. 5.1).
     panel_width, panel_height : pixels of one backend's panel, even numbers in
         [64, 4096]; default 480 x 360 keeps a 10 s GIF around a few MB.
-    engine_options : per engine, options over its calibrated settings (``--settings``).
+    runs : per backend its run (:class:`compare.run.spec.RunSpec` on the recorded
+        scene and excitation, e.g. with a ``--settings`` file's values); a backend
+        without one runs at its defaults (:func:`recording_run`).
     """
 
     fps: float = 30.0
     duration: float | None = None
     panel_width: int = 480
     panel_height: int = 360
-    engine_options: tuple = ()  # (engine, ((field, value), ...)): a settings file's tables
+    runs: tuple = ()  # RunSpec, at most one per backend
 
-    def options(self, engine: str) -> dict:
-        """The settings-file options of ``engine`` (empty when none)."""
-        return dict(dict(self.engine_options).get(engine, ()))
+    def run_of(self, backend: str):
+        """The run given for ``backend`` (None: its defaults)."""
+        return next((r for r in self.runs if r.backend == backend), None)
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.fps) and 0.0 < self.fps <= 120.0):
@@ -155,24 +157,25 @@ def load_backend(name: str):
     return get_backend(name)
 
 
-def backend_settings(name: str, duration: float, options: dict | None = None):
-    """Backend ``name``'s calibrated settings, run for the whole recorded span.
+def recording_run(name: str, scene: Scene, excitation, duration: float, run=None):
+    """Backend ``name``'s run of ``scene`` under ``excitation`` over the whole
+    recorded span: ``run`` (a :class:`compare.run.spec.RunSpec` of that backend,
+    default its defaults, which are calibrated for time histories) with one more
+    layer, ``t_max = duration`` and ``early_stop=False``.
 
     ``early_stop=False``: a run would otherwise stop as soon as survival is
     certain (energy below the barrier, or at rest), which freezes the picture
     while the pendulum still swings; every backend runs to ``t_max`` (or until it
     overturns).
     """
-    from trilith_xval.engines import configure
-    return configure(name, **(options or {}), t_max=duration, early_stop=False)
+    from trilith_xval.compare.run.spec import RunSpec
+    run = RunSpec.resolve(name, scene, excitation) if run is None else run.at(scene, excitation)
+    return run.with_options("the recorded span", t_max=duration, early_stop=False)
 
 
-def run_backend(name: str, scene: Scene, excitation, duration: float,
-                options: dict | None = None) -> Trajectory:
-    """Simulate ``scene`` in backend ``name`` (``options`` over its calibrated
-    settings) up to ``duration`` seconds."""
-    return load_backend(name).simulate(scene, excitation,
-                                       backend_settings(name, duration, options))
+def run_backend(run) -> Trajectory:
+    """Simulate ``run`` (a :func:`recording_run`) in its backend."""
+    return load_backend(run.backend).simulate(run.scene, run.excitation, run.settings)
 
 
 def shown_duration(trajectories: dict[str, Trajectory], duration: float,
@@ -358,8 +361,9 @@ def record(scene: Scene, excitation, engine: str, out: str | Path,
     if trajectories is None:
         for name in names:  # fail on a missing backend before any long run
             load_backend(name)
-        trajectories = {name: run_backend(name, scene, excitation, duration,
-                                          settings.options(name)) for name in names}
+        trajectories = {name: run_backend(recording_run(name, scene, excitation, duration,
+                                                        settings.run_of(name)))
+                        for name in names}
     duration = shown_duration(trajectories, duration)
     times = frame_times(duration, settings.fps)
     dpi = 100

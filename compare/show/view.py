@@ -63,37 +63,36 @@ def record_hint(scene_name: str, engine: str, excitation) -> str:
     return f"trilith record --scene {scene_name} --engine {engine} {what} --out run.gif"
 
 
-def _own_gui(name: str, scene: Scene, excitation, duration: float,
-             options: dict | None = None) -> bool:
-    """Run engine ``name`` in its own GUI window if it declares the ``'gui'``
-    capability; return whether it did."""
+def _own_gui(run, duration: float) -> bool:
+    """Run ``run`` (a :func:`compare.show.record.recording_run`) in its engine's own
+    GUI window if the engine declares the ``'gui'`` capability; return whether it did."""
     from trilith_xval.engines import supports
-    from trilith_xval.compare.show.record import backend_settings, load_backend
+    from trilith_xval.compare.show.record import load_backend
 
-    if not supports(name, "gui"):
+    if not supports(run.backend, "gui"):
         return False
-    load_backend(name).view(scene, excitation, backend_settings(name, duration, options),
-                            duration=duration)
+    load_backend(run.backend).view(run.scene, run.excitation, run.settings, duration=duration)
     return True
 
 
 def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
          duration: float | None = None, scene_arg: str | None = None,
-         engine_options: tuple = ()) -> dict:
+         runs: tuple = ()) -> dict:
     """Show a run in a window: PyBullet's GUI if available, else a matplotlib
     animation drawn from the backend's Trajectory (several panels for ``'all'``).
 
     Returns the trajectories shown (backend -> Trajectory); empty when PyBullet's
     own GUI was used.  Raises ``ValueError`` when there is no display, with the
     equivalent ``trilith record`` command (``scene_arg``: the ``--scene`` value
-    to quote in it, by default ``scene.name``); ``engine_options`` as
+    to quote in it, by default ``scene.name``); ``runs`` as
     :class:`compare.show.record.RecordSettings`'s.
     """
-    from trilith_xval.compare.show.record import (RecordSettings, Panels, default_duration, frame_times,
-                               load_backend, resolve_engines, run_backend, shown_duration)
+    from trilith_xval.compare.show.record import (RecordSettings, Panels, default_duration,
+                                                  frame_times, load_backend, recording_run,
+                                                  resolve_engines, run_backend, shown_duration)
 
     settings = RecordSettings(fps=fps, duration=duration,  # validates fps/duration
-                              engine_options=engine_options)
+                              runs=runs)
     names = resolve_engines(engine)
     problem = display_problem()
     if problem is None:
@@ -111,12 +110,12 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     for name in names:
         load_backend(name)
     span = settings.duration if settings.duration is not None else default_duration(excitation)
-    if len(names) == 1 and _own_gui(names[0], scene, excitation, span,
-                                     settings.options(names[0])):
+    spans = {name: recording_run(name, scene, excitation, span, settings.run_of(name))
+             for name in names}
+    if len(names) == 1 and _own_gui(spans[names[0]], span):
         return {}
     frame_times(span, settings.fps)  # validates the frame count before any run
-    trajectories = {name: run_backend(name, scene, excitation, span, settings.options(name))
-                    for name in names}
+    trajectories = {name: run_backend(run) for name, run in spans.items()}
     times = frame_times(shown_duration(trajectories, span), settings.fps)
 
     import matplotlib.pyplot as plt

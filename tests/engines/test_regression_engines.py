@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import pytest
 
-from trilith_xval.compare.campaign.validation import CampaignConfig, Tolerances, backend_settings
+from trilith_xval.compare.campaign.validation import CampaignConfig, Tolerances, campaign_run
 from trilith_xval.compare.measure.reference_spectra import first_overturning_amplitude, monotone_above
 from trilith_xval.compare.measure.thresholds import engine_threshold
 from trilith_xval.engines import engine_names, get_backend
@@ -44,7 +44,7 @@ def test_overturning_threshold_within_2_percent(engine):
     assert monotone_above(scene, omega, a_ref, 2 * CONFIG.rel_bracket)
     for w in (omega - CONFIG.jump_margin, omega + CONFIG.jump_margin):
         assert first_overturning_amplitude(scene, w)[1] == mode_ref
-    p = engine_threshold(engine, scene, omega, a_ref, backend_settings(engine, CONFIG),
+    p = engine_threshold(engine, scene, omega, a_ref, campaign_run(engine, CONFIG, scene).settings,
                          mode_reference=mode_ref, rel_tol=4e-3)
     # Every probe must end 'overturned' or 'survived' (an 'unstable' run would
     # count as survived and bias the bisection).

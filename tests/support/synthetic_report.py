@@ -17,9 +17,9 @@ import numpy as np
 
 from trilith_xval.analytic.excitation import Pulse
 from trilith_xval.compare.measure import trajectories as metrics
-from trilith_xval.compare.campaign.validation import POINTS, CampaignConfig, CampaignResult
+from trilith_xval.compare.campaign.validation import CampaignConfig, CampaignResult
 from trilith_xval.compare.campaign.verdicts import build_verdicts
-from trilith_xval.scenes import load_scene
+from trilith_xval.scenes import POINTS, load_scene
 
 ENGINES = ("pybullet", "pymunk")
 SHIFT = {"pybullet": 0.004, "pymunk": -0.0002}  # s: the fake engines' time offsets

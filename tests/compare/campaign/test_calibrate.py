@@ -218,3 +218,34 @@ def test_the_pareto_plot_draws_on_the_given_axes(tmp_path):
     assert pareto_plot(cal, out, ax=left) is left  # the caller's figure, written
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     plt.close(fig)
+
+
+def test_every_candidate_runs_its_run_spec(monkeypatch):
+    """A candidate's releases run one RunSpec each: the engine's defaults, the
+    base, then the candidate's own values, on each release's scene with no base
+    motion (the free-rocking measurement is a stand-in here)."""
+    import types
+
+    from trilith_xval.analytic.excitation import Still
+    from trilith_xval.compare.measure import restitution
+    from trilith_xval.compare.run.spec import RunSpec
+    seen = []
+
+    def stand_in(run, theta0=None, n_impacts=4, psi0=0.0, restitution_factor=1.0):
+        seen.append(run)
+        return types.SimpleNamespace(max_rel_error=0.001, complete=True,
+                                     diagnostics={"cpu_time": 0.1, "steps": 10},
+                                     settings={"dt": run.settings.dt})
+    monkeypatch.setattr(restitution, "free_rocking", stand_in)
+    vs = ValidationSet(releases=((3.0, 1.0),), n_impacts=2)
+    cal = calibrate("pymunk", "restitution", validation=vs, space={"dt": [5e-4, 1e-3]},
+                    base={"iterations": 20})
+    assert [e.options for e in cal.evaluations] == [{"dt": 5e-4}, {"dt": 1e-3}]
+    # Each candidate: the lam-3 release and the scene itself (with its pendulum).
+    assert len(seen) == 4 and all(isinstance(r, RunSpec) for r in seen)
+    for run, dt in zip(seen, (5e-4, 5e-4, 1e-3, 1e-3)):
+        assert isinstance(run.excitation, Still)
+        assert run.settings == engines.configure("pymunk", iterations=20, dt=dt)
+        assert set(dict(run.origin).values()) == {"the candidate settings"}
+    assert seen[0].scene.lam == 3.0 and not seen[0].scene.has_pendulum
+    assert seen[1].scene.has_pendulum

@@ -66,20 +66,24 @@ def default_run():
     stand-in: thresholds and the rest raise (recorded as errors, cheap), the
     re-verification returns a disagreeing row for Drake."""
     import trilith_xval.compare.campaign.validation as campaign
+    from trilith_xval.compare.campaign import validation_jobs as jobs
 
-    def refuse(*args, **kwargs):
+    def refuse(job):
         raise RuntimeError("stand-in")
 
-    def reverify(name, scene, point, source):
+    def reverify(job):
+        name, scene, point, source = job.args()
         return {"engine": name, "case": "pendulum", "omega": point["omega"],
                 "a_stored": point["a_engine"], "a_now": point["a_engine"] * 1.05,
                 "mode_stored": "x", "mode_now": "x", "rel_difference": 0.05,
                 "tolerance": stored_parts.REVERIFY_TOL, "passed": name != "drake",
                 "source": source}
 
-    saved = dict(campaign._JOBS)
-    campaign._JOBS.update({k: refuse for k in ("history", "restitution", "threshold",
-                                               "jump", "long_run")}, reverify=reverify)
+    kinds = (jobs.HistoryJob, jobs.RestitutionJob, jobs.ThresholdPointJob, jobs.JumpJob,
+             jobs.LongRunJob, jobs.ReverifyJob)
+    saved = {kind: kind.__call__ for kind in kinds}
+    for kind in kinds:
+        kind.__call__ = reverify if kind is jobs.ReverifyJob else refuse
     try:
         config = CampaignConfig.default_report(engines=("pymunk", "drake"), points=("A",),
                                                restitution_lams=(5.0,),
@@ -87,8 +91,8 @@ def default_run():
                                                long_runs=False, workers=1)
         result = campaign.run_campaign(config)
     finally:
-        campaign._JOBS.clear()
-        campaign._JOBS.update(saved)
+        for kind, call in saved.items():
+            kind.__call__ = call
     return result
 
 

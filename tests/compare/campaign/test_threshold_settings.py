@@ -12,7 +12,7 @@ from trilith_xval import engines as engines_pkg
 from trilith_xval.compare.campaign.settings_file import domain_notes, read_settings_file, threshold_options
 from trilith_xval.analytic.pulses import pulse_of
 from trilith_xval.compare.run.spec import RunSpec
-from trilith_xval.compare.campaign.validation import CampaignConfig, backend_settings, engine_options
+from trilith_xval.compare.campaign.validation import CampaignConfig, campaign_run
 from trilith_xval.engines import configure
 from trilith_xval.engines.calibration import calibrated, scene_coordinates, threshold_choice
 from trilith_xval.scenes import load_scene
@@ -61,9 +61,10 @@ def test_only_threshold_searches_use_them(engine):
     scene = load_scene("fig5")
     stored = threshold_options(engine, scene)
     config = CampaignConfig(engines=(engine,))
-    assert engine_options(engine, config, thresholds=True) == stored
-    assert engine_options(engine, config) == {}
-    assert backend_settings(engine, config) == configure(engine)  # restitution, histories
+    assert campaign_run(engine, config, scene, thresholds=True).settings == configure(engine,
+                                                                                      **stored)
+    assert campaign_run(engine, config, scene).settings == configure(engine)  # histories
+    assert campaign_run(engine, config, scene).origin == ()
     assert job_settings(engine, 0.0, scene, 10.0, 12.0).dt == stored.get("dt",
                                                                           configure(engine).dt)
 
@@ -105,8 +106,10 @@ def test_a_settings_file_then_dt_go_over_the_calibrated_step():
     assert job_settings("pymunk", 2e-4, scene, 10.0, 12.0, (("dt", 5e-4),)).dt == 2e-4
     config = CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"iterations": 30}},
                             engine_dt=3e-4)
-    options = engine_options("pymunk", config, thresholds=True)
-    assert options == {"dt": 3e-4, "iterations": 30}
+    run = campaign_run("pymunk", config, scene, thresholds=True)
+    assert (run.settings.dt, run.settings.iterations) == (3e-4, 30)
+    assert dict(run.origin) == {"dt": "the campaign's engine_dt",
+                                "iterations": "the campaign's engine_settings"}
 
 
 def test_the_report_names_the_threshold_step():

@@ -120,21 +120,37 @@ def test_campaign_jobs_carry_the_file_into_their_keys():
     filed_job, = threshold_jobs(study, refs, {"pymunk": {"dt": 1e-3}})
     assert threshold_description(filed_job)["settings"]["dt"] == 1e-3
     assert digest(threshold_description(plain_job)) != digest(threshold_description(filed_job))
+    from trilith_xval.compare.campaign.validation_jobs import RestitutionJob
+    from trilith_xval.compare.campaign.config import campaign_run
+    from trilith_xval.scenes import load_scene
     a = CampaignConfig(engines=("pymunk",))
     b = CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"dt": 1e-3}})
-    job = ("restitution", ("pymunk", None))
-    assert digest(_job_description((job[0], (*job[1], a)))) != \
-        digest(_job_description((job[0], (*job[1], b))))
+    fig5 = load_scene("fig5")
+    job_a = RestitutionJob(campaign_run("pymunk", a, fig5), a)
+    job_b = RestitutionJob(campaign_run("pymunk", b, fig5), b)
+    assert job_b.run.settings.dt == 1e-3 != job_a.run.settings.dt
+    assert digest(_job_description(job_a)) != digest(_job_description(job_b))
     with pytest.raises(ValueError, match="iterations"):
         CampaignConfig(engines=("pymunk",), engine_settings={"pymunk": {"iterations": 0}})
 
 
 def test_recordings_run_with_the_file_options():
-    from trilith_xval.compare.show.record import RecordSettings, backend_settings
-    settings = RecordSettings(engine_options=(("pymunk", (("dt", 1e-3),)),))
-    assert settings.options("pymunk") == {"dt": 1e-3} and settings.options("mujoco") == {}
-    run = backend_settings("pymunk", 2.0, settings.options("pymunk"))
-    assert (run.dt, run.t_max, run.early_stop) == (1e-3, 2.0, False)
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.compare.show.record import RecordSettings, recording_run
+    from trilith_xval.engines import configure
+    from trilith_xval.scenes import load_scene
+    fig5, pulse = load_scene("fig5"), Pulse(19.0, 15.0)
+    filed = RunSpec.resolve("pymunk", fig5, pulse, file_options={"dt": 1e-3}, file_name="f.toml")
+    settings = RecordSettings(runs=(filed,))
+    assert settings.run_of("pymunk") is filed and settings.run_of("mujoco") is None
+    run = recording_run("pymunk", fig5, pulse, 2.0, settings.run_of("pymunk"))
+    assert (run.settings.dt, run.settings.t_max, run.settings.early_stop) == (1e-3, 2.0, False)
+    assert dict(run.origin) == {"dt": "--settings f.toml", "t_max": "the recorded span",
+                                "early_stop": "the recorded span"}
+    # Without a given run: the backend's defaults over the span, as before.
+    plain = recording_run("mujoco", fig5, pulse, 2.0)
+    assert plain.settings == configure("mujoco", t_max=2.0, early_stop=False)
 
 
 @pytest.mark.parametrize("command", ["simulate", "map"])
@@ -161,3 +177,30 @@ def test_a_friction_given_above_the_bound_is_kept_as_given(tmp_path, capsys):
     path.write_text(f"[pymunk]\nfriction = {1.05 * need!r}\n")  # below the 1.2x margin
     doc = _simulate_json(COMMANDS["simulate"] + ["--settings", str(path)], capsys)
     assert doc["settings"]["friction_used"] == 1.05 * need
+
+
+def test_record_resolves_each_backends_run_from_the_file(tmp_path):
+    """trilith record / view hand each backend's RunSpec (defaults, then the
+    --settings table) to the recording: the run a panel shows is that spec with
+    the recorded span over it."""
+    from trilith_xval.analytic.excitation import Pulse
+    from trilith_xval.compare.cli.main import build_parser
+    from trilith_xval.compare.cli.record import watch_inputs
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.compare.show.record import recording_run
+    from trilith_xval.scenes import load_scene
+    path = tmp_path / "s.toml"
+    path.write_text("[pymunk]\ndt = 0.0005\n")
+    parser, _ = build_parser()
+    args = parser.parse_args(["record", "--engine", "analytic,pymunk", "--settings", str(path),
+                              "--duration", "1", "--out", str(tmp_path / "x.gif")])
+    scene, excitation, settings = watch_inputs(args)
+    assert excitation == Pulse(19.0, 15.0) and scene == load_scene("fig5")
+    assert [r.backend for r in settings.runs] == ["analytic", "pymunk"]
+    filed = RunSpec.resolve("pymunk", scene, excitation, file_options={"dt": 5e-4},
+                            file_name=repr(str(path)))
+    assert settings.run_of("pymunk").key() == filed.key()
+    assert settings.run_of("analytic").key() == RunSpec.resolve("analytic", scene,
+                                                                excitation).key()
+    shown = recording_run("pymunk", scene, excitation, 1.0, settings.run_of("pymunk"))
+    assert (shown.settings.dt, shown.settings.t_max) == (5e-4, 1.0)

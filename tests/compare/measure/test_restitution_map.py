@@ -86,3 +86,23 @@ def test_bad_input_is_one_line_exit_2(capsys, args, words):
     assert main(["restitution-map", "--no-cache", *args]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("error:") and words in err
+
+
+def test_a_cell_is_a_value_holding_its_variants_run(monkeypatch):
+    """A cell's run is the engine's RunSpec with its variant's options over the
+    defaults; the whole cell is stored under the description it always had."""
+    from trilith_xval.compare.measure import restitution_map as rm
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.spec import RunSpec
+    from trilith_xval.engines import configure
+    cell = rm.MapCell("pymunk", "dt=5e-4", "fig5_eq20", 12.0, 8.8, "after-impact")
+    run = cell.run()
+    assert isinstance(run, RunSpec) and run.scene == rm.cell_scene("fig5_eq20")
+    assert run.settings == configure("pymunk", dt=5e-4)
+    assert dict(run.origin) == {"dt": "the variant dt=5e-4"}
+    seen = []
+    monkeypatch.setattr(runs, "memo", lambda kind, key, compute, **kw: seen.append((kind, key)))
+    rm._cell_memo(cell)
+    assert seen == [("restitution_map_cell",
+                     {"cell": ["pymunk", "dt=5e-4", "fig5_eq20", 12.0, 8.8, "after-impact"],
+                      "options": {"dt": 5e-4}, "n_impacts": rm.N_IMPACTS})]

@@ -107,12 +107,12 @@ def test_cli_bad_input_exits_2(argv, needle, capsys, tmp_path):
 
 
 def test_a_job_that_raises_is_reported_and_fails_its_verdict(monkeypatch):
-    import trilith_xval.compare.campaign.validation as campaign
+    from trilith_xval.compare.campaign.validation_jobs import RestitutionJob
 
-    def broken(name, scene, config=None):
+    def broken(job):
         raise RuntimeError("engine exploded")
 
-    monkeypatch.setitem(campaign._JOBS, "restitution", broken)
+    monkeypatch.setattr(RestitutionJob, "__call__", broken)
     cfg = CampaignConfig(**{**TINY, "points": (), "spectrum_cases": (), "pendulum_lams": (),
                             "workers": 1})
     result = run_campaign(cfg)

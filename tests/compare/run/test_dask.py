@@ -13,6 +13,7 @@ import pytest
 
 from trilith_xval.compare.run import runs
 from trilith_xval.compare.campaign.validation import CampaignConfig, _run_one
+from trilith_xval.compare.campaign.validation_jobs import history_job
 from trilith_xval.compare.run.store import RunStore
 from tests.support.trajectories import assert_same_trajectory
 
@@ -40,7 +41,7 @@ def cluster():
 def _jobs(fig5):
     """Campaign history jobs: pymunk at the paper's A and D, coarse steps (fast)."""
     config = CampaignConfig(engines=("pymunk",), engine_dt=5e-4)
-    return [("history", ("pymunk", scene, point, config))
+    return [history_job("pymunk", scene, point, config)
             for scene in (fig5, fig5.without_pendulum()) for point in ("A", "D")]
 
 

@@ -362,7 +362,7 @@ def test_view_with_a_display_animates_the_trajectories(monkeypatch):
 
     monkeypatch.setattr(view_mod, "display_problem", lambda: None)
     monkeypatch.setattr(view_mod, "NON_INTERACTIVE_BACKENDS", ())
-    monkeypatch.setattr(rec, "run_backend", lambda name, *a: synthetic(name, 0.1))
+    monkeypatch.setattr(rec, "run_backend", lambda run: synthetic(run.backend, 0.1))
     monkeypatch.setattr(plt, "show", fake_show)
     trajs = view_mod.view(FIG5, Pulse(4.0, 9.0), "all", fps=10.0, duration=1.0)
     assert set(trajs) == set(rec.ALL_ENGINES)
