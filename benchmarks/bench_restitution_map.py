@@ -21,7 +21,7 @@ WORKERS = os.environ.get("BENCH_RMAP_WORKERS", "2")
 
 
 def main(argv: list[str] | None = None) -> int:
-    from trilith_xval.compare.measure.restitution_map import GRIDS, LAMS, TRILITH
+    from trilith_xval.compare.measure.restitution_map import LAMS, TRILITH, grids
     with tempfile.TemporaryDirectory(prefix="bench-rmap-") as tmp:
         out = Path(tmp) / "map.json"
         run = timed_trilith(["restitution-map", "--workers", WORKERS, "--json", str(out),
@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
             print(run.stderr, file=sys.stderr)
             return 1
         doc = json.loads(out.read_text())
-    expected = sum(len(v) for v in GRIDS.values()) * (len(LAMS) + len(TRILITH))
+    expected = sum(len(v) for v in grids().values()) * (len(LAMS) + len(TRILITH))
     payload = {"command": f"trilith restitution-map --workers {WORKERS} --no-cache",
                "cpu_s": cpu, "wall_s": wall, "load_average": run.load_average,
                "target_cpu_s": TARGET_CPU_S, "met": cpu <= TARGET_CPU_S,

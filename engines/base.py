@@ -205,6 +205,12 @@ class Engine:
     # Builds any body list (engines.geometry.Structure: the kinds of analytic.kinds),
     # not only the parametric trilith; read() then fills PlaneState.bodies.
     structures: ClassVar[bool] = False
+    # The restitution map's variants beyond the step (name, why, options over the
+    # defaults): the parameters of this engine that act on a rocking impact
+    # (compare/measure/restitution_map.py); and those it fixes rather than exposes,
+    # said beside the map.
+    impact_variants: ClassVar[tuple[tuple[str, str, Mapping], ...]] = ()
+    impact_fixed: ClassVar[str] = ""
 
     @classmethod
     def version(cls) -> str:

@@ -13,7 +13,8 @@ from trilith_xval.compare.run.jsonable import plain
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    from trilith_xval.compare.measure.restitution_map import GRIDS, LAMS
+    from trilith_xval.compare.measure.restitution_map import LAMS
+    from trilith_xval.engines import engine_names
     parser = subparsers.add_parser(
         "restitution-map",
         help="r_eff / r_H and threshold error vs lam per engine, over its settings",
@@ -23,7 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "(lam 1.5-10) and the fig5 trilith (Eq. 20, Eq. 19); the cheapest "
                     "settings within 0.5 % and 2 % per lam range.")
     parser.add_argument("--engine", action="append", default=None, metavar="NAME",
-                        help=f"engine ({', '.join(GRIDS)} or all); repeatable (default: all)")
+                        help=f"engine ({', '.join(engine_names())} or all); repeatable (default: all)")
     parser.add_argument("--lam", action="append", type=float, default=None, metavar="LAM",
                         help=f"block slenderness, one of {', '.join(f'{x:g}' for x in LAMS)}; "
                              "repeatable (default: all)")
@@ -43,12 +44,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _engines(names) -> list[str]:
-    from trilith_xval.compare.measure.restitution_map import GRIDS
+    from trilith_xval.engines import engine_names
     if not names or names == ["all"]:
-        return list(GRIDS)
+        return list(engine_names())
     for n in names:
-        if n not in GRIDS:
-            raise ValueError(f"--engine must be one of {', '.join(GRIDS)} or all, got {n!r}")
+        if n not in engine_names():
+            raise ValueError(f"--engine must be one of {', '.join(engine_names())} or all, "
+                             f"got {n!r}")
     if len(set(names)) != len(names):
         raise ValueError(f"--engine: an engine is named twice in {names}")
     return list(names)
@@ -75,8 +77,8 @@ def run(args: argparse.Namespace) -> int:
 
     engines, lams = _engines(args.engine), _lams(args.lam)
     if args.variant is not None:
-        from trilith_xval.compare.measure.restitution_map import GRIDS
-        known = {v.name for e in engines for v in GRIDS[e]}
+        from trilith_xval.compare.measure.restitution_map import grid
+        known = {v.name for e in engines for v in grid(e)}
         bad = [v for v in args.variant if v not in known]
         if bad:
             raise ValueError(f"--variant must be one of {', '.join(sorted(known))}, "

@@ -1,7 +1,7 @@
 """The restitution map: each engine's effective rocking restitution and threshold
 error against the slenderness ``lam``, over the settings that matter.
 
-For every engine, every settings variant of :data:`GRIDS` and every scene of the
+For every engine, every settings variant of :func:`grid` and every scene of the
 block family (``block_lam1.5`` ... ``block_lam10``, mu = gamma = 0, each column
 an independent Housner block) plus the trilith at the paper's lam (``fig5``:
 Eq. 20 with the lintel and no pendulum, Eq. 19 with the pendulum), one *cell*:
@@ -30,7 +30,7 @@ import os
 import time
 from dataclasses import dataclass, field
 
-__all__ = ["Variant", "MapCell", "GRIDS", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO",
+__all__ = ["Variant", "MapCell", "STEP_VARIANTS", "grid", "grids", "LAMS", "TRILITH", "LAM_RANGES", "OMEGA_RATIO",
            "N_IMPACTS", "R_TOL", "THR_TOL", "cell_scene", "measure_cell", "restitution_map",
            "cheapest", "not_exposed"]
 
@@ -75,66 +75,35 @@ def _v(name, why, **options) -> Variant:
 
 # Per engine: the defaults, the step at two coarser values (where the cost is)
 # and one or two values of each named parameter the engine exposes, one at a
-# time (docs/restitution-map.md).  Finer steps are left out: every engine's
-# error at 1e-4 s is already below R_TOL and they double the cost.
-GRIDS: dict[str, tuple[Variant, ...]] = {
-    "pybullet": (
-        _v("default", "calibrated defaults (dt 1e-4 s)"),
-        _v("dt=2e-4", "step x2", dt=2e-4),
-        _v("dt=5e-4", "step x5", dt=5e-4),
-        _v("iterations=10", "fewer PGS iterations", solver_iterations=10),
-        _v("iterations=200", "more PGS iterations", solver_iterations=200),
-        _v("erp=0.05", "softer position correction", contact_erp=0.05),
-        _v("erp=0.8", "stiffer position correction", contact_erp=0.8),
-    ),
-    "pymunk": (
-        _v("default", "calibrated defaults (dt 1e-4 s)"),
-        _v("dt=2e-4", "step x2", dt=2e-4),
-        _v("dt=5e-4", "step x5", dt=5e-4),
-        _v("iterations=10", "Chipmunk's default iterations", iterations=10),
-        _v("iterations=100", "more iterations", iterations=100),
-        _v("slop=1e-3", "collision slop x10", slop_fraction=1e-3),
-        _v("slop=1e-2", "collision slop x100", slop_fraction=1e-2),
-    ),
-    "mujoco": (
-        _v("default", "calibrated defaults (dt 1e-4 s)"),
-        _v("dt=2e-4", "step x2", dt=2e-4),
-        _v("dt=5e-4", "step x5", dt=5e-4),
-        _v("solref timeconst=2dt", "solref: MuJoCo's smallest stable time constant",
-           timeconst_steps=2.0),
-        _v("solref dampratio=1", "solref: MuJoCo's default damping ratio", dampratio=1.0),
-        _v("solimp MuJoCo default", "solimp (0.9, 0.95, 0.001, 0.5, 2)",
-           solimp=(0.9, 0.95, 0.001, 0.5, 2.0)),
-        _v("cone=pyramidal", "MuJoCo's default friction cone", cone="pyramidal"),
-        _v("impratio=1", "MuJoCo's default impratio", impratio=1.0),
-    ),
-    "dart": (
-        _v("default", "calibrated defaults (dt 1e-4 s)"),
-        _v("dt=2e-4", "step x2", dt=2e-4),
-        _v("dt=5e-4", "step x5", dt=5e-4),
-        _v("detector=fcl", "FCL collision detector", detector="fcl"),
-        _v("detector=bullet", "Bullet collision detector", detector="bullet"),
-    ),
-    "drake": (
-        _v("default", "calibrated defaults (dt 1e-4 s)"),
-        _v("dt=2e-4", "step x2", dt=2e-4),
-        _v("dt=5e-4", "step x5", dt=5e-4),
-        _v("relaxation_time=1e-3", "SAP relaxation time 1 ms", relaxation_time=1e-3),
-        _v("hydroelastic", "hydroelastic contact model", contact_model="hydroelastic"),
-    ),
-}
+# time (the engine class's ``impact_variants``; docs/restitution-map.md).  Finer
+# steps are left out: every engine's error at 1e-4 s is already below R_TOL and
+# they double the cost.
+STEP_VARIANTS = (_v("default", "calibrated defaults (dt 1e-4 s)"),
+                 _v("dt=2e-4", "step x2", dt=2e-4),
+                 _v("dt=5e-4", "step x5", dt=5e-4))
 
 
-def not_exposed() -> dict[str, str]:
-    """Parameters the issue names that an engine's Settings do not expose, and why."""
-    return {
-        "pybullet": "restitution (0 on every body: the rocking impact is plastic by "
-                    "construction, engines/pybullet_/bodies.py) and split impulse (always "
-                    "on, engines/pybullet_/world.py) are fixed, not Settings fields",
-        "pymunk": "elasticity (0 on every shape, engines/pymunk_/world.py) is fixed",
-        "dart": "the constraint solver (DART's boxed LCP, Dantzig) is fixed; the "
-                "collision detector is the setting",
-    }
+def grid(engine: str) -> tuple[Variant, ...]:
+    """``engine``'s settings variants: :data:`STEP_VARIANTS`, then its class's
+    ``impact_variants`` (every registered engine, entry-point ones included)."""
+    from trilith_xval.engines import get_backend
+    return STEP_VARIANTS + tuple(Variant(name, dict(options), why) for name, why, options
+                                 in get_backend(engine).impact_variants)
+
+
+def grids(engines=None) -> dict[str, tuple[Variant, ...]]:
+    """:func:`grid` of each of ``engines`` (default: every registered engine)."""
+    from trilith_xval.engines import engine_names
+    return {e: grid(e) for e in (engine_names() if engines is None else engines)}
+
+
+def not_exposed(engines=None) -> dict[str, str]:
+    """Per engine, the impact parameters its Settings do not expose, and why (the
+    class's ``impact_fixed``)."""
+    from trilith_xval.engines import engine_names, get_backend
+    fixed = {e: get_backend(e).impact_fixed
+             for e in (engine_names() if engines is None else engines)}
+    return {e: text for e, text in fixed.items() if text}
 
 
 def cell_scene(scene_name: str):
@@ -174,7 +143,7 @@ def model_point(scene_name: str) -> tuple[float, float, str | None]:
 
 @dataclass(frozen=True)
 class MapCell:
-    """One cell: ``engine`` with its variant named ``variant`` (of :data:`GRIDS`) on
+    """One cell: ``engine`` with its variant named ``variant`` (of :func:`grid`) on
     the scene named ``scene`` (:func:`cell_scene`), the one-sine pulse at
     ``omega`` [rad/s] where the model's threshold is ``a_model`` [m/s^2] (mode
     ``mode``)."""
@@ -191,7 +160,7 @@ class MapCell:
         return [self.engine, self.variant, self.scene, self.omega, self.a_model, self.mode]
 
     def grid_variant(self) -> Variant:
-        return next(v for v in GRIDS[self.engine] if v.name == self.variant)
+        return next(v for v in grid(self.engine) if v.name == self.variant)
 
     def run(self):
         """The cell's run (:class:`compare.run.spec.RunSpec`): the engine's
@@ -247,18 +216,18 @@ def measure_cell(cell: MapCell) -> dict:
 
 
 def _cells(engines, scenes, models, variants=None) -> list[MapCell]:
-    return [MapCell(e, v.name, s, *models[s]) for e in engines for v in GRIDS[e]
+    return [MapCell(e, v.name, s, *models[s]) for e in engines for v in grid(e)
             if variants is None or v.name in variants for s in scenes]
 
 
-def restitution_map(engines=tuple(GRIDS), lams=LAMS, *, trilith: bool = True,
+def restitution_map(engines=None, lams=LAMS, *, trilith: bool = True,
                     workers: int = 1, variants=None) -> dict:
     """Measure the map (module docstring): plain data, cells in job order.
 
     Parameters
     ----------
-    engines : sequence of str
-        Keys of :data:`GRIDS`.
+    engines : sequence of str, optional
+        Registered engines (default: every one).
     lams : sequence of float
         Members of :data:`LAMS` (the block scenes).
     trilith : bool
@@ -277,14 +246,16 @@ def restitution_map(engines=tuple(GRIDS), lams=LAMS, *, trilith: bool = True,
     """
     from trilith_xval.compare.run import runs
     from trilith_xval.compare.run.progress import bar
+    from trilith_xval.engines import engine_names
+    engines = engine_names() if engines is None else tuple(engines)
     for e in engines:
-        if e not in GRIDS:
-            raise ValueError(f"engine must be one of {', '.join(GRIDS)}, got {e!r}")
+        if e not in engine_names():
+            raise ValueError(f"engine must be one of {', '.join(engine_names())}, got {e!r}")
     for lam in lams:
         if lam not in LAMS:
             raise ValueError(f"lam must be one of {', '.join(f'{x:g}' for x in LAMS)}, got {lam!r}")
     if variants is not None:
-        known = {v.name for e in engines for v in GRIDS[e]}
+        known = {v.name for e in engines for v in grid(e)}
         for name in variants:
             if name not in known:
                 raise ValueError(f"variant must be one of {', '.join(sorted(known))}, "
@@ -305,7 +276,7 @@ def restitution_map(engines=tuple(GRIDS), lams=LAMS, *, trilith: bool = True,
     spent = time.process_time() - c0 + _children_cpu() - k0
     return {"engines": list(engines), "lams": list(lams), "trilith": trilith,
             "omega_ratio": OMEGA_RATIO, "n_impacts": N_IMPACTS, "r_tol": R_TOL,
-            "thr_tol": THR_TOL, "grids": {e: [v.to_dict() for v in GRIDS[e]
+            "thr_tol": THR_TOL, "grids": {e: [v.to_dict() for v in grid(e)
                                               if variants is None or v.name in variants]
                                           for e in engines},
             "not_exposed": not_exposed(), "cells": cells,

@@ -73,6 +73,12 @@ class DartEngine(Engine):
     label = "DART"
     color = "tab:cyan"
     regression_point = ("no_pendulum", 12.5)
+    impact_variants = (
+        ("detector=fcl", "FCL collision detector", {"detector": "fcl"}),
+        ("detector=bullet", "Bullet collision detector", {"detector": "bullet"}),
+    )
+    impact_fixed = ("the constraint solver (DART's boxed LCP, Dantzig) is fixed; the "
+                    "collision detector is the setting")
     marker = "v"
     affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})

@@ -160,6 +160,10 @@ class DrakeEngine(Engine):
     # `trilith calibrate`'s search beside the step: the contact damping ratio around
     # its calibrated 2.5 (docs/drake.md).
     calibration_space = {"damping_ratio": (1.5, 2.5, 4.0)}
+    impact_variants = (
+        ("relaxation_time=1e-3", "SAP relaxation time 1 ms", {"relaxation_time": 1e-3}),
+        ("hydroelastic", "hydroelastic contact model", {"contact_model": "hydroelastic"}),
+    )
     Settings = Settings
 
     @classmethod

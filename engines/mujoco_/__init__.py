@@ -211,6 +211,15 @@ class MujocoEngine(Engine):
     label = "MuJoCo"
     color = "tab:purple"
     regression_point = ("fig5", 12.5)
+    impact_variants = (
+        ("solref timeconst=2dt", "solref: MuJoCo's smallest stable time constant",
+         {"timeconst_steps": 2.0}),
+        ("solref dampratio=1", "solref: MuJoCo's default damping ratio", {"dampratio": 1.0}),
+        ("solimp MuJoCo default", "solimp (0.9, 0.95, 0.001, 0.5, 2)",
+         {"solimp": (0.9, 0.95, 0.001, 0.5, 2.0)}),
+        ("cone=pyramidal", "MuJoCo's default friction cone", {"cone": "pyramidal"}),
+        ("impratio=1", "MuJoCo's default impratio", {"impratio": 1.0}),
+    )
     marker = "^"
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
                               "initial_tilt", "trajectory"})

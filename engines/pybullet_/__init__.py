@@ -154,6 +154,15 @@ class PyBulletEngine(Engine):
     label = "PyBullet"
     color = "tab:blue"
     regression_point = ("no_pendulum", 12.5)
+    impact_variants = (
+        ("iterations=10", "fewer PGS iterations", {"solver_iterations": 10}),
+        ("iterations=200", "more PGS iterations", {"solver_iterations": 200}),
+        ("erp=0.05", "softer position correction", {"contact_erp": 0.05}),
+        ("erp=0.8", "stiffer position correction", {"contact_erp": 0.8}),
+    )
+    impact_fixed = ("restitution (0 on every body: the rocking impact is plastic by "
+                    "construction, engines/pybullet_/bodies.py) and split impulse (always "
+                    "on, engines/pybullet_/world.py) are fixed, not Settings fields")
     marker = "o"
     capabilities = frozenset({"time_step", "solver_iterations", "render", "gui",
                               "moving_ground", "initial_tilt", "trajectory"})

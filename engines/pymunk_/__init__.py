@@ -112,6 +112,13 @@ class PymunkEngine(Engine):
     # `trilith calibrate`'s search beside the step: more iterations, a ten times looser
     # collision slop (defaults first).
     calibration_space = {"iterations": (30, 60), "slop_fraction": (1e-4, 1e-3)}
+    impact_variants = (
+        ("iterations=10", "Chipmunk's default iterations", {"iterations": 10}),
+        ("iterations=100", "more iterations", {"iterations": 100}),
+        ("slop=1e-3", "collision slop x10", {"slop_fraction": 1e-3}),
+        ("slop=1e-2", "collision slop x100", {"slop_fraction": 1e-2}),
+    )
+    impact_fixed = "elasticity (0 on every shape, engines/pymunk_/world.py) is fixed"
     Settings = Settings
 
     @classmethod

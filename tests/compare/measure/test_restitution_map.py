@@ -10,7 +10,7 @@ import pytest
 
 from trilith_xval.compare.cli.main import main
 from trilith_xval.compare.campaign.settings_file import read_settings_file
-from trilith_xval.compare.measure.restitution_map import GRIDS, R_TOL, cheapest, passes
+from trilith_xval.compare.measure.restitution_map import R_TOL, cheapest, grid, grids, passes
 
 
 @pytest.fixture(scope="module")
@@ -57,7 +57,7 @@ def test_outputs_are_figures_and_loadable_settings(small_map):
     assert (tmp / "out" / "restitution_map_pymunk.png").stat().st_size > 0
     files = sorted((tmp / "out" / "settings").glob("*.toml"))
     assert len(files) == sum(p["variant"] is not None for p in doc["cheapest"])
-    options = {v.name: v.options for v in GRIDS["pymunk"]}
+    options = {v.name: v.options for v in grid("pymunk")}
     for f in files:
         loaded = read_settings_file(f)
         pick = next(p for p in doc["cheapest"] if f.name == f"pymunk-{p['range']}.toml")
@@ -68,8 +68,8 @@ def test_every_grid_variant_is_a_loadable_settings_file(tmp_path):
     # Any variant may come out cheapest, so each must be writable and read back
     # as the same options (MuJoCo's solimp tuple as a TOML array included).
     from trilith_xval.compare.campaign.settings_file import settings_toml
-    for engine, grid in GRIDS.items():
-        for k, v in enumerate(grid):
+    for engine, variants in grids().items():
+        for k, v in enumerate(variants):
             path = tmp_path / f"{engine}-{k}.toml"
             path.write_text(settings_toml(engine, v.options, v.why))
             assert read_settings_file(path).options(engine) == v.options
@@ -106,3 +106,15 @@ def test_a_cell_is_a_value_holding_its_variants_run(monkeypatch):
     assert seen == [("restitution_map_cell",
                      {"cell": ["pymunk", "dt=5e-4", "fig5_eq20", 12.0, 8.8, "after-impact"],
                       "options": {"dt": 5e-4}, "n_impacts": rm.N_IMPACTS})]
+
+
+def test_the_grids_are_the_engines_own_and_unchanged_in_the_stored_map():
+    """Each engine's variants live on its class (engines/NAME_/): the grids the
+    stored map was measured with are the ones the registry gives now."""
+    import json
+    from tests.support.paths import ROOT
+    stored = json.loads((ROOT / "docs" / "validation" / "restitution_map.json").read_text())
+    now = {e: [v.to_dict() for v in variants] for e, variants in grids(stored["engines"]).items()}
+    assert json.loads(json.dumps(now)) == stored["grids"]
+    from trilith_xval.compare.measure.restitution_map import not_exposed
+    assert not_exposed() == stored["not_exposed"]
