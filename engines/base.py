@@ -43,6 +43,9 @@ CAPABILITIES = {
     "moving_ground": "base_motion='ground' moves a ground body (besides the gravity trick)",
     "initial_tilt": "theta0/psi0 releases (free-rocking restitution)",
     "trajectory": "simulate() samples theta(t) (every backend does)",
+    "free_block": "free_block(side, mass, inertia, g, state, friction, n_frames, frame_rate, "
+                  "on_step) -> (thetas, warnings): a free planar block started in flight "
+                  "(a measured impact's replay, compare/peers/impact_replay.py)",
 }
 BASE_MOTIONS = ("gravity", "ground")
 # Default friction is at least this multiple of the no-sliding bound

@@ -161,22 +161,5 @@ def load_scene(name_or_path: str | Path = "fig5", **overrides):
         if b > 0:  # otherwise Scene refuses b before it reads lam
             values["lam"] = h / b
             given_h = f"h = {h:g} m and b = {b:g} m give lam = h/b = {h / b:g}; "
+    from .kind_files import build_scene
     return build_scene(Scene, values, overrides, f"{path}: {given_h}")
-
-
-def build_scene(cls, values: dict, overrides: dict, where: str):
-    """``cls(**values)`` with ``overrides`` applied; ``ValueError`` prefixed by
-    ``where`` when the file's values are refused (their messages start with the
-    field name, "b must be in ..."), or naming the override when the file alone is
-    valid and the override is to blame."""
-    try:
-        scene = cls(**values)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{where}{exc}") from None
-    if not overrides:
-        return scene
-    try:
-        return scene.replace(**overrides)
-    except (TypeError, ValueError) as exc:
-        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
-        raise ValueError(f"override {shown}: {exc}") from None

@@ -58,7 +58,6 @@ def load_kind(path: Path, table: dict, overrides: dict, check_value):
     values.setdefault("name", path.stem)
     if kind == "drums" and len(values.get("heights", ())) == 1:
         return _one_drum(where, values, overrides)
-    from . import build_scene
     return build_scene(cls, values, overrides, f"{where}: ")
 
 
@@ -80,3 +79,21 @@ def _one_drum(where: str, values: dict, overrides: dict):
         return scene.replace(**overrides) if overrides else scene
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: one drum is the trilith (h = {h:g} m): {exc}") from None
+
+
+def build_scene(cls, values: dict, overrides: dict, where: str):
+    """``cls(**values)`` with ``overrides`` applied; ``ValueError`` prefixed by
+    ``where`` when the file's values are refused (their messages start with the
+    field name, "b must be in ..."), or naming the override when the file alone is
+    valid and the override is to blame."""
+    try:
+        scene = cls(**values)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}{exc}") from None
+    if not overrides:
+        return scene
+    try:
+        return scene.replace(**overrides)
+    except (TypeError, ValueError) as exc:
+        shown = ", ".join(f"{k}={v!r}" for k, v in overrides.items())
+        raise ValueError(f"override {shown}: {exc}") from None

@@ -9,8 +9,9 @@ project's contact settings for that engine (the calibrated defaults of
 :class:`engines.pymunk_.Settings` and :class:`engines.mujoco_.Settings`: step,
 solver iterations, Pymunk's plastic contact and slop, MuJoCo's overdamped soft
 contact).  The engines' own scene builders are for the trilith on its base; the
-free block needs ``x, z, th`` and their rates set at once, so it has a small
-builder here.
+free block needs ``x, z, th`` and their rates set at once, so each replaying
+engine has a small world for it (``Engine.free_block``, capability
+``free_block``: ``engines/pymunk_/free_block.py``, ``engines/mujoco_/free_block.py``).
 
 The start (:attr:`.impact_data.Impact.state`) is frame ``j - 1``: the fitted
 angle and rate, the pivot corner on the ground with the measured slip.  The run
@@ -33,7 +34,13 @@ from .impact_data import CORNERS, FRAME_RATE, SIDE, Filter, Impact, impact_rate,
 __all__ = ["ENGINES", "DEFAULT_FRICTION", "replay", "replay_pymunk", "replay_mujoco",
            "engine_versions"]
 
-ENGINES = ("pymunk", "mujoco")
+def _replaying() -> tuple[str, ...]:
+    from trilith_xval.engines import engine_names, supports
+    return tuple(e for e in engine_names() if supports(e, "free_block"))
+
+
+# The engines whose class can start a free block in flight (capability free_block).
+ENGINES = _replaying()
 DEFAULT_FRICTION = 10.0  # the project's engines' default (engines.base): no sliding
 
 
@@ -65,6 +72,8 @@ class _Landing:
         self.before = self.after = None
 
     def step(self, z: float, th: float, omega: float, omega_prev: float) -> None:
+        """After every engine step: the block's height ``z`` [m], angle [rad] and
+        rates [rad/s] now and before the step."""
         self.k += 1
         if self.k_land is None:
             if z + self.ox * math.sin(th) + self.oz * math.cos(th) <= 0.0:
@@ -78,101 +87,43 @@ class _Landing:
         return self.after / self.before, self.k_land * self.dt
 
 
+def _replay_in(engine: str, impact: Impact, friction: float, flt: Filter) -> dict:
+    """Replay ``impact`` in the world of ``engine``'s ``free_block``."""
+    from trilith_xval.engines import get_backend
+    scene = square_scene()
+    cls = get_backend(engine)
+    dt = cls.Settings().dt
+    watch = _Landing(impact, dt)
+    thetas, warnings = cls.free_block(SIDE, scene.m1, scene.inertia_J_G, scene.g, impact.state,
+                                      friction, _frames_to_run(impact, flt), FRAME_RATE,
+                                      watch.step)
+    out = _post_ratio(impact, thetas, watch.result(), flt)
+    if warnings is not None:
+        out["warnings"] = warnings
+    return out
+
+
 def replay_pymunk(impact: Impact, friction: float = DEFAULT_FRICTION,
                   flt: Filter = Filter()) -> dict:
     """Replay ``impact`` in Pymunk; ``{'rate_after', 'ratio', 'residual', ...}``."""
-    import pymunk
-
-    from trilith_xval.engines.pymunk_ import Settings
-    s = Settings()
-    scene = square_scene()
-    space = pymunk.Space()
-    space.iterations = s.iterations
-    space.collision_slop = s.slop_fraction * SIDE
-    if s.collision_bias is not None:
-        space.collision_bias = s.collision_bias
-    space.gravity = (0.0, -scene.g)
-    shape_friction = math.sqrt(friction)  # Pymunk multiplies the pair's values
-    ground = pymunk.Body(body_type=pymunk.Body.STATIC)
-    ground.position = (0.0, -0.5 * SIDE)
-    floor = pymunk.Poly.create_box(ground, (1000.0 * SIDE, SIDE), radius=0.0)
-    block = pymunk.Body(scene.m1, scene.inertia_J_G)
-    box = pymunk.Poly.create_box(block, (SIDE, SIDE), radius=0.0)
-    for shape in (floor, box):
-        shape.friction, shape.elasticity = shape_friction, 0.0
-    x, z, th, vx, vz, w = impact.state
-    block.position, block.angle = (x, z), th
-    block.velocity, block.angular_velocity = (vx, vz), w
-    space.add(ground, floor, block, box)
-    steps = int(round(1.0 / (FRAME_RATE * s.dt)))
-    ths, watch = [th], _Landing(impact, s.dt)
-    for _ in range(_frames_to_run(impact, flt) - 1):
-        for _ in range(steps):
-            w0 = block.angular_velocity
-            space.step(s.dt)
-            watch.step(block.position[1], block.angle, block.angular_velocity, w0)
-        ths.append(block.angle)
-    return _post_ratio(impact, ths, watch.result(), flt)
-
-
-def _mjcf(friction: float, s) -> str:
-    scene = square_scene()
-    half = 0.5 * SIDE
-    timeconst = s.timeconst if s.timeconst is not None else s.timeconst_steps * s.dt
-    j = scene.inertia_J_G
-    return (
-        '<mujoco model="square"><compiler angle="radian" inertiafromgeom="false"/>'
-        f'<option timestep="{s.dt!r}" gravity="0 0 {-scene.g!r}" integrator="{s.integrator}" '
-        f'cone="{s.cone}" impratio="{s.impratio!r}" iterations="{s.iterations}" '
-        f'solver="{s.solver}"/>'
-        f'<default><geom condim="3" margin="0" gap="0" friction="{friction!r} 0 0" '
-        f'solref="{timeconst!r} {s.dampratio!r}" solimp="{" ".join(map(repr, s.solimp))}"/>'
-        '</default><worldbody><geom name="ground" type="plane" size="10 10 1"/>'
-        '<body name="block" pos="0 0 0">'
-        '<joint name="x" type="slide" axis="1 0 0"/><joint name="z" type="slide" axis="0 0 1"/>'
-        '<joint name="th" type="hinge" axis="0 -1 0"/>'
-        f'<inertial pos="0 0 0" mass="{scene.m1!r}" diaginertia="{j!r} {j!r} {j!r}"/>'
-        f'<geom type="box" size="{half!r} {half!r} {half!r}"/></body></worldbody></mujoco>')
+    return _replay_in("pymunk", impact, friction, flt)
 
 
 def replay_mujoco(impact: Impact, friction: float = DEFAULT_FRICTION,
                   flt: Filter = Filter()) -> dict:
     """Replay ``impact`` in MuJoCo (planar joints, 3D box on a plane)."""
-    import mujoco
-
-    from trilith_xval.engines.mujoco_ import Settings
-    s = Settings()
-    model = mujoco.MjModel.from_xml_string(_mjcf(friction, s))
-    data = mujoco.MjData(model)
-    x, z, th, vx, vz, w = impact.state
-    data.qpos[:] = (x, z, th)
-    data.qvel[:] = (vx, vz, w)
-    mujoco.mj_forward(model, data)
-    steps = int(round(1.0 / (FRAME_RATE * s.dt)))
-    ths, watch = [th], _Landing(impact, s.dt)
-    for _ in range(_frames_to_run(impact, flt) - 1):
-        for _ in range(steps):
-            w0 = float(data.qvel[2])
-            mujoco.mj_step(model, data)
-            watch.step(float(data.qpos[1]), float(data.qpos[2]), float(data.qvel[2]), w0)
-        ths.append(float(data.qpos[2]))
-    out = _post_ratio(impact, ths, watch.result(), flt)
-    out["warnings"] = int(sum(data.warning[i].number for i in range(len(data.warning))))
-    return out
+    return _replay_in("mujoco", impact, friction, flt)
 
 
 def replay(engine: str, impact: Impact, friction: float = DEFAULT_FRICTION,
            flt: Filter = Filter()) -> dict:
     """Replay ``impact`` in ``engine`` (one of :data:`ENGINES`)."""
-    if engine == "pymunk":
-        return replay_pymunk(impact, friction, flt)
-    if engine == "mujoco":
-        return replay_mujoco(impact, friction, flt)
-    raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    return _replay_in(engine, impact, friction, flt)
 
 
 def engine_versions() -> dict:
-    """``{'pymunk': ..., 'mujoco': ...}`` version strings."""
-    import mujoco
-    import pymunk
-    return {"pymunk": f"pymunk {pymunk.version}", "mujoco": f"mujoco {mujoco.__version__}"}
+    """Each replaying engine's version string (``Engine.version()``)."""
+    from trilith_xval.engines import get_backend
+    return {engine: get_backend(engine).version() for engine in ENGINES}

@@ -222,13 +222,20 @@ class MujocoEngine(Engine):
     )
     marker = "^"
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
-                              "initial_tilt", "trajectory"})
+                              "initial_tilt", "trajectory", "free_block"})
     default_friction = 10.0
     structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: the contact time constant (solref),
     # in steps; MuJoCo requires at least 2 for stability (default 3).
     calibration_space = {"timeconst_steps": (2.0, 3.0, 5.0)}
     Settings = Settings
+
+    @classmethod
+    def free_block(cls, *args, settings=None):
+        """A free planar block started in flight (:mod:`.free_block`), at
+        ``settings`` (default: the calibrated defaults)."""
+        from .free_block import free_block
+        return free_block(*args, cls.Settings() if settings is None else settings)
 
     @classmethod
     def version(cls) -> str:

@@ -106,7 +106,7 @@ class PymunkEngine(Engine):
     color = "tab:orange"
     marker = "s"
     capabilities = frozenset({"time_step", "solver_iterations", "moving_ground",
-                              "initial_tilt", "trajectory"})
+                              "initial_tilt", "trajectory", "free_block"})
     default_friction = 10.0
     structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: more iterations, a ten times looser
@@ -120,6 +120,13 @@ class PymunkEngine(Engine):
     )
     impact_fixed = "elasticity (0 on every shape, engines/pymunk_/world.py) is fixed"
     Settings = Settings
+
+    @classmethod
+    def free_block(cls, *args, settings=None):
+        """A free planar block started in flight (:mod:`.free_block`), at
+        ``settings`` (default: the calibrated defaults)."""
+        from .free_block import free_block
+        return free_block(*args, cls.Settings() if settings is None else settings)
 
     @classmethod
     def version(cls) -> str:
