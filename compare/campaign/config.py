@@ -84,7 +84,7 @@ class CampaignConfig:
     # What the default report takes from a stored full run (compare/campaign/stored_parts.py):
     # None runs everything (report --full); these three choose no number of a job that runs.
     stored: str | None = None  # a stored summary.json: its other threshold points are shown
-    stored_jobs: tuple[str, ...] = ()  # job kinds shown from ``stored`` instead of run ("jump")
+    stored_jobs: tuple[str, ...] = ()  # job kinds shown from ``stored`` instead of run ("jump", "long_run")
     reverify: bool = False  # re-measure one point of every stored engine spectrum
 
     # Fields that only choose which jobs run: left out of job keys, so the default
@@ -118,8 +118,9 @@ class CampaignConfig:
                 raise ValueError(f"spectrum_cases: unknown case {case!r}; allowed: pendulum, "
                                  "no_pendulum")
         for kind in self.stored_jobs:
-            if kind != "jump":
-                raise ValueError(f"stored_jobs: unknown job kind {kind!r}; allowed: jump")
+            if kind not in ("jump", "long_run"):
+                raise ValueError(f"stored_jobs: unknown job kind {kind!r}; allowed: jump, "
+                                 "long_run")
         lo, hi = self.omega_range
         if not 0.0 < lo < hi:
             raise ValueError(f"omega_range must satisfy 0 < lo < hi, got {self.omega_range!r}")
@@ -135,11 +136,12 @@ class CampaignConfig:
     @classmethod
     def default_report(cls, **changes) -> "CampaignConfig":
         """What ``trilith report`` runs without ``--full``: the full grids, but the
-        threshold points by :func:`compare.campaign.stored_parts.recompute_omegas`
-        and the jump shifts from the stored validation, and its engine spectra
-        re-verified on a sample (minutes on 2 cores instead of ~40)."""
+        threshold points by :func:`compare.campaign.stored_parts.recompute_omegas`,
+        the jump shifts and the long runs (20 s windows: a sixth of the report's
+        CPU, Drake's most of it) from the stored validation, labelled, and its
+        engine spectra re-verified on a sample (minutes on 2 cores instead of ~40)."""
         from trilith_xval.compare.campaign.stored_parts import STORED_SUMMARY
-        base = dict(stored=str(STORED_SUMMARY), stored_jobs=("jump",), reverify=True)
+        base = dict(stored=str(STORED_SUMMARY), stored_jobs=("jump", "long_run"), reverify=True)
         base.update(changes)
         return cls(**base)
 

@@ -107,6 +107,15 @@ def load_stored(path, scene, config) -> tuple[dict | None, str]:
     return doc, ""
 
 
+def uses_stored_long_runs(stored: dict | None, config) -> bool:
+    """Whether the long runs are shown from ``stored`` rather than run: asked for
+    (``long_run`` in ``config.stored_jobs``, long runs on) and measured over the
+    same window."""
+    return (stored is not None and config.long_runs and "long_run" in config.stored_jobs
+            and (stored.get("config") or {}).get("long_run_t_max") == config.long_run_t_max
+            and bool(stored.get("long_runs")))
+
+
 def _stored_points(stored: dict | None, engine: str, case: str) -> dict:
     pts = ((stored or {}).get("spectra", {}).get(case) or {}).get("engines", {}).get(engine, [])
     return {round(float(p["omega"]), 6): p for p in pts}
@@ -247,6 +256,10 @@ def merge(result, stored: dict | None, source: dict | None, recomputed: dict,
                 spec["jump_shifts"] = {e: dict(v, stored=label) for e, v in shifts.items()
                                        if e in result.config.engines}
     parts["thresholds"] = thresholds
+    if uses_stored_long_runs(stored, result.config):
+        result.long_runs = [dict(r, stored=label) for r in stored.get("long_runs", [])
+                            if r["backend"] in result.config.engines]
+        parts["long_runs"] = "stored"
     parts["jump_shifts"] = ("stored" if stored is not None and "jump" in result.config.stored_jobs
                             else "recomputed")
     reverified = list(reverified)

@@ -277,7 +277,9 @@ def run_campaign(config: CampaignConfig | None = None, progress: bool = False) -
                              else []):
         jobs.append(ReverifyJob(name, scene, point, src))
         labels.append(("reverify", True, name))
-    if config.long_runs:
+    if stored_parts.uses_stored_long_runs(stored_run, config):
+        pass  # the long runs come from the stored run (stored_parts.merge)
+    elif config.long_runs:
         from trilith_xval.compare.measure.long_runs import LONG_RUNS
         for name in config.engines:
             for label, scene_name, amplitude, omega in LONG_RUNS:

@@ -104,5 +104,16 @@ def build_verdicts(result) -> list[dict]:
                 "reason": "the model's verdict over the same window; pivots slide < 1 mm, a "
                           "tenth of the monitor's collapse limit",
                 "detail": "; ".join(f"{r['case']} ({r['scene']}): {r['detail']}"
-                                    for r in longs)})
+                                    for r in longs)
+                + _stored_note(longs)})
     return rows
+
+
+def _stored_note(rows: list) -> str:
+    """Where rows shown from a stored run came from (empty when measured now)."""
+    label = next((r["stored"] for r in rows if r.get("stored")), None)
+    if not label:
+        return ""
+    return (f"; from {label.get('file', 'the stored run')} (run "
+            f"{str(label.get('run_commit') or label.get('commit') or '?')[:12]}, "
+            f"{label.get('run_date') or label.get('date') or 'date not recorded'})")

@@ -186,3 +186,37 @@ def test_a_tampered_stored_spectrum_point_fails_the_reverification(tmp_path, mon
     assert not row["passed"] and row["rel_difference"] == pytest.approx(-0.03 / 1.03, rel=1e-6)
     (line,) = stored_parts.failures({"reverified": [row]})
     assert "pymunk" in line and "Omega = 12 rad/s" in line
+
+
+def test_the_default_report_shows_the_stored_long_runs_labelled(monkeypatch):
+    """No long run is run; the stored rows are shown with their run, and the verdict
+    says where they come from."""
+    import trilith_xval.compare.campaign.validation as campaign
+    from trilith_xval.compare.campaign import validation_jobs as jobs
+    ran = []
+
+    def refuse(job):
+        ran.append(type(job).__name__)
+        raise RuntimeError("stand-in")
+    for kind in (jobs.HistoryJob, jobs.RestitutionJob, jobs.ThresholdPointJob, jobs.JumpJob,
+                 jobs.LongRunJob, jobs.ReverifyJob):
+        monkeypatch.setattr(kind, "__call__", refuse)
+    config = CampaignConfig.default_report(engines=("pymunk",), points=("A",),
+                                           restitution_lams=(5.0,), restitution_mus=(1.0,),
+                                           pendulum_lams=(5.0,), reverify=False, workers=1)
+    result = campaign.run_campaign(config)
+    stored = json.loads(STORED.read_text())
+    assert "LongRunJob" not in ran and ran  # the other jobs were asked for
+    assert result.sources["parts"]["long_runs"] == "stored"
+    rows = [r for r in stored["long_runs"] if r["backend"] == "pymunk"]
+    assert [{k: v for k, v in r.items() if k != "stored"} for r in result.long_runs] == rows
+    label = result.sources["stored_run"]
+    assert all(r["stored"] == label for r in result.long_runs)
+    (verdict,) = [v for v in result.verdicts if v["id"] == "long_run"]
+    assert "from docs/validation/summary.json" in verdict["detail"]
+    # Another window: the stored rows do not apply and the long runs are run.
+    ran.clear()
+    campaign.run_campaign(CampaignConfig.default_report(
+        engines=("pymunk",), points=("A",), restitution_lams=(5.0,), restitution_mus=(1.0,),
+        pendulum_lams=(5.0,), reverify=False, workers=1, long_run_t_max=10.0))
+    assert "LongRunJob" in ran
