@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trilith_xval.analytic.options import check_real
+from trilith_xval.engines import geometry
 from trilith_xval.engines.base import Engine, EngineSettings
 from trilith_xval.engines.diagnostics import PlaneState, Pose
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
@@ -177,15 +178,16 @@ class PyBulletEngine(Engine):
         return f"pybullet {_v('pybullet')} (API {pb.getAPIVersion()})"
 
     def build(self, mode: int = pb.DIRECT) -> None:
-        s, scene = self.settings, self.scene
+        s = self.settings
         self.mode = mode
+        self.structure = structure = geometry.structure_of(self.scene, s.theta0, s.psi0)
         self.client = c = world.acquire_client(mode)
-        world.configure_client(c, scene, s)
+        world.configure_client(c, structure, s)
         self.moving = s.base_motion == "ground"
         # An excitation whose window is empty (Still) never loads the bodies.
         exc = self.excitation
-        self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(self.friction),
-                                  self.moving, s.friction_anchor, slop=world.effective_slop(s),
+        self.bodies = build_scene(c, structure, math.sqrt(self.friction), self.moving,
+                                  s.friction_anchor, slop=world.effective_slop(s),
                                   under_load=exc.end_time > exc.start_time)
         self.start_y = {body: pb.getBasePositionAndOrientation(body, physicsClientId=c)[0][1]
                         for body in self.bodies.dynamic}
@@ -226,23 +228,22 @@ class PyBulletEngine(Engine):
         # Each body is read once per sample: a sample's reads cost about two steps
         # (benchmarks/bench_overhead.py), so re-reading would slow every run.
         poses, drift, roll_yaw = [], 0.0, 0.0
-        for body in bodies.columns:
-            theta, theta_dot, pos, quat = world.column_angle(c, body)
-            vel = pb.getBaseVelocity(body, physicsClientId=c)[0]
-            poses.append(Pose(pos[0], pos[2], theta, vel[0], vel[2], theta_dot))
-            drift, roll_yaw = self._out_of_plane(body, pos, quat, drift, roll_yaw)
-        lintel = psi = psi_dot = None
-        if bodies.lintel is not None:
-            read = world.lintel_state(c, bodies)
+        psi = psi_dot = 0.0
+        for body in bodies.boxes:
+            read = world.body_state(c, body)
             pos, quat, vel, omega = read
             m = pb.getMatrixFromQuaternion(quat)
-            lintel = Pose(pos[0], pos[2], math.atan2(-m[2], m[8]), vel[0], vel[2], -omega[1])
-            drift, roll_yaw = self._out_of_plane(bodies.lintel, pos, quat, drift, roll_yaw)
-            if bodies.pendulum_joint is not None:
+            # The box's up axis is the third column of R: (m[2], m[5], m[8]).
+            poses.append(Pose(pos[0], pos[2], math.atan2(-m[2], m[8]), vel[0], vel[2],
+                              -omega[1]))
+            drift, roll_yaw = self._out_of_plane(body, pos, quat, drift, roll_yaw)
+            if body == bodies.parent:
                 psi, psi_dot = world.pendulum_state(c, bodies, read)
         gx = (pb.getJointState(bodies.ground, 0, physicsClientId=c)[0] if self.moving else 0.0)
-        return PlaneState((poses[0], poses[1]), lintel, psi or 0.0, psi_dot or 0.0, gx, drift,
-                          roll_yaw)
+        if not self.structure.is_trilith:
+            return PlaneState((), None, psi, psi_dot, gx, drift, roll_yaw, bodies=tuple(poses))
+        lintel = poses[2] if len(poses) > 2 else None
+        return PlaneState((poses[0], poses[1]), lintel, psi, psi_dot, gx, drift, roll_yaw)
 
     def _out_of_plane(self, body, pos, quat, drift, roll_yaw) -> tuple[float, float]:
         roll, _, yaw = pb.getEulerFromQuaternion(quat)
