@@ -6,17 +6,20 @@ The reference builders are verbatim copies of the pre-body-list code
 same calls with the same numbers in the same order, so no tolerance is due.
 Three scenes: fig5 (lintel and pendulum), no_pendulum, single_block (no lintel);
 a free-rocking release (a tilt, no pulse: the zero-gap start) and a one-sine
-pulse (the start sunk by the contact slop), with both base motions."""
+pulse (the start sunk by the contact slop), with both base motions where the
+engine has them."""
 from __future__ import annotations
 
 import pytest
 
 from trilith_xval.analytic.excitation import Pulse
+from trilith_xval.engines.dart_ import DartEngine
+from trilith_xval.engines.dart_ import Settings as DartSettings
 from trilith_xval.engines.pybullet_ import PyBulletEngine
 from trilith_xval.engines.pybullet_ import Settings as PyBulletSettings
 from trilith_xval.scenes import load_scene
 from tests.engines.test_structure import _same
-from tests.support.legacy.engines import LegacyPyBullet
+from tests.support.legacy.engines import LegacyDart, LegacyPyBullet
 
 RUNS = [
     ("free", dict(theta0=0.05, t_max=0.6, early_stop=False), Pulse(0.0, 9.0)),
@@ -45,4 +48,24 @@ def test_pybullet_overturn_is_seen_the_same():
     scene, pulse, s = load_scene("fig5"), Pulse(25.0, 9.0), PyBulletSettings(verdict_only=True)
     a, b = PyBulletEngine.simulate(scene, pulse, s), LegacyPyBullet.simulate(scene, pulse, s)
     assert a.verdict.status in ("overturned", "collapsed")
+    _same(a, b)
+
+
+# DART repeats itself bit for bit only on some runs: its contacts are ordered by
+# memory address, so a rerun of the same build can differ in the last bits
+# (measured with the builder before the body list: single_block under Pulse(6, 9)
+# 1.7e-11 rad, fig5 9e-12 rad, in one rerun out of two to four; fig5, no_pendulum and
+# single_block under Pulse(19, 15) and the free releases repeated exactly in four
+# reruns each).  The comparison is made on runs it repeats, at Fig. 5's point A.
+DART_RUNS = [RUNS[0], ("sine", dict(t_max=0.6), Pulse(19.0, 15.0))]
+
+
+@pytest.mark.parametrize("label, options, pulse", DART_RUNS, ids=[r[0] for r in DART_RUNS])
+@pytest.mark.parametrize("scene_name", SCENES)
+def test_dart_trajectory_is_bit_identical(scene_name, label, options, pulse):
+    # DART has the gravity base motion only.
+    scene = load_scene(scene_name)
+    s = DartSettings(**options)
+    a, b = DartEngine.simulate(scene, pulse, s), LegacyDart.simulate(scene, pulse, s)
+    assert a.max_abs_theta > 1e-3
     _same(a, b)

@@ -1,6 +1,7 @@
-"""Pymunk, MuJoCo and PyBullet engines whose build and read hooks are the
+"""Pymunk, MuJoCo, PyBullet and DART engines whose build and read hooks are the
 pre-body-list code, verbatim (builders in :mod:`.pymunk_world`,
-:mod:`.mujoco_world` and :mod:`.pybullet_bodies` / :mod:`.pybullet_world`)."""
+:mod:`.mujoco_world`, :mod:`.pybullet_bodies` / :mod:`.pybullet_world` and
+:mod:`.dart_world`)."""
 from __future__ import annotations
 
 import math
@@ -8,13 +9,14 @@ import math
 import mujoco
 
 from trilith_xval.engines import geometry
-from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines.dart_ import DartEngine
+from trilith_xval.engines.diagnostics import PlaneState, Pose, joint_plane_state
 from trilith_xval.engines.mujoco_ import MujocoEngine
 from trilith_xval.engines.pybullet_ import PyBulletEngine
 from trilith_xval.engines.pymunk_ import PymunkEngine
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
-from . import mujoco_world, pybullet_world, pymunk_world
+from . import dart_world, mujoco_world, pybullet_world, pymunk_world
 from .pybullet_bodies import build_scene as pybullet_build_scene
 
 
@@ -139,3 +141,15 @@ class LegacyPyBullet(PyBulletEngine):
         roll, _, yaw = pb.getEulerFromQuaternion(quat)
         return (max(drift, abs(pos[1] - self.start_y[body])),
                 max(roll_yaw, abs(roll), abs(yaw)))
+
+
+class LegacyDart(DartEngine):
+    def build(self) -> None:
+        s = self.settings
+        self.world = dart_world.DartWorld(self.scene, s.dt, self.friction, s.detector, s.theta0,
+                                          s.psi0)
+
+    def read(self) -> PlaneState:
+        world = self.world
+        return joint_plane_state(world.planar_states(),
+                                 world.pendulum_state() if world.pendulum is not None else None)
