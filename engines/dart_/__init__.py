@@ -79,6 +79,7 @@ class DartEngine(Engine):
     affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     Settings = Settings
 
     @classmethod
@@ -103,7 +104,7 @@ class DartEngine(Engine):
         pendulum = world.pendulum_state() if world.pendulum is not None else None
         if self.structure.is_trilith:
             return joint_plane_state(states, pendulum)
-        poses = tuple(Pose(*state) for state in states)
+        poses = tuple(Pose(*map(float, state)) for state in states)
         psi = psi_dot = 0.0
         if pendulum is not None:
             parent = poses[world.parent_index]

@@ -59,9 +59,9 @@ def test_spectrum_without_consensus_or_with_a_trilith_engine_refuses(capsys, no_
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "give --consensus E1,E2" in err
     assert main(["spectrum", "--scene", "drums", "--omega", "8",
-                 "--consensus", "dart,pymunk"]) == 2
+                 "--consensus", "drake,pymunk"]) == 2
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "dart runs the parametric trilith only" in err
+    assert len(err.splitlines()) == 1 and "drake runs the parametric trilith only" in err
 
 
 def test_spectrum_consensus_brackets_each_engines_own_failure(capsys):
