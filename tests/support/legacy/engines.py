@@ -1,7 +1,7 @@
-"""Pymunk, MuJoCo, PyBullet and DART engines whose build and read hooks are the
-pre-body-list code, verbatim (builders in :mod:`.pymunk_world`,
-:mod:`.mujoco_world`, :mod:`.pybullet_bodies` / :mod:`.pybullet_world` and
-:mod:`.dart_world`)."""
+"""Pymunk, MuJoCo, PyBullet, DART and Drake engines whose build and read hooks
+are the pre-body-list code, verbatim (builders in :mod:`.pymunk_world`,
+:mod:`.mujoco_world`, :mod:`.pybullet_bodies` / :mod:`.pybullet_world`,
+:mod:`.dart_world` and :mod:`.drake_world`)."""
 from __future__ import annotations
 
 import math
@@ -11,12 +11,13 @@ import mujoco
 from trilith_xval.engines import geometry
 from trilith_xval.engines.dart_ import DartEngine
 from trilith_xval.engines.diagnostics import PlaneState, Pose, joint_plane_state
+from trilith_xval.engines.drake_ import DrakeEngine
 from trilith_xval.engines.mujoco_ import MujocoEngine
 from trilith_xval.engines.pybullet_ import PyBulletEngine
 from trilith_xval.engines.pymunk_ import PymunkEngine
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
-from . import dart_world, mujoco_world, pybullet_world, pymunk_world
+from . import dart_world, drake_world, mujoco_world, pybullet_world, pymunk_world
 from .pybullet_bodies import build_scene as pybullet_build_scene
 
 
@@ -148,6 +149,21 @@ class LegacyDart(DartEngine):
         s = self.settings
         self.world = dart_world.DartWorld(self.scene, s.dt, self.friction, s.detector, s.theta0,
                                           s.psi0)
+
+    def read(self) -> PlaneState:
+        world = self.world
+        return joint_plane_state(world.planar_states(),
+                                 world.pendulum_state() if world.pendulum is not None else None)
+
+
+class LegacyDrake(DrakeEngine):
+    def build(self) -> None:
+        s, scene = self.settings, self.scene
+        self.world = drake_world.DrakeWorld(scene, s.dt, self.friction, s.contact_model,
+                                            s.solver, s.stiffness(scene),
+                                            s.sap_relaxation_time(scene), s.dissipation,
+                                            s.sphere_fraction * scene.b, s.hydroelastic_modulus,
+                                            s.theta0, s.psi0)
 
     def read(self) -> PlaneState:
         world = self.world
