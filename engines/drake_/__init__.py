@@ -197,6 +197,7 @@ class DrakeEngine(Engine):
                                  "(docs/drake.md); lam 5 and 7 within 0.27 %",
     }
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: the contact damping ratio around
     # its calibrated 2.5 (docs/drake.md).
     calibration_space = {"damping_ratio": (1.5, 2.5, 4.0)}

@@ -17,19 +17,23 @@ from tests.support.slip import support_slip
 KINDS = ("drums", "unequal", "block_on_block")
 
 
-@pytest.mark.parametrize("engine", ["drake"])
-def test_trilith_only_engines_refuse_another_kind_by_name(engine):
+def test_an_engine_without_the_body_list_refuses_another_kind_by_name():
+    # Every shipped engine builds the body list; an engine that does not (the
+    # toy engine of the contract tests, structures = False) refuses by name.
+    from tests.support.toy_engine import ToyEngine
     with pytest.raises(ValueError) as info:
-        get_backend(engine)(load_scene("drums"), Pulse(2.0, 8.0))
+        ToyEngine(load_scene("drums"), Pulse(2.0, 8.0))
     message = str(info.value)
-    assert message.startswith(f"{engine} runs the parametric trilith only")
+    assert message.startswith("toy runs the parametric trilith only")
     assert "'drums' kind" in message and len(message.splitlines()) == 1
 
 
 def test_structure_engines_are_the_ones_that_say_so():
-    for name in geometry.STRUCTURE_ENGINES:
-        assert get_backend(name).structures
-    assert not get_backend("drake").structures
+    from trilith_xval import engines
+    says = {name for name in engines.ENGINES
+            if getattr(get_backend(name), "structures", False)}
+    assert says == set(geometry.STRUCTURE_ENGINES)
+    assert set(geometry.STRUCTURE_ENGINES) == {"pymunk", "mujoco", "pybullet", "dart", "drake"}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -57,6 +61,7 @@ def test_below_uplift_every_body_stays_put(engine, kind):
 STRONG = {"drums": 8.0, "unequal": 8.0, "block_on_block": 12.0}
 
 
+@pytest.mark.slow  # five engines, DART and Drake at 2-4 CPU s per simulated second
 @pytest.mark.parametrize("kind", KINDS)
 def test_the_engines_fail_a_strongly_shaken_structure_alike(kind):
     scene = load_scene(kind)
@@ -177,8 +182,17 @@ _SLEEPS = pytest.mark.xfail(strict=True, reason="DART's body deactivation freeze
                             "0.5 s after the pulse")
 
 
-@pytest.mark.parametrize("engine", [pytest.param(e, marks=_SLEEPS) if e == "dart" else e
-                                    for e in geometry.STRUCTURE_ENGINES])
+# Drake's contact is compliant: the swinging bob tilts the drums elastically by
+# 2.1e-5 rad (measured; the trilith's own check names 3.3e-6 rad, a known failure of
+# engines.testing), over the 1e-6 rad of a rigid base, though under the 1e-4 rad of
+# uplift; its psi follows the reference to 1.0e-3 of the swing.
+_COMPLIANT = pytest.mark.xfail(strict=True, reason="Drake's compliant contact tilts the "
+                               "drums by 2.1e-5 rad under the swinging bob")
+_BOB_MARKS = {"dart": _SLEEPS, "drake": _COMPLIANT}
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=_BOB_MARKS[e]) if e in _BOB_MARKS
+                                    else e for e in geometry.STRUCTURE_ENGINES])
 def test_below_uplift_the_drums_bob_is_a_pendulum_on_a_rigid_base(engine):
     # Where a limit is exact: the frame does not uplift (1 m/s^2 against g b/H = 1.96),
     # so the bob swings on a rigidly moving hinge, psi'' = -(g sin psi + a(t) cos psi)/l,
