@@ -28,8 +28,6 @@ from __future__ import annotations
 import dartpy as dart
 import numpy as np
 
-from trilith_xval.engines import geometry
-
 __all__ = ["DartWorld", "COLLISION_DETECTORS", "NEGLIGIBLE_INERTIA_FRACTION"]
 
 COLLISION_DETECTORS = ("dart", "fcl", "bullet", "ode")
