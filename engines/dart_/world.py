@@ -75,6 +75,9 @@ class DartWorld:
     def __init__(self, structure, dt: float, friction: float, detector: str):
         self.structure = structure
         self.world = w = dart.simulation.World()
+        # dartpy 6.20 puts bodies to sleep by default (slower than 0.01 m/s and 0.05
+        # rad/s for 0.5 s: every velocity set to 0); left as the trilith's calibration
+        # and thresholds were measured with it (its effect: docs/geometry.md, DART).
         w.setTimeStep(dt)
         w.setGravity([0.0, 0.0, -structure.g])
         w.getConstraintSolver().setCollisionDetector(_detector(detector))
