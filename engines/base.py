@@ -271,10 +271,21 @@ class Engine:
 
     def _init_kind(self, scene, excitation, s) -> None:
         """The checks of a scene of :mod:`analytic.kinds`: an initial tilt only as
-        a plumb error (:data:`engines.geometry.MAX_KIND_TILT`), the run budget;
-        the friction is the engine's calibrated default unless given (the
-        no-sliding bound is the model's, :func:`~analytic.bounds.required_friction`;
-        a body moving with the ground needs ``PGA/g``, which is checked)."""
+        a plumb error (:data:`engines.geometry.MAX_KIND_TILT`), the run budget,
+        and the friction.
+
+        The friction is the engine's calibrated default unless given, raised to
+        ``FRICTION_MARGIN * PGA/g`` when the pulse asks more; a value given must
+        be at least ``PGA/g``.  Why ``PGA/g`` for a stack of blocks: until a part
+        uplifts the whole structure moves with the ground, and every interface
+        (a column or a drum on the ground, a drum on a drum, a lintel on its
+        columns) carries the horizontal force ``m_above a(t)`` of the bodies above
+        it under their weight ``m_above g``: each level needs the same ``a/g``, the
+        bound of a single block, whatever the stack.  The model's bound
+        (:func:`~analytic.bounds.required_friction`) adds the rocking trilith's
+        demand; the rocking demand of the other kinds has no model, so it is
+        measured instead (PyBullet at its calibrated 1: no contact slips beyond
+        the contact slop at the strong pulses of ``tests/engines/test_kinds_engines.py``)."""
         name = self.name
         self.structure = geometry.structure_of(scene, s.theta0, s.psi0)
         need = excitation.acceleration_bound() / scene.g

@@ -30,7 +30,7 @@ __all__ = ["RestPoses", "size", "column_lefts", "rest_poses", "base_corners", "b
 TRILITH_KINDS = ("trilith", "block")
 # The shipped engines that build any Structure (their class sets ``structures``);
 # the others build the parametric trilith only and refuse the other kinds.
-STRUCTURE_ENGINES = ("pymunk", "mujoco")
+STRUCTURE_ENGINES = ("pymunk", "mujoco", "pybullet", "dart", "drake")
 
 
 class RestPoses(NamedTuple):

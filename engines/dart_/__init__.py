@@ -1,7 +1,8 @@
 """DART (dartpy): the trilith as planar 3D boxes with rigid (LCP) contact.
 
-The world is built from the :class:`~analytic.parameters.Scene` only
-(:mod:`engines.geometry`, in :mod:`engines.dart_.world`): two ``b x h``
+The world is built from the scene's body list (:class:`~engines.geometry.Structure`,
+in :mod:`engines.dart_.world`; the trilith's is the world built before the body
+list, bit for bit): two ``b x h``
 columns and the lintel on planar joints in the vertical x-z plane, box-on-box
 contact with DART's collision detector and the boxed LCP (Dantzig) of its
 constraint solver, and a point-like pendulum bob on a revolute joint at the
@@ -23,8 +24,9 @@ from dataclasses import dataclass
 
 import dartpy as dart
 
+from trilith_xval.engines import geometry
 from trilith_xval.engines.base import Engine, EngineSettings
-from trilith_xval.engines.diagnostics import PlaneState, joint_plane_state
+from trilith_xval.engines.diagnostics import PlaneState, Pose, joint_plane_state
 
 from .world import COLLISION_DETECTORS, DartWorld
 
@@ -83,6 +85,7 @@ class DartEngine(Engine):
     affordable = False  # 10-55 CPU s per threshold point (docs/atlas.md)
     capabilities = frozenset({"time_step", "initial_tilt", "trajectory"})
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     Settings = Settings
 
     @classmethod
@@ -92,7 +95,8 @@ class DartEngine(Engine):
 
     def build(self) -> None:
         s = self.settings
-        self.world = DartWorld(self.scene, s.dt, self.friction, s.detector, s.theta0, s.psi0)
+        self.structure = geometry.structure_of(self.scene, s.theta0, s.psi0)
+        self.world = DartWorld(self.structure, s.dt, self.friction, s.detector)
 
     def advance(self, steps: int) -> None:
         n = self.step_index
@@ -102,8 +106,16 @@ class DartEngine(Engine):
 
     def read(self) -> PlaneState:
         world = self.world
-        return joint_plane_state(world.planar_states(),
-                                 world.pendulum_state() if world.pendulum is not None else None)
+        states = world.planar_states()
+        pendulum = world.pendulum_state() if world.pendulum is not None else None
+        if self.structure.is_trilith:
+            return joint_plane_state(states, pendulum)
+        poses = tuple(Pose(*map(float, state)) for state in states)
+        psi = psi_dot = 0.0
+        if pendulum is not None:
+            parent = poses[world.parent_index]
+            psi, psi_dot = pendulum[0] + parent.angle, pendulum[1] + parent.omega
+        return PlaneState((), None, psi, psi_dot, bodies=poses)
 
     def close(self) -> None:
         world, self.world = getattr(self, "world", None), None

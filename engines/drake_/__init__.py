@@ -1,7 +1,8 @@
 """Drake: the trilith as a discrete MultibodyPlant of planar 3D bodies with compliant contact.
 
-The plant is built from the :class:`~analytic.parameters.Scene` only
-(:mod:`engines.geometry`, in :mod:`engines.drake_.world`): two ``b x h``
+The plant is built from the scene's body list (:class:`~engines.geometry.Structure`,
+in :mod:`engines.drake_.world`; the trilith's is the plant built before the body
+list, bit for bit): two ``b x h``
 columns and the lintel on planar joints in the vertical x-z plane, a
 point-like pendulum bob on a revolute joint at the lintel's underside that
 collides with nothing (Eq. 1, 8).  ``gamma = 0`` builds no pendulum, ``mu =
@@ -24,8 +25,9 @@ import math
 from dataclasses import dataclass, field
 
 from trilith_xval.analytic.options import check_real
+from trilith_xval.engines import geometry
 from trilith_xval.engines.base import Engine, EngineSettings
-from trilith_xval.engines.diagnostics import PlaneState, joint_plane_state
+from trilith_xval.engines.diagnostics import PlaneState, Pose, joint_plane_state
 from trilith_xval.engines.monitor import MonitorSettings
 
 from .world import CONTACT_MODELS, SOLVERS, DrakeWorld
@@ -135,6 +137,44 @@ class Settings(EngineSettings):
             return self.relaxation_time
         return 2.0 * self.damping_ratio * math.sqrt(self.sink_fraction * scene.b / scene.g)
 
+    def contact_scales(self, scene, structure) -> tuple[float, float, float]:
+        """``(stiffness [N/m], relaxation time [s], sphere radius [m])`` of a run.
+
+        The parametric trilith: :meth:`stiffness`, :meth:`sap_relaxation_time`
+        and ``sphere_fraction * b``, as calibrated.  Another kind of
+        :mod:`analytic.kinds`: the same rules with the heaviest load a body on
+        the ground carries (:func:`footing_load`; a column's share of the
+        trilith's weight is the trilith's case) and the narrowest width in
+        place of ``b`` (the sink is then at most ``sink_fraction`` of every
+        body's width)."""
+        if structure.is_trilith:
+            return (self.stiffness(scene), self.sap_relaxation_time(scene),
+                    self.sphere_fraction * scene.b)
+        width, g = structure.width_scale, structure.g
+        stiffness = footing_load(structure) * g / (4.0 * self.sink_fraction * width)
+        tau = (self.relaxation_time if self.relaxation_time is not None else
+               2.0 * self.damping_ratio * math.sqrt(self.sink_fraction * width / g))
+        return stiffness, tau, self.sphere_fraction * width
+
+
+def footing_load(structure) -> float:
+    """The largest mass [kg] one body standing on the ground carries: its own, an
+    equal share of each body resting on it (of what that body carries), and the
+    bob's with its parent."""
+    uppers: dict[str, list[str]] = {}
+    count: dict[str, int] = {}
+    for upper, lower in structure.supports:
+        uppers.setdefault(lower, []).append(upper)
+        count[upper] = count.get(upper, 0) + 1
+    bob = structure.bob
+
+    def carried(name: str) -> float:
+        own = structure.body(name).mass + (bob.mass if bob is not None and bob.parent == name
+                                           else 0.0)
+        return own + sum(carried(u) / count[u] for u in uppers.get(name, ()))
+
+    return max(carried(name) for name in uppers.get("ground", ()))
+
 
 class DrakeEngine(Engine):
     """Drake (MultibodyPlant, discrete compliant contact); the hooks of
@@ -157,6 +197,7 @@ class DrakeEngine(Engine):
                                  "(docs/drake.md); lam 5 and 7 within 0.27 %",
     }
     default_friction = 10.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: the contact damping ratio around
     # its calibrated 2.5 (docs/drake.md).
     calibration_space = {"damping_ratio": (1.5, 2.5, 4.0)}
@@ -175,10 +216,10 @@ class DrakeEngine(Engine):
 
     def build(self) -> None:
         s, scene = self.settings, self.scene
-        self.world = DrakeWorld(scene, s.dt, self.friction, s.contact_model, s.solver,
-                                s.stiffness(scene), s.sap_relaxation_time(scene), s.dissipation,
-                                s.sphere_fraction * scene.b, s.hydroelastic_modulus,
-                                s.theta0, s.psi0)
+        self.structure = structure = geometry.structure_of(scene, s.theta0, s.psi0)
+        stiffness, tau, radius = s.contact_scales(scene, structure)
+        self.world = DrakeWorld(structure, s.dt, self.friction, s.contact_model, s.solver,
+                                stiffness, tau, s.dissipation, radius, s.hydroelastic_modulus)
 
     def advance(self, steps: int) -> None:
         n = self.step_index
@@ -188,8 +229,16 @@ class DrakeEngine(Engine):
 
     def read(self) -> PlaneState:
         world = self.world
-        return joint_plane_state(world.planar_states(),
-                                 world.pendulum_state() if world.pendulum is not None else None)
+        states = world.planar_states()
+        pendulum = world.pendulum_state() if world.pendulum is not None else None
+        if self.structure.is_trilith:
+            return joint_plane_state(states, pendulum)
+        poses = tuple(Pose(*state) for state in states)
+        psi = psi_dot = 0.0
+        if pendulum is not None:
+            parent = poses[world.parent_index]
+            psi, psi_dot = pendulum[0] + parent.angle, pendulum[1] + parent.omega
+        return PlaneState((), None, psi, psi_dot, bodies=poses)
 
     def close(self) -> None:
         world, self.world = getattr(self, "world", None), None

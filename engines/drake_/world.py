@@ -1,6 +1,9 @@
-"""The trilith in Drake: a discrete MultibodyPlant of planar bodies with compliant contact.
+"""A scene in Drake: a discrete MultibodyPlant of planar bodies with compliant contact.
 
-Bodies (all sizes read from :class:`analytic.parameters.Scene`):
+The plant is built from the scene's body list (:class:`~engines.geometry.Structure`:
+the trilith, the block, or another kind of :mod:`analytic.kinds`).  Bodies of the
+trilith (all sizes read from :class:`analytic.parameters.Scene` through its
+Structure; the other kinds' boxes the same way):
 
 * the ground, a box welded to the world whose top face is ``z = 0``;
 * each column and the lintel, a body on a :class:`PlanarJoint` whose plane is
@@ -11,10 +14,15 @@ Bodies (all sizes read from :class:`analytic.parameters.Scene`):
 
 Contact (``contact_model``):
 
-* ``'point'``: each column touches the ground and the lintel through eight
-  small spheres at its corners (inset so that they are tangent to the box
-  faces); the ground and the lintel are boxes.  Box-on-box point contact is
-  poorer (its contact point jumps between corners) and slower.
+* ``'point'``: at every support the narrower body (the upper one if equal)
+  touches the wider one through eight small spheres at its corners (inset so
+  that they are tangent to the box faces), the wider one through its box:
+  each column touches the ground and the lintel by its corner spheres, the
+  ground and the lintel are boxes; a drum resting on a drum has both, and
+  the pairs that would double a contact (box on box, sphere on sphere, the
+  wider body's spheres on the narrower's box, a drum's box on the ground)
+  are filtered out.  Box-on-box point contact is poorer (its contact point
+  jumps between corners) and slower.
 * ``'hydroelastic'``: compliant column and lintel boxes (pressure field of
   modulus ``hydroelastic_modulus``) on a rigid ground box.
 
@@ -29,7 +37,8 @@ import math
 
 import numpy as np
 from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMaterial,
-                              AddRigidHydroelasticProperties, Box, ProximityProperties, Sphere)
+                              AddRigidHydroelasticProperties, Box, CollisionFilterDeclaration,
+                              GeometrySet, ProximityProperties, Sphere)
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.plant import (AddMultibodyPlant, CoulombFriction,
@@ -39,7 +48,6 @@ from pydrake.multibody.tree import (FixedOffsetFrame, PlanarJoint, RevoluteJoint
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 
-from trilith_xval.engines import geometry
 
 __all__ = ["DrakeWorld", "CONTACT_MODELS", "SOLVERS", "NEGLIGIBLE_INERTIA_FRACTION"]
 
@@ -51,11 +59,13 @@ _PLANE = RollPitchYaw(0.5 * math.pi, 0.0, 0.0).ToRotationMatrix()
 
 
 class DrakeWorld:
-    """A fresh Drake diagram holding one trilith (nothing shared between runs).
+    """A fresh Drake diagram holding one scene (nothing shared between runs).
 
     Parameters
     ----------
-    scene : analytic.parameters.Scene
+    structure : engines.geometry.Structure
+        The scene's body list at the start of the run
+        (:func:`~engines.geometry.structure_of` at ``theta0``, ``psi0``).
     dt : float
         Discrete time step [s] of the plant.
     friction : float
@@ -76,22 +86,23 @@ class DrakeWorld:
         Radius [m] of the corner spheres (point contact).
     hydroelastic_modulus : float
         Pressure-field modulus [Pa] of the compliant boxes (hydroelastic contact).
-    theta0, psi0 : float
-        Initial tilt of the columns and absolute pendulum angle [rad], at rest.
 
     The planar joints hang from one frame at the world origin, so a body's
     coordinates are its centre ``(x, z)`` and CCW angle in the analytic plane.
+    Bodies are added in the structure's order, with the calls of the trilith's
+    builder before the body list, in its order (the trilith's plant is unchanged
+    bit for bit, ``tests/engines/test_structure_3d.py``).
     """
 
-    def __init__(self, scene, dt: float, friction: float, contact_model: str, solver: str,
+    def __init__(self, structure, dt: float, friction: float, contact_model: str, solver: str,
                  stiffness: float, relaxation_time: float, dissipation: float,
-                 sphere_radius: float, hydroelastic_modulus: float, theta0: float, psi0: float):
-        self.scene = scene
+                 sphere_radius: float, hydroelastic_modulus: float):
+        self.structure = structure
         builder = DiagramBuilder()
         config = MultibodyPlantConfig(time_step=dt, contact_model=contact_model,
                                       discrete_contact_approximation=solver)
-        self.plant, self.scene_graph = plant, _ = AddMultibodyPlant(config, builder)
-        plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -scene.g])
+        self.plant, self.scene_graph = plant, scene_graph = AddMultibodyPlant(config, builder)
+        plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -structure.g])
 
         def props(rigid_hydro: bool = False) -> ProximityProperties:
             p = ProximityProperties()
@@ -102,60 +113,64 @@ class DrakeWorld:
                 if rigid_hydro:
                     AddRigidHydroelasticProperties(p)
                 else:
-                    AddCompliantHydroelasticProperties(0.1 * scene.b, hydroelastic_modulus, p)
+                    AddCompliantHydroelasticProperties(0.1 * structure.width_scale,
+                                                       hydroelastic_modulus, p)
             return p
 
-        b, h, depth = scene.b, scene.h, scene.depth
-        span, t_l = scene.lintel_length, scene.lintel_thickness
-        g_half = geometry.ground_box(scene)
+        depth = structure.depth
+        centre_x, *g_half = structure.ground
         world = plant.world_body()
-        plant.RegisterCollisionGeometry(
-            world, RigidTransform([0.5 * span, 0.0, -g_half[2]]), Box(*(2.0 * v for v in g_half)),
+        ground_id = plant.RegisterCollisionGeometry(
+            world, RigidTransform([centre_x, 0.0, -g_half[2]]), Box(*(2.0 * v for v in g_half)),
             "ground", props(rigid_hydro=True))
-        poses = geometry.rest_poses(scene, theta0, psi0)
-        bodies = [("column_left", poses.columns[0], theta0, scene.m1, (b, depth, h)),
-                  ("column_right", poses.columns[1], theta0, scene.m1, (b, depth, h))]
-        if scene.mu > 0.0:
-            bodies.append(("lintel", poses.lintel, 0.0, scene.m3, (span, depth, t_l)))
+        spheres, boxes = _contact_shapes(structure, contact_model)
         plane = plant.AddFrame(FixedOffsetFrame("plane", world, RigidTransform(_PLANE)))
         self.bodies, self.joints, self.masses = [], [], []
+        ids: dict[str, dict[str, list]] = {}
         r = sphere_radius
-        for name, (x, z), angle, mass, size in bodies:
-            if name == "lintel":
-                inertia = RotationalInertia(*geometry.box_inertia(mass, *size))
-            else:  # only the inertia about y enters a planar motion: J_G of the scene
-                inertia = RotationalInertia(*(scene.inertia_J_G,) * 3)
+        for box in structure.bodies:
+            name, size = box.name, (box.b, depth, box.h)
+            # Only the inertia about y enters a planar motion (a column's: J_G of
+            # the scene, which the structure gives on all three axes).
+            inertia = RotationalInertia(*box.inertia)
             body = plant.AddRigidBody(name, SpatialInertia.MakeFromCentralInertia(
-                mass, np.zeros(3), inertia))
+                box.mass, np.zeros(3), inertia))
             own = plant.AddFrame(FixedOffsetFrame(f"{name}_plane", body.body_frame(),
                                                   RigidTransform(_PLANE)))
             joint = plant.AddJoint(PlanarJoint(f"{name}_joint", plane, own))
+            x, z, angle = box.start
             joint.set_default_pose([x, z], angle)
-            if name == "lintel" or contact_model == "hydroelastic":
-                plant.RegisterCollisionGeometry(body, RigidTransform(), Box(*size), name,
-                                                props())
-            else:  # eight corner spheres, tangent to the box faces
+            ids[name] = {"box": [], "spheres": []}
+            if name in boxes:
+                ids[name]["box"].append(plant.RegisterCollisionGeometry(
+                    body, RigidTransform(), Box(*size), name, props()))
+            if name in spheres:  # eight corner spheres, tangent to the box faces
                 hx, hy, hz = (0.5 * v - r for v in size)
                 for k, (sx, sy, sz) in enumerate(np.ndindex(2, 2, 2)):
                     corner = [(2 * sx - 1) * hx, (2 * sy - 1) * hy, (2 * sz - 1) * hz]
-                    plant.RegisterCollisionGeometry(body, RigidTransform(corner), Sphere(r),
-                                                    f"{name}_corner{k}", props())
+                    ids[name]["spheres"].append(plant.RegisterCollisionGeometry(
+                        body, RigidTransform(corner), Sphere(r), f"{name}_corner{k}", props()))
             self.bodies.append(body)
             self.joints.append(joint)
-            self.masses.append(mass)
+            self.masses.append(box.mass)
         self.pendulum = None
-        if scene.has_pendulum:
-            l, m4 = scene.pendulum_length, scene.m4
+        spec = structure.bob
+        if spec is not None:
+            l, m4 = spec.length, spec.mass
             bob_i = NEGLIGIBLE_INERTIA_FRACTION * m4 * l * l
             bob = plant.AddRigidBody("pendulum", SpatialInertia.MakeFromCentralInertia(
                 m4, [0.0, 0.0, -l], RotationalInertia(bob_i, bob_i, bob_i)))
-            hinge = plant.AddFrame(FixedOffsetFrame("hinge", self.bodies[2].body_frame(),
-                                                    RigidTransform([scene.hinge_x, 0.0, -0.5 * t_l])))
+            self.parent_index = k = structure.index(spec.parent)
+            hinge = plant.AddFrame(FixedOffsetFrame("hinge", self.bodies[k].body_frame(),
+                                                    RigidTransform([spec.anchor[0], 0.0,
+                                                                    spec.anchor[1]])))
             self.pendulum = plant.AddJoint(RevoluteJoint("pendulum_psi", hinge, bob.body_frame(),
                                                          [0.0, -1.0, 0.0]))
-            self.pendulum.set_default_angle(psi0)
+            # Relative to the parent, turned by its start angle.
+            self.pendulum.set_default_angle(spec.psi0 - structure.bodies[k].start[2])
             self.bob = bob
         plant.Finalize()
+        _filter_doubled_contacts(scene_graph, structure, ids, ground_id)
         self.diagram = builder.Build()
         self.simulator = Simulator(self.diagram)
         self.context = self.simulator.get_mutable_context()
@@ -174,8 +189,8 @@ class DrakeWorld:
         for body, mass in zip(self.bodies, self.masses):
             forces.append(_force(body, np.zeros(3), mass * load))
         if self.pendulum is not None:
-            forces.append(_force(self.bob, [0.0, 0.0, -self.scene.pendulum_length],
-                                 self.scene.m4 * load))
+            spec = self.structure.bob
+            forces.append(_force(self.bob, [0.0, 0.0, -spec.length], spec.mass * load))
         self.force_port.FixValue(self.plant_context, forces)
 
     def steps(self, first: int, loads) -> None:
@@ -191,13 +206,13 @@ class DrakeWorld:
         sim.AdvanceTo(k * dt)
 
     def planar_states(self) -> list[tuple[float, float, float, float, float, float]]:
-        """``[x, z, angle, vx, vz, omega]`` of each column and the lintel."""
+        """``[x, z, angle, vx, vz, omega]`` of each box in the structure's order."""
         q = self.plant.GetPositions(self.plant_context).tolist()
         v = self.plant.GetVelocities(self.plant_context).tolist()
         return [q[iq:iq + 3] + v[iv:iv + 3] for iq, iv in self._q]
 
     def pendulum_state(self) -> tuple[float, float]:
-        """Relative hinge angle and rate (add the lintel's for the absolute)."""
+        """Relative hinge angle and rate (add the parent's for the absolute)."""
         return (float(self.pendulum.get_angle(self.plant_context)),
                 float(self.pendulum.get_angular_rate(self.plant_context)))
 
@@ -211,3 +226,52 @@ def _force(body, point, fx: float) -> ExternallyAppliedSpatialForce:
     f.p_BoBq_B = np.asarray(point, dtype=float)
     f.F_Bq_W = SpatialForce(np.zeros(3), np.array([fx, 0.0, 0.0]))
     return f
+
+
+def _contact_shapes(structure, contact_model: str) -> tuple[set[str], set[str]]:
+    """The boxes that touch by corner spheres and those that touch by their box.
+
+    Hydroelastic: every box by its box.  Point: at each support the narrower
+    body (the upper one if equal) by its spheres, the wider by its box; a body
+    in no such pair (none in the shipped kinds) by its box."""
+    names = [box.name for box in structure.bodies]
+    if contact_model == "hydroelastic":
+        return set(), set(names)
+    spheres, boxes = set(), set()
+    for upper, lower in structure.supports:
+        if lower == "ground":
+            spheres.add(upper)
+            continue
+        narrow, wide = ((upper, lower) if structure.body(upper).b <= structure.body(lower).b
+                        else (lower, upper))
+        spheres.add(narrow)
+        boxes.add(wide)
+    boxes |= set(names) - spheres - boxes
+    return spheres, boxes
+
+
+def _filter_doubled_contacts(scene_graph, structure, ids, ground_id) -> None:
+    """Exclude the geometry pairs that would double a support's point contact
+    (see the module docstring).  In the trilith no body has both a box and
+    spheres, and hydroelastic contact has no spheres, so nothing is excluded
+    there and the plant is the one built before the body list."""
+    pairs = []
+    for upper, lower in structure.supports:
+        if lower == "ground":
+            if ids[upper]["spheres"]:  # its box, if any, is for the body above it
+                pairs.append((ids[upper]["box"], [ground_id]))
+            continue
+        narrow, wide = ((upper, lower) if structure.body(upper).b <= structure.body(lower).b
+                        else (lower, upper))
+        if not ids[narrow]["spheres"]:
+            continue  # hydroelastic: box on box is the contact
+        pairs += [(ids[wide]["spheres"], ids[narrow]["box"]),
+                  (ids[wide]["box"], ids[narrow]["box"]),
+                  (ids[wide]["spheres"], ids[narrow]["spheres"])]
+    pairs = [(a, b) for a, b in pairs if a and b]
+    if not pairs:
+        return
+    declaration = CollisionFilterDeclaration()
+    for a, b in pairs:
+        declaration.ExcludeBetween(GeometrySet(a), GeometrySet(b))
+    scene_graph.collision_filter_manager().Apply(declaration)

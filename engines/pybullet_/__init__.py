@@ -1,5 +1,8 @@
 """PyBullet (3D) backend: the trilith as boxes on a box ground, the pendulum as a
-revolute link of the lintel (bodies built in :mod:`engines.pybullet_.bodies`).
+revolute link of the lintel (bodies built in :mod:`engines.pybullet_.bodies` from
+the scene's body list, :class:`~engines.geometry.Structure`, so the other kinds of
+:mod:`analytic.kinds` run too; the trilith's world is the one built before the
+body list, bit for bit).
 
 The hooks of :class:`engines.base.Engine`, plus
 :meth:`PyBulletEngine.render_frames` (headless RGB frames for recordings) and
@@ -39,7 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trilith_xval.analytic.kinds import KindScene
 from trilith_xval.analytic.options import check_real
+from trilith_xval.engines import geometry
 from trilith_xval.engines.base import Engine, EngineSettings
 from trilith_xval.engines.diagnostics import PlaneState, Pose
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
@@ -169,8 +174,11 @@ class PyBulletEngine(Engine):
     # 1, the calibrated value (Settings notes): stronger pulses need more while
     # rocking; at the paper's point D (25 m/s^2 = 2.5 g, with the pendulum)
     # friction 1 lets the pivots slide by 7 mm before the trilith passes alpha,
-    # the bound (2.55, times the margin) keeps it below 1 um.
+    # the bound (2.55, times the margin) keeps it below 1 um.  The other kinds
+    # (drums, unequal, block_on_block) do not slip at 1 at their strong pulses
+    # (8-12 m/s^2, tests/engines/test_kinds_engines.py).
     default_friction = 1.0
+    structures = True  # builds any body list (engines.geometry.Structure)
     # `trilith calibrate`'s search beside the step: more solver iterations, a stiffer
     # position correction (defaults first; both within Bullet's documented ranges).
     calibration_space = {"solver_iterations": (50, 100), "contact_erp": (0.2, 0.4)}
@@ -186,15 +194,16 @@ class PyBulletEngine(Engine):
         return f"pybullet {_v('pybullet')} (API {pb.getAPIVersion()})"
 
     def build(self, mode: int = pb.DIRECT) -> None:
-        s, scene = self.settings, self.scene
+        s = self.settings
         self.mode = mode
+        self.structure = structure = geometry.structure_of(self.scene, s.theta0, s.psi0)
         self.client = c = world.acquire_client(mode)
-        world.configure_client(c, scene, s)
+        world.configure_client(c, structure, s)
         self.moving = s.base_motion == "ground"
         # An excitation whose window is empty (Still) never loads the bodies.
         exc = self.excitation
-        self.bodies = build_scene(c, scene, s.theta0, s.psi0, math.sqrt(self.friction),
-                                  self.moving, s.friction_anchor, slop=world.effective_slop(s),
+        self.bodies = build_scene(c, structure, math.sqrt(self.friction), self.moving,
+                                  s.friction_anchor, slop=world.effective_slop(s),
                                   under_load=exc.end_time > exc.start_time)
         self.start_y = {body: pb.getBasePositionAndOrientation(body, physicsClientId=c)[0][1]
                         for body in self.bodies.dynamic}
@@ -235,23 +244,22 @@ class PyBulletEngine(Engine):
         # Each body is read once per sample: a sample's reads cost about two steps
         # (benchmarks/bench_overhead.py), so re-reading would slow every run.
         poses, drift, roll_yaw = [], 0.0, 0.0
-        for body in bodies.columns:
-            theta, theta_dot, pos, quat = world.column_angle(c, body)
-            vel = pb.getBaseVelocity(body, physicsClientId=c)[0]
-            poses.append(Pose(pos[0], pos[2], theta, vel[0], vel[2], theta_dot))
-            drift, roll_yaw = self._out_of_plane(body, pos, quat, drift, roll_yaw)
-        lintel = psi = psi_dot = None
-        if bodies.lintel is not None:
-            read = world.lintel_state(c, bodies)
+        psi = psi_dot = 0.0
+        for body in bodies.boxes:
+            read = world.body_state(c, body)
             pos, quat, vel, omega = read
             m = pb.getMatrixFromQuaternion(quat)
-            lintel = Pose(pos[0], pos[2], math.atan2(-m[2], m[8]), vel[0], vel[2], -omega[1])
-            drift, roll_yaw = self._out_of_plane(bodies.lintel, pos, quat, drift, roll_yaw)
-            if bodies.pendulum_joint is not None:
+            # The box's up axis is the third column of R: (m[2], m[5], m[8]).
+            poses.append(Pose(pos[0], pos[2], math.atan2(-m[2], m[8]), vel[0], vel[2],
+                              -omega[1]))
+            drift, roll_yaw = self._out_of_plane(body, pos, quat, drift, roll_yaw)
+            if body == bodies.parent:
                 psi, psi_dot = world.pendulum_state(c, bodies, read)
         gx = (pb.getJointState(bodies.ground, 0, physicsClientId=c)[0] if self.moving else 0.0)
-        return PlaneState((poses[0], poses[1]), lintel, psi or 0.0, psi_dot or 0.0, gx, drift,
-                          roll_yaw)
+        if not self.structure.is_trilith:
+            return PlaneState((), None, psi, psi_dot, gx, drift, roll_yaw, bodies=tuple(poses))
+        lintel = poses[2] if len(poses) > 2 else None
+        return PlaneState((poses[0], poses[1]), lintel, psi, psi_dot, gx, drift, roll_yaw)
 
     def _out_of_plane(self, body, pos, quat, drift, roll_yaw) -> tuple[float, float]:
         roll, _, yaw = pb.getEulerFromQuaternion(quat)
@@ -264,6 +272,7 @@ class PyBulletEngine(Engine):
                       width: int = 320, height: int = 240) -> list[np.ndarray]:
         """RGB ``uint8`` frames ``(height, width, 3)`` of a run at the requested
         ``times`` [s] (headless, ``ER_TINY_RENDERER``).  The run stops at the last time."""
+        _trilith_only(scene, "render_frames")
         engine = cls(scene, excitation, settings)
         times = np.asarray(times, dtype=float)
         if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(times < 0.0) or np.any(
@@ -301,6 +310,7 @@ class PyBulletEngine(Engine):
     def view(cls, scene, excitation, settings: Settings | None = None,
              duration: float = 10.0) -> None:
         """Open a PyBullet GUI window and run ``scene`` in real time (needs a display)."""
+        _trilith_only(scene, "view")
         engine = cls(scene, excitation, settings)
         dt = engine.settings.dt
         engine.build(mode=pb.GUI)
@@ -317,3 +327,10 @@ class PyBulletEngine(Engine):
                     time.sleep(lag)
         finally:
             engine.close()
+
+
+def _trilith_only(scene, what: str) -> None:
+    # The camera is placed from the trilith's lintel length and column height.
+    if isinstance(scene, KindScene):
+        raise ValueError(f"pybullet {what} draws the parametric trilith only, not the "
+                         f"{scene.kind!r} kind")

@@ -1,8 +1,10 @@
-"""Building the trilith's bodies in a PyBullet client, for :mod:`engines.pybullet_`.
+"""Building a scene's bodies in a PyBullet client, for :mod:`engines.pybullet_`.
 
-Geometry and signs are described in :mod:`engines.pybullet_.world` (the analytic
-plane is PyBullet's x-z plane, ``theta = -pitch``); the numbers come from
-:mod:`engines.geometry`.
+:func:`build_scene` turns the scene's body list (:class:`~engines.geometry.Structure`:
+the trilith, the block, or another kind of :mod:`analytic.kinds`) into
+PyBullet multibodies.  Geometry and signs are described in
+:mod:`engines.pybullet_.world` (the analytic plane is PyBullet's x-z plane,
+``theta = -pitch``); the numbers come from :mod:`engines.geometry`.
 """
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ from dataclasses import dataclass
 from trilith_xval.engines import geometry
 from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
-__all__ = ["Bodies", "build_scene", "initial_poses", "NEGLIGIBLE_MASS_FRACTION",
+__all__ = ["Bodies", "build_scene", "initial_poses", "contact_levels", "NEGLIGIBLE_MASS_FRACTION",
            "GROUND_MASS_FACTOR"]
 
 # Own inertia of the pendulum bob relative to m4 l^2: negligible (the analytic
@@ -22,24 +24,39 @@ NEGLIGIBLE_MASS_FRACTION = 1e-6
 GROUND_MASS_FACTOR = 1e6
 
 
-
 @dataclass
 class Bodies:
-    """PyBullet ids of one built scene, and the numbers needed to read it."""
+    """PyBullet ids of one built scene, and the numbers needed to read it.
+
+    ``boxes`` are the structure's bodies in its order (for the trilith: left
+    column, right column, lintel if ``mu > 0``); ``parent`` is the body the
+    pendulum hangs on (a multibody base), ``pendulum_joint`` the bob's joint
+    (= link) index on it, ``hinge_local`` the hinge in the parent's frame.
+    """
 
     client: int
     ground: int
     ground_link: int  # -1: static box base; 0: the prismatic link of a moving ground
-    columns: tuple[int, int]
-    lintel: int | None
-    lintel_link: int  # -1: the lintel is a multibody base
-    pendulum_joint: int | None  # joint (= link) index on the lintel, or None
-    hinge_local: tuple[float, float, float]  # hinge in the lintel's frame
-    length: float  # pendulum length l
+    boxes: tuple[int, ...]
+    structure: geometry.Structure
+    parent: int | None  # the bob's parent body, or None without a pendulum
+    pendulum_joint: int | None
+    hinge_local: tuple[float, float, float]
+    length: float  # pendulum length l (0 without one)
 
     @property
     def dynamic(self) -> tuple[int, ...]:
-        return self.columns + ((self.lintel,) if self.lintel is not None else ())
+        return self.boxes
+
+    @property
+    def columns(self) -> tuple[int, int]:
+        """The trilith's columns (the first two boxes)."""
+        return self.boxes[0], self.boxes[1]
+
+    @property
+    def lintel(self) -> int | None:
+        """The trilith's lintel, None for ``mu = 0``."""
+        return self.boxes[2] if len(self.boxes) > 2 else None
 
 
 def _quat_theta(theta: float) -> tuple[float, float, float, float]:
@@ -63,20 +80,27 @@ def initial_poses(scene, theta0: float, psi0: float, sink: float = 0.0) -> dict:
     return {"columns": centres, "lintel": lintel, "quat": _quat_theta(theta0)}
 
 
-def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
-                moving_ground: bool, friction_anchor: bool = True, slop: float = 0.0,
+def build_scene(client: int, structure, friction: float, moving_ground: bool,
+                friction_anchor: bool = True, slop: float = 0.0,
                 under_load: bool = False) -> Bodies:
-    """Create every body of ``scene`` in ``client`` (see the module docstring).
+    """Create every body of ``structure`` (:func:`engines.geometry.structure_of`)
+    in ``client``, each box with Bullet's per-body ``friction`` (the pair's
+    product is the run's coefficient); see :mod:`engines.pybullet_.world`.
 
-    ``slop``: Bullet's ``contactSlop`` [m].  The bodies start sunk by it
-    (:func:`initial_poses`), where a resting contact settles: penetrations below
+    Bodies are created in the structure's order after the ground, with the
+    calls of the trilith's builder before the body list, in its order, so the
+    trilith's world is unchanged bit for bit (``tests/engines/test_structure.py``).
+
+    ``slop``: Bullet's ``contactSlop`` [m].  Each box starts sunk by it times
+    the number of contacts below it (:func:`contact_levels`: a column by one
+    slop, the lintel on it by two), where a resting contact settles: penetrations below
     the slop are left to close freely, so bodies placed at zero gap fall through
     ``slop`` without any contact force, ~4.5 ms for 1e-4 m.  Under a pulse starting
     at t = 0 they slid frictionless meanwhile and landed with a sideways velocity
     whose friction impulse kicked them into rocking: uplift 3-4 ms early at the
     paper's points A and D (theta error ~1e-2 alpha before the first impact).
 
-    An upright start (``theta0 == 0``) and any start ``under_load`` (a pulse or a
+    An upright start (no box turned) and any start ``under_load`` (a pulse or a
     record moves the ground from t = 0) are sunk.  At zero gap a tilted start under
     a pulse fell through the slop for ~4.5 ms while the ground accelerated and
     landed sliding: with a 1e-6 rad tilt at Omega = 20 rad/s, A = 46.6 m/s^2 (Fig. 5)
@@ -88,19 +112,20 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
     0.5 % either way, median 0.039 % vs 0.034 %) but moved the column-step
     outliers (see ``engines.pybullet_.Settings``) onto other releases.
     """
-    b, h, depth = scene.b, scene.h, scene.depth
-    span = scene.lintel_length
-    poses = initial_poses(scene, theta0, psi0,
-                          sink=slop if theta0 == 0.0 or under_load else 0.0)
+    b_vis = structure.width_scale  # the scale of the bob's drawing (visual only)
+    depth = structure.depth
+    tilted = any(box.start[2] != 0.0 for box in structure.bodies)
+    sink = slop if not tilted or under_load else 0.0
+    levels = contact_levels(structure)
 
-    # Ground: wide enough for columns lying on their sides, thick enough that a
+    # Ground: wide enough for bodies lying on their sides, thick enough that a
     # corner cannot tunnel through it; a box, not a GEOM_PLANE (DESIGN.md: the
     # plane makes top and bottom impacts resolve one step apart).
-    g_half = geometry.ground_box(scene)
+    centre_x, *g_half = structure.ground
     g_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=g_half, physicsClientId=client)
-    g_pos = (0.5 * span, 0.0, -g_half[2])
+    g_pos = (centre_x, 0.0, -g_half[2])
     if moving_ground:
-        total = scene.m1 * (2.0 + scene.mu + scene.gamma)
+        total = structure.total_mass
         ground = pb.createMultiBody(
             baseMass=0.0, basePosition=(0.0, 0.0, 0.0),
             linkMasses=[GROUND_MASS_FACTOR * total], linkCollisionShapeIndices=[g_shape],
@@ -116,93 +141,91 @@ def build_scene(client: int, scene, theta0: float, psi0: float, friction: float,
                                     basePosition=g_pos, physicsClientId=client)
         ground_link = -1
 
-    col_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * b, 0.5 * depth, 0.5 * h),
-                                        physicsClientId=client)
-    col_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * b, 0.5 * depth, 0.5 * h),
-                                   rgbaColor=(0.75, 0.7, 0.6, 1.0), physicsClientId=client)
-    columns = []
-    for (x, z) in poses["columns"]:
-        body = pb.createMultiBody(baseMass=scene.m1, baseCollisionShapeIndex=col_shape,
-                                  baseVisualShapeIndex=col_vis, basePosition=(x, 0.0, z),
-                                  baseOrientation=poses["quat"], physicsClientId=client)
-        ix, _, iz = geometry.box_inertia(scene.m1, b, depth, h)
-        # J_G comes from the scene (it may differ from the uniform box's value).
-        pb.changeDynamics(body, -1, mass=scene.m1, localInertiaDiagonal=(ix, scene.inertia_J_G, iz),
-                          physicsClientId=client)
-        columns.append(body)
-
-    lintel = None
-    lintel_link = -1
-    joint = None
-    t_lin = scene.lintel_thickness
-    hinge_local = (scene.hinge_x, 0.0, -0.5 * t_lin)
-    if scene.mu > 0.0:
-        half = (0.5 * span, 0.5 * depth, 0.5 * t_lin)
-        l_shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=client)
-        l_vis = pb.createVisualShape(pb.GEOM_BOX, halfExtents=half,
-                                     rgbaColor=(0.6, 0.55, 0.5, 1.0), physicsClientId=client)
-        lx, lz = poses["lintel"]
-        links: list[dict] = []
-        if scene.has_pendulum:
-            l = scene.pendulum_length
+    bob = structure.bob
+    shapes: dict[tuple, tuple[int, int]] = {}  # equal boxes share their shapes
+    boxes, parent, joint, hinge_local = [], None, None, (0.0, 0.0, 0.0)
+    for box in structure.bodies:
+        half = (0.5 * box.b, 0.5 * depth, 0.5 * box.h)
+        if half not in shapes:
+            rgba = (0.6, 0.55, 0.5, 1.0) if box.name == "lintel" else (0.75, 0.7, 0.6, 1.0)
+            shapes[half] = (
+                pb.createCollisionShape(pb.GEOM_BOX, halfExtents=half, physicsClientId=client),
+                pb.createVisualShape(pb.GEOM_BOX, halfExtents=half, rgbaColor=rgba,
+                                     physicsClientId=client))
+        shape, vis = shapes[half]
+        x, z, angle = box.start
+        hangs = bob is not None and bob.parent == box.name
+        link_kw = {}
+        if hangs:
+            l = bob.length
+            hinge_local = (bob.anchor[0], 0.0, bob.anchor[1])
             # Visual only (no collision shape, inertia set below): a rod and the
             # bob, drawn in the link frame (hinge at its origin).
             bob_vis = pb.createVisualShapeArray(
-                shapeTypes=[pb.GEOM_SPHERE, pb.GEOM_CYLINDER], radii=[0.15 * b, 0.02 * b],
+                shapeTypes=[pb.GEOM_SPHERE, pb.GEOM_CYLINDER], radii=[0.15 * b_vis, 0.02 * b_vis],
                 lengths=[0.0, l], visualFramePositions=[(0.0, 0.0, -l), (0.0, 0.0, -0.5 * l)],
                 rgbaColors=[(0.8, 0.1, 0.1, 1.0), (0.3, 0.3, 0.3, 1.0)], physicsClientId=client)
             # Link frame at the hinge; its centre of mass (the bob) l below it.
             # Axis -y: a positive joint angle is a CCW (analytic) swing.
-            links.append(dict(mass=scene.m4, col=-1, vis=bob_vis, pos=hinge_local,
-                              com=(0.0, 0.0, -l), parent=lintel_link + 1,
-                              type=pb.JOINT_REVOLUTE, axis=(0.0, -1.0, 0.0)))
-            joint = len(links) - 1
-        link_kw = {}
-        if links:
             link_kw = dict(
-                linkMasses=[k["mass"] for k in links],
-                linkCollisionShapeIndices=[k["col"] for k in links],
-                linkVisualShapeIndices=[k["vis"] for k in links],
-                linkPositions=[k["pos"] for k in links],
-                linkOrientations=[(0, 0, 0, 1)] * len(links),
-                linkInertialFramePositions=[k["com"] for k in links],
-                linkInertialFrameOrientations=[(0, 0, 0, 1)] * len(links),
-                linkParentIndices=[k["parent"] for k in links],
-                linkJointTypes=[k["type"] for k in links],
-                linkJointAxis=[k["axis"] for k in links])
-        lintel = pb.createMultiBody(baseMass=scene.m3, baseCollisionShapeIndex=l_shape,
-                                    baseVisualShapeIndex=l_vis, basePosition=(lx, 0.0, lz),
-                                    physicsClientId=client, **link_kw)
-        pb.changeDynamics(lintel, lintel_link, mass=scene.m3,
-                          localInertiaDiagonal=geometry.box_inertia(scene.m3, span, depth, t_lin),
+                linkMasses=[bob.mass], linkCollisionShapeIndices=[-1],
+                linkVisualShapeIndices=[bob_vis], linkPositions=[hinge_local],
+                linkOrientations=[(0, 0, 0, 1)], linkInertialFramePositions=[(0.0, 0.0, -l)],
+                linkInertialFrameOrientations=[(0, 0, 0, 1)], linkParentIndices=[0],
+                linkJointTypes=[pb.JOINT_REVOLUTE], linkJointAxis=[(0.0, -1.0, 0.0)])
+        body = pb.createMultiBody(baseMass=box.mass, baseCollisionShapeIndex=shape,
+                                  baseVisualShapeIndex=vis,
+                                  basePosition=(x, 0.0, z - levels[box.name] * sink),
+                                  baseOrientation=_quat_theta(angle), physicsClientId=client,
+                                  **link_kw)
+        # In the plane the structure's inertia (a column's J_G, which may differ
+        # from the uniform box's); out of it, the uniform box's (the structure
+        # gives J_G on all three axes for planar engines, where they never turn).
+        ix, _, iz = geometry.box_inertia(box.mass, box.b, depth, box.h)
+        pb.changeDynamics(body, -1, mass=box.mass, localInertiaDiagonal=(ix, box.inertia[1], iz),
                           physicsClientId=client)
-        for k in range(len(links)):
-            # Joints are free: no default velocity motor (it would lock them).
-            pb.setJointMotorControl2(lintel, k, pb.VELOCITY_CONTROL, force=0.0,
+        if hangs:
+            joint, parent = 0, body
+            # The joint is free: no default velocity motor (it would lock it).
+            pb.setJointMotorControl2(body, joint, pb.VELOCITY_CONTROL, force=0.0,
                                      physicsClientId=client)
-        if scene.has_pendulum:
-            bob_i = NEGLIGIBLE_MASS_FRACTION * scene.m4 * l * l
-            pb.changeDynamics(lintel, joint, mass=scene.m4,
+            bob_i = NEGLIGIBLE_MASS_FRACTION * bob.mass * l * l
+            pb.changeDynamics(body, joint, mass=bob.mass,
                               localInertiaDiagonal=(bob_i, bob_i, bob_i), physicsClientId=client)
             # The analytic pendulum passes through everything.
-            pb.setCollisionFilterGroupMask(lintel, joint, 0, 0, physicsClientId=client)
-            # Joint angle = psi relative to the lintel, which starts unrotated.
-            pb.resetJointState(lintel, joint, psi0, 0.0, physicsClientId=client)
+            pb.setCollisionFilterGroupMask(body, joint, 0, 0, physicsClientId=client)
+            # Joint angle = psi relative to the parent, turned by its start angle.
+            pb.resetJointState(body, joint, bob.psi0 - angle, 0.0, physicsClientId=client)
+        boxes.append(body)
 
-    bodies = Bodies(client, ground, ground_link, (columns[0], columns[1]), lintel,
-                    lintel_link if lintel is not None else -1, joint, hinge_local,
-                    scene.pendulum_length)
-    for body in bodies.dynamic:
-        parts = [-1] if body != lintel else [bodies.lintel_link]
-        for link in parts:
-            # DESIGN.md: no damping (default 0.04 costs 0.8 % restitution),
-            # plastic contacts, friction anchors against creeping.
-            pb.changeDynamics(body, link, lateralFriction=friction, restitution=0.0,
-                              linearDamping=0.0, angularDamping=0.0,
-                              frictionAnchor=int(friction_anchor),
-                              rollingFriction=0.0, spinningFriction=0.0,
-                              physicsClientId=client)
+    bodies = Bodies(client, ground, ground_link, tuple(boxes), structure, parent, joint,
+                    hinge_local, bob.length if bob is not None else 0.0)
+    for body in bodies.boxes:
+        # DESIGN.md: no damping (default 0.04 costs 0.8 % restitution),
+        # plastic contacts, friction anchors against creeping.
+        pb.changeDynamics(body, -1, lateralFriction=friction, restitution=0.0,
+                          linearDamping=0.0, angularDamping=0.0,
+                          frictionAnchor=int(friction_anchor),
+                          rollingFriction=0.0, spinningFriction=0.0,
+                          physicsClientId=client)
     pb.changeDynamics(ground, ground_link, lateralFriction=friction, restitution=0.0,
                       frictionAnchor=int(friction_anchor), linearDamping=0.0, angularDamping=0.0,
                       physicsClientId=client)
     return bodies
+
+
+def contact_levels(structure) -> dict[str, float]:
+    """How many contacts stand between each box and the ground (1.0 on the ground,
+    one more than its highest support above it), as a float: a box starts sunk by
+    that many contact slops, each contact below it settled at one slop."""
+    below: dict[str, list[str]] = {}
+    for upper, lower in structure.supports:
+        below.setdefault(upper, []).append(lower)
+    levels: dict[str, float] = {"ground": 0.0}
+
+    def level(name: str) -> float:
+        if name not in levels:
+            levels[name] = 1.0 + max(level(lower) for lower in below[name])
+        return levels[name]
+
+    return {box.name: level(box.name) for box in structure.bodies}

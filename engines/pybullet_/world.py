@@ -1,13 +1,16 @@
-"""PyBullet's side of the trilith: clients, solver parameters and state reading.
+"""PyBullet's side of a scene: clients, solver parameters and state reading.
 
-The bodies are built in :mod:`engines.pybullet_.bodies`.
+The bodies are built in :mod:`engines.pybullet_.bodies` from the scene's body
+list (:class:`~engines.geometry.Structure`).
 
 The analytic plane (x right, y up) is PyBullet's x-z plane (z up); the depth
 ``scene.depth`` runs along y.  A counter-clockwise rotation in the analytic plane
 (``theta > 0``, x towards up) is a rotation about PyBullet's **-y** axis, so
 ``theta = -pitch`` and ``theta_dot = -omega_y``.
 
-Bodies (all from the :class:`~analytic.parameters.Scene`, nothing typed twice):
+Bodies of the trilith (all from the :class:`~analytic.parameters.Scene` through
+its Structure, nothing typed twice; the other kinds of :mod:`analytic.kinds`:
+each box a multibody the same way, the drums' bob a link of the lintel):
 
 * ground: a static box whose top face is ``z = 0`` ("gravity" base motion), or a
   very heavy box on a prismatic joint along x whose state is reset to the
@@ -16,7 +19,8 @@ Bodies (all from the :class:`~analytic.parameters.Scene`, nothing typed twice):
   one's left bottom corner at ``x = 0``, clear gap ``d``;
 * the lintel (``mu > 0`` only), ``lintel_length x depth x lintel_thickness``,
   mass ``m3``, resting on both column tops;
-* the pendulum (``gamma > 0`` only): a revolute link of the lintel multibody,
+* the pendulum (``gamma > 0`` only): a revolute link of the lintel multibody (its
+  parent's),
   hinge on the lintel's underside at ``hinge_x`` from its middle, the point mass
   ``m4`` at distance ``l`` (the link's centre of mass), negligible own inertia,
   no collision shape and collision filter mask 0, joint motor disabled.
@@ -32,7 +36,7 @@ from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
 from .bodies import Bodies
 
-__all__ = ["column_angle", "pendulum_state", "lintel_state", "effective_slop",
+__all__ = ["pendulum_state", "body_state", "effective_slop",
            "effective_friction_erp", "effective_residual_threshold", "configure_client",
            "acquire_client", "release_client", "DT_CALIBRATED"]
 
@@ -78,30 +82,21 @@ def effective_residual_threshold(settings) -> float:
     return 1e-7 * _step_ratio(settings) ** 2
 
 
-def column_angle(client: int, body: int) -> tuple[float, float, tuple, tuple]:
-    """``(theta, theta_dot, position, orientation)`` of a column (analytic signs)."""
-    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    _, omega = pb.getBaseVelocity(body, physicsClientId=client)
-    m = pb.getMatrixFromQuaternion(quat)
-    # The column's up axis is the third column of R: (m[2], m[5], m[8]).
-    theta = math.atan2(-m[2], m[8])
-    return theta, -omega[1], pos, quat
-
-
-def pendulum_state(client: int, bodies: Bodies, lintel_read: tuple | None = None
+def pendulum_state(client: int, bodies: Bodies, parent_read: tuple | None = None
                    ) -> tuple[float, float]:
     """``(psi, psi_dot)``: the bob's absolute angle from the downward vertical,
     CCW positive (bob at hinge + l (sin psi, -cos psi)), from world positions.
-    ``lintel_read``: the :func:`lintel_state` already read at this instant, if any."""
-    lintel, joint = bodies.lintel, bodies.pendulum_joint
-    state = pb.getLinkState(lintel, joint, computeLinkVelocity=1, computeForwardKinematics=1,
+    ``parent_read``: the :func:`body_state` of the bob's parent (the lintel)
+    already read at this instant, if any."""
+    parent, joint = bodies.parent, bodies.pendulum_joint
+    state = pb.getLinkState(parent, joint, computeLinkVelocity=1, computeForwardKinematics=1,
                            physicsClientId=client)
     bob, bob_v = state[0], state[6]
-    pos, quat, vel, omega = (lintel_read if lintel_read is not None
-                             else lintel_state(client, bodies))
+    pos, quat, vel, omega = (parent_read if parent_read is not None
+                             else body_state(client, parent))
     hinge = pb.multiplyTransforms(pos, quat, bodies.hinge_local, (0, 0, 0, 1))[0]
     r = [hinge[k] - pos[k] for k in range(3)]
-    # Hinge velocity = v + omega x r (rigid lintel).
+    # Hinge velocity = v + omega x r (rigid parent).
     hv = (vel[0] + omega[1] * r[2] - omega[2] * r[1], vel[2] + omega[0] * r[1] - omega[1] * r[0])
     rx, rz = bob[0] - hinge[0], bob[2] - hinge[2]
     vx, vz = bob_v[0] - hv[0], bob_v[2] - hv[1]
@@ -110,15 +105,12 @@ def pendulum_state(client: int, bodies: Bodies, lintel_read: tuple | None = None
     return psi, psi_dot
 
 
-def lintel_state(client: int, bodies: Bodies) -> tuple[tuple, tuple, tuple, tuple]:
-    """World ``(position, orientation, velocity, angular velocity)`` of the lintel."""
-    if bodies.lintel_link < 0:
-        pos, quat = pb.getBasePositionAndOrientation(bodies.lintel, physicsClientId=client)
-        vel, omega = pb.getBaseVelocity(bodies.lintel, physicsClientId=client)
-        return pos, quat, vel, omega
-    st = pb.getLinkState(bodies.lintel, bodies.lintel_link, computeLinkVelocity=1,
-                         computeForwardKinematics=1, physicsClientId=client)
-    return st[0], st[1], st[6], st[7]
+def body_state(client: int, body: int) -> tuple[tuple, tuple, tuple, tuple]:
+    """World ``(position, orientation, velocity, angular velocity)`` of a box (a
+    multibody base)."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    vel, omega = pb.getBaseVelocity(body, physicsClientId=client)
+    return pos, quat, vel, omega
 
 
 # Idle DIRECT clients kept for the next World: connecting costs 10-20 ms, about
@@ -146,17 +138,19 @@ def release_client(client: int, mode: int) -> None:
         pb.disconnect(physicsClientId=client)
 
 
-def configure_client(client: int, scene, s) -> None:
+def configure_client(client: int, structure, s) -> None:
     """Reset ``client`` and set every engine parameter explicitly (some are
-    process-global in Bullet, so a run must not depend on what ran before)."""
+    process-global in Bullet, so a run must not depend on what ran before).
+    ``structure``: the run's :class:`~engines.geometry.Structure` (its gravity;
+    its narrowest width scales the default contact breaking threshold)."""
     pb.resetSimulation(physicsClientId=client)
     pb.setPhysicsEngineParameter(
         fixedTimeStep=s.dt, numSubSteps=0, numSolverIterations=s.solver_iterations,
         contactERP=s.contact_erp, erp=s.contact_erp, frictionERP=effective_friction_erp(s),
         useSplitImpulse=1, splitImpulsePenetrationThreshold=-0.04,
-        contactBreakingThreshold=s.contact_breaking_threshold or 0.01 * scene.b,
+        contactBreakingThreshold=s.contact_breaking_threshold or 0.01 * structure.width_scale,
         restitutionVelocityThreshold=0.2, contactSlop=effective_slop(s), enableConeFriction=0,
         deterministicOverlappingPairs=1, globalCFM=0.0,
         solverResidualThreshold=effective_residual_threshold(s), warmStartingFactor=0.85,
         physicsClientId=client)
-    pb.setGravity(0.0, 0.0, -scene.g, physicsClientId=client)
+    pb.setGravity(0.0, 0.0, -structure.g, physicsClientId=client)

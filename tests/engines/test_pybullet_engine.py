@@ -100,20 +100,20 @@ def test_single_block_without_lintel_rocks_as_housner():
 
 
 def test_non_finite_state_gives_unstable(monkeypatch):
-    """Test hook: the column reading goes NaN after 0.2 s; the run must stop as
+    """Test hook: the bodies' reading goes NaN after 0.2 s; the run must stop as
     'unstable' at that sample with finite returned arrays."""
-    real = ps.column_angle
+    real = ps.body_state
     calls = {"n": 0}
 
     def poisoned(client, body):
         calls["n"] += 1
-        theta, rate, pos, quat = real(client, body)
-        # two columns read per sample; samples every sample_every steps
-        return (math.nan if calls["n"] > 2 * n_samples else theta), rate, pos, quat
+        pos, quat, vel, omega = real(client, body)
+        # three boxes (two columns, the lintel) read per sample
+        return ((math.nan, *pos[1:]) if calls["n"] > 3 * n_samples else pos), quat, vel, omega
 
     settings = Settings(t_max=2.0)
     n_samples = round(0.2 / (settings.dt * settings.sample_every))
-    monkeypatch.setattr(ps, "column_angle", poisoned)
+    monkeypatch.setattr(ps, "body_state", poisoned)
     tr = PyBulletEngine.simulate(load_scene("fig5"), Pulse(4.0, 9.0), settings)
     assert tr.verdict.status == "unstable"
     assert tr.verdict.time == pytest.approx(0.2, abs=2e-3)

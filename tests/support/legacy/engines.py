@@ -1,15 +1,24 @@
-"""Pymunk and MuJoCo engines whose build and read hooks are the pre-body-list code,
-verbatim (builders in :mod:`.pymunk_world` and :mod:`.mujoco_world`)."""
+"""Pymunk, MuJoCo, PyBullet, DART and Drake engines whose build and read hooks
+are the pre-body-list code, verbatim (builders in :mod:`.pymunk_world`,
+:mod:`.mujoco_world`, :mod:`.pybullet_bodies` / :mod:`.pybullet_world`,
+:mod:`.dart_world` and :mod:`.drake_world`)."""
 from __future__ import annotations
+
+import math
 
 import mujoco
 
 from trilith_xval.engines import geometry
-from trilith_xval.engines.diagnostics import PlaneState, Pose
+from trilith_xval.engines.dart_ import DartEngine
+from trilith_xval.engines.diagnostics import PlaneState, Pose, joint_plane_state
+from trilith_xval.engines.drake_ import DrakeEngine
 from trilith_xval.engines.mujoco_ import MujocoEngine
+from trilith_xval.engines.pybullet_ import PyBulletEngine
 from trilith_xval.engines.pymunk_ import PymunkEngine
+from trilith_xval.engines._quiet_pybullet import pybullet as pb
 
-from . import mujoco_world, pymunk_world
+from . import dart_world, drake_world, mujoco_world, pybullet_world, pymunk_world
+from .pybullet_bodies import build_scene as pybullet_build_scene
 
 
 class LegacyPymunk(PymunkEngine):
@@ -80,3 +89,83 @@ class LegacyMujoco(MujocoEngine):
             psi, psi_dot = qpos[pe] + qpos[li + 2], qvel[pe] + qvel[li + 2]
         gx = float(qpos[self.ground]) if self.moving else 0.0
         return PlaneState((pose(al, 0), pose(ar, 1)), lintel, psi, psi_dot, gx, problem=problem)
+
+
+class LegacyPyBullet(PyBulletEngine):
+    def build(self, mode: int = pb.DIRECT) -> None:
+        world = pybullet_world
+        s, scene = self.settings, self.scene
+        self.mode = mode
+        self.client = c = world.acquire_client(mode)
+        world.configure_client(c, scene, s)
+        self.moving = s.base_motion == "ground"
+        # An excitation whose window is empty (Still) never loads the bodies.
+        exc = self.excitation
+        self.bodies = pybullet_build_scene(c, scene, s.theta0, s.psi0, math.sqrt(self.friction),
+                                           self.moving, s.friction_anchor,
+                                           slop=world.effective_slop(s),
+                                           under_load=exc.end_time > exc.start_time)
+        self.start_y = {body: pb.getBasePositionAndOrientation(body, physicsClientId=c)[0][1]
+                        for body in self.bodies.dynamic}
+        if self.moving:
+            self._set_ground(0)
+
+    def read(self) -> PlaneState:
+        world = pybullet_world
+        c, bodies = self.client, self.bodies
+        # Each body is read once per sample: a sample's reads cost about two steps
+        # (benchmarks/bench_overhead.py), so re-reading would slow every run.
+        poses, drift, roll_yaw = [], 0.0, 0.0
+        for body in bodies.columns:
+            theta, theta_dot, pos, quat = world.column_angle(c, body)
+            vel = pb.getBaseVelocity(body, physicsClientId=c)[0]
+            poses.append(Pose(pos[0], pos[2], theta, vel[0], vel[2], theta_dot))
+            drift, roll_yaw = self._out_of_plane(body, pos, quat, drift, roll_yaw)
+        lintel = psi = psi_dot = None
+        if bodies.lintel is not None:
+            read = world.lintel_state(c, bodies)
+            pos, quat, vel, omega = read
+            m = pb.getMatrixFromQuaternion(quat)
+            lintel = Pose(pos[0], pos[2], math.atan2(-m[2], m[8]), vel[0], vel[2], -omega[1])
+            drift, roll_yaw = self._out_of_plane(bodies.lintel, pos, quat, drift, roll_yaw)
+            if bodies.pendulum_joint is not None:
+                psi, psi_dot = world.pendulum_state(c, bodies, read)
+        gx = (pb.getJointState(bodies.ground, 0, physicsClientId=c)[0] if self.moving else 0.0)
+        return PlaneState((poses[0], poses[1]), lintel, psi or 0.0, psi_dot or 0.0, gx, drift,
+                          roll_yaw)
+
+    def _set_ground(self, step: int) -> None:
+        x, v = self.ground_motion(step)
+        pb.resetJointState(self.bodies.ground, 0, x, v, physicsClientId=self.client)
+
+    def _out_of_plane(self, body, pos, quat, drift, roll_yaw) -> tuple[float, float]:
+        roll, _, yaw = pb.getEulerFromQuaternion(quat)
+        return (max(drift, abs(pos[1] - self.start_y[body])),
+                max(roll_yaw, abs(roll), abs(yaw)))
+
+
+class LegacyDart(DartEngine):
+    def build(self) -> None:
+        s = self.settings
+        self.world = dart_world.DartWorld(self.scene, s.dt, self.friction, s.detector, s.theta0,
+                                          s.psi0)
+
+    def read(self) -> PlaneState:
+        world = self.world
+        return joint_plane_state(world.planar_states(),
+                                 world.pendulum_state() if world.pendulum is not None else None)
+
+
+class LegacyDrake(DrakeEngine):
+    def build(self) -> None:
+        s, scene = self.settings, self.scene
+        self.world = drake_world.DrakeWorld(scene, s.dt, self.friction, s.contact_model,
+                                            s.solver, s.stiffness(scene),
+                                            s.sap_relaxation_time(scene), s.dissipation,
+                                            s.sphere_fraction * scene.b, s.hydroelastic_modulus,
+                                            s.theta0, s.psi0)
+
+    def read(self) -> PlaneState:
+        world = self.world
+        return joint_plane_state(world.planar_states(),
+                                 world.pendulum_state() if world.pendulum is not None else None)
