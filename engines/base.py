@@ -247,27 +247,9 @@ class Engine:
                              "the analytic model allows, cannot carry the pendulum hinge in an "
                              "engine)")
         s.check_scene(scene)
-        need = required_friction(scene, excitation)
-        if s.friction is None:
-            friction = max(self.default_friction, FRICTION_MARGIN * need)
-        else:
-            friction = check_real(type(s).__name__, "friction", s.friction, 0.0, 1e3)
-            if friction < need:
-                raise ValueError(f"{type(s).__name__}: friction must be >= {need:.4g} for "
-                                 f"rocking without sliding in this scene and excitation (see "
-                                 f"analytic.bounds.required_friction), got {s.friction!r}")
-        steps = run_steps(s, excitation)
-        if steps > MAX_RUN_STEPS:
-            raise ValueError(f"{name}: a run of {steps * s.dt:.4g} s (t_max, or the excitation's "
-                             f"end plus t_cap) at dt = {s.dt:g} s is {steps:.3g} steps, over the "
-                             f"budget of {MAX_RUN_STEPS:.0e}; raise dt or shorten t_max")
-        self.scene, self.excitation, self.settings = scene, excitation, s
-        self.friction = friction
-        self.required_friction = need
-        self.step_index = 0
-        dt = s.dt
-        # The d'Alembert load is evaluated mid-step; from this step on it is 0.
-        self._load_end = max(0, math.ceil(excitation.end_time / dt) + 1)
+        self._start(scene, excitation, s, required_friction(scene, excitation),
+                    "for rocking without sliding in this scene and excitation (see "
+                    "analytic.bounds.required_friction)")
 
     def _init_kind(self, scene, excitation, s) -> None:
         """The checks of a scene of :mod:`analytic.kinds`: an initial tilt only as
@@ -286,22 +268,34 @@ class Engine:
         demand; the rocking demand of the other kinds has no model, so it is
         measured instead (PyBullet at its calibrated 1: no contact slips beyond
         the contact slop at the strong pulses of ``tests/engines/test_kinds_engines.py``)."""
-        name = self.name
         self.structure = geometry.structure_of(scene, s.theta0, s.psi0)
         need = excitation.acceleration_bound() / scene.g
-        friction = (max(self.default_friction, FRICTION_MARGIN * need) if s.friction is None
-                    else check_real(type(s).__name__, "friction", s.friction, 0.0, 1e3))
-        if friction < need:
-            raise ValueError(f"{type(s).__name__}: friction must be >= {need:.4g} (the peak "
-                             f"ground acceleration over g) for this excitation, got "
-                             f"{s.friction!r}")
+        self._start(scene, excitation, s, need,
+                    "(the peak ground acceleration over g) for this excitation")
+
+    def _start(self, scene, excitation, s, need: float, why: str) -> None:
+        """The checks every run shares, then its state: the friction (the engine's
+        default unless given, raised to ``FRICTION_MARGIN * need`` when the
+        excitation asks more; a value given must be at least ``need``, the
+        no-sliding bound, ``why`` saying which), the run budget
+        (:data:`MAX_RUN_STEPS`), and the step counter and load window."""
+        if s.friction is None:
+            friction = max(self.default_friction, FRICTION_MARGIN * need)
+        else:
+            friction = check_real(type(s).__name__, "friction", s.friction, 0.0, 1e3)
+            if friction < need:
+                raise ValueError(f"{type(s).__name__}: friction must be >= {need:.4g} {why}, "
+                                 f"got {s.friction!r}")
         steps = run_steps(s, excitation)
         if steps > MAX_RUN_STEPS:
-            raise ValueError(f"{name}: a run of {steps * s.dt:.4g} s at dt = {s.dt:g} s is "
-                             f"{steps:.3g} steps, over the budget of {MAX_RUN_STEPS:.0e}")
+            raise ValueError(f"{self.name}: a run of {steps * s.dt:.4g} s (t_max, or the "
+                             f"excitation's end plus t_cap) at dt = {s.dt:g} s is {steps:.3g} "
+                             f"steps, over the budget of {MAX_RUN_STEPS:.0e}; raise dt or "
+                             "shorten t_max")
         self.scene, self.excitation, self.settings = scene, excitation, s
         self.friction, self.required_friction = friction, need
         self.step_index = 0
+        # The d'Alembert load is evaluated mid-step; from this step on it is 0.
         self._load_end = max(0, math.ceil(excitation.end_time / s.dt) + 1)
 
     # ------------------------------------------------------------------ the hooks
