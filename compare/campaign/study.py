@@ -69,6 +69,9 @@ class Study:
     rel_tol: float = 4e-3  # a fifth of the 2 % acceptance (the --quick report's value)
     workers: int = 2  # the target machine has 2 cores
     records: object = None  # compare.campaign.record_study.RecordAxis, or None
+    # Scenes of another kind (analytic.kinds): answered by the engines' consensus
+    # (compare.campaign.kind_study), never against the model; ``scenes`` are triliths.
+    kind_scenes: tuple[str, ...] = ()
 
     def describe(self) -> dict:
         out = {f: getattr(self, f) for f in self.__dataclass_fields__}
@@ -130,17 +133,16 @@ def load_study(path) -> Study:
             raise ValueError(f"{where}: scenes: {pattern!r} matches no scene; allowed: "
                              f"{', '.join(scene_names())} (or globs)")
         names += [n for n in hits if n not in names]
-    for n in names:  # a campaign measures engines against the model
-        kind = getattr(load_scene(n), "kind", "trilith")
-        if kind != "trilith":
-            raise ValueError(f"{where}: scenes: {n!r} is of the {kind} kind, which the analytic "
-                             f"model does not cover (docs/geometry.md)")
     engines = [str(e) for e in _list(table, "engines", where)]
     engines = list(ENGINES) if engines == ["all"] else engines
     for e in engines:
         if e not in ENGINES:
             raise ValueError(f"{where}: engines: unknown engine {e!r}; allowed: "
                              f"{', '.join(ENGINES)} or all")
+    kinds = [n for n in names if getattr(load_scene(n), "kind", "trilith") != "trilith"]
+    if kinds:
+        _check_kind_engines(kinds, engines, where)
+    names = [n for n in names if n not in kinds]
     pulses = [str(p) for p in _list(table, "pulses", where)] if "pulses" in table else ["sine"]
     for p in pulses:
         if p not in PULSE_FAMILY:
@@ -183,11 +185,33 @@ def load_study(path) -> Study:
         shown = repr(workers) if len(repr(workers)) <= 40 else f"a {type(workers).__name__}"
         raise ValueError(f"{where}: campaign.workers must be an integer in [1, 256] (as "
                          f"--workers), got {shown}")
-    return Study(name=name, scenes=tuple(names),
+    if records is not None and kinds:
+        raise ValueError(f"{where}: records: the record axis needs the model's IDA, which "
+                         f"the {', '.join(kinds)} scene(s) of another kind do not have; "
+                         f"give them in a campaign without [campaign.records]")
+    if kinds and len(omegas) == 0:
+        raise ValueError(f"{where}: campaign.omega is needed for the scenes of another kind "
+                         f"({', '.join(kinds)}): they are answered pulse by pulse")
+    return Study(name=name, scenes=tuple(names), kind_scenes=tuple(kinds),
                  engines=tuple(engines), pulses=tuple(pulses),
                  omegas=tuple(float(w) for w in np.asarray(omegas)), steps=tuple(steps),
                  cases=tuple(cases), rel_bracket=rel_bracket, rel_tol=rel_tol,
                  workers=workers, records=records)
+
+
+def _check_kind_engines(kinds: list[str], engines: list[str], where: str) -> None:
+    """Scenes of another kind are answered by two or more engines against each other,
+    each one that builds them (:data:`engines.geometry.STRUCTURE_ENGINES`)."""
+    from trilith_xval.engines.geometry import STRUCTURE_ENGINES
+    others = [e for e in engines if e not in STRUCTURE_ENGINES]
+    if others:
+        raise ValueError(f"{where}: engines: {', '.join(others)} run(s) the parametric trilith "
+                         f"only, not the scene(s) of another kind {', '.join(kinds)} (engines "
+                         f"that run them: {', '.join(STRUCTURE_ENGINES)})")
+    if len(engines) < 2:
+        raise ValueError(f"{where}: engines: the scene(s) of another kind {', '.join(kinds)} "
+                         f"have no model and are answered by the engines against each other: "
+                         f"give two or more, got {', '.join(engines)}")
 
 
 def _scene(name: str, case: str):

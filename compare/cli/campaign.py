@@ -131,10 +131,15 @@ def run(args: argparse.Namespace) -> int:
         jobs = threshold_jobs(study, references, None if loaded is None else loaded.tables)
         unique, index = distinct(jobs)
         est = _estimates(unique, store)
+        from trilith_xval.compare.campaign.kind_study import kind_points
+        n_kind = len(kind_points(study))
+        others = (f"; {n_kind} points of {len(study.kind_scenes)} scene(s) of another kind, "
+                  f"engine against engine (a scan and {len(study.engines)} converged searches "
+                  "each; not in the estimate)" if n_kind else "")
         print(f"campaign {study.name}: {len(study.scenes)} scenes, {len(ref_jobs)} reference "
               f"points, {len(jobs)} engine threshold jobs ({len(unique)} distinct); at most {_duration(sum(est))} of "
               f"CPU, ~{_duration(sum(est) / workers)} on {workers} workers (jobs already in "
-              "the store cost nothing)",
+              f"the store cost nothing){others}",
               # Asked for with --estimate it is the result (stdout); before a run, a
               # progress line (stderr).
               file=sys.stdout if args.estimate else sys.stderr, flush=True)
@@ -145,6 +150,14 @@ def run(args: argparse.Namespace) -> int:
                                   on_done=lambda i, r: bar.update(est[i])))
         bar.close()
         rows = [{**done[i], "scene": job.scene, "case": job.case} for job, i in zip(jobs, index)]
+        kind_rows = []
+        if study.kind_scenes:
+            from trilith_xval.compare.campaign.kind_study import kind_rows as consensus_rows
+            from trilith_xval.compare.run.progress import bar as count_bar
+            kbar = count_bar(len(kind_points(study)) * (1 + len(study.engines)),
+                             "campaign: engines against each other", "jobs")
+            kind_rows = consensus_rows(study, workers, on_done=lambda i, r: kbar.update(1))
+            kbar.close()
         record_refs: list = []
         if study.records is not None:
             from trilith_xval.compare.cli.campaign_records import record_rows
@@ -153,6 +166,7 @@ def run(args: argparse.Namespace) -> int:
         doc = {"study": study.describe(), "references": [
             {"scene": n, "case": c, "pulse": p, "omega": w, "a_reference": a, "mode": m}
             for (n, c, p, w), (a, m) in references.items()] + record_refs, "rows": rows,
+            "consensus": kind_rows,
             "summary": summarise(rows), "versions": _versions(study),
             "settings_file": None if loaded is None else loaded.describe(),
             "wall_time": time.perf_counter() - t0}
@@ -246,15 +260,38 @@ def write_campaign(doc: dict, out: Path) -> None:
             "table{border-collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;"
             "padding:2px 6px;text-align:right}</style></head><body>"
             f"<h1>Campaign {html.escape(study['name'])}</h1>"
-            f"<p>{len(study['scenes'])} scenes, engines {', '.join(study['engines'])}, "
+            f"<p>{len(study['scenes']) + len(study.get('kind_scenes') or ())} scenes, engines {', '.join(study['engines'])}, "
             f"steps {study['steps']}, Omega {study['omegas']} rad/s; engine overturning "
             "threshold against the analytic one (rel_error = A_engine/A_analytic - 1).</p>"
             "<h2>Summary</h2>" + table(doc["summary"], list(doc["summary"][0]) if
                                        doc["summary"] else [])
             + "<h2>Every job</h2>" + table(doc["rows"], cols)
+            + _consensus_section(doc.get("consensus") or [], study["engines"], table)
             + f"<h2>Versions</h2>{table([doc['versions']], list(doc['versions']))}"
             "</body></html>\n")
     atomic.write_text(out / "index.html", page)
+
+
+def _consensus_section(rows: list[dict], engines: list[str], table) -> str:
+    """The points of the scenes of another kind (compare.campaign.kind_study): each
+    engine's own first failure and the consensus, headed as engine against engine."""
+    if not rows:
+        return ""
+    flat = []
+    for r in rows:
+        row = {k: r.get(k) for k in ("scene", "case", "pulse", "omega", "status", "median",
+                                     "failure")}
+        for e in engines:
+            got = (r.get("engines") or {}).get(e)
+            row[f"{e} [m/s^2]"] = got["a_fails"] if got else None
+            row[f"{e} dev."] = got["deviation"] if got else None
+        row["outliers"] = "; ".join(f"{o['engine']} ({o['cause']})" for o in r["outliers"])
+        row["no answer"] = "; ".join(f"{m['engine']} ({m['cause']})" for m in r["no_answer"])
+        flat.append(row)
+    return ("<h2>Scenes of another kind: engine against engine</h2><p>The model does not "
+            "cover these scenes (docs/geometry.md): each engine's own first failure "
+            "(overturn or collapse), converged in the step, and the median of the engines; "
+            "never agreement with the model.</p>" + table(flat, list(flat[0])))
 
 
 def _fmt(value) -> str:
