@@ -64,6 +64,8 @@ class DartWorld:
         shapes' values, so every contact gets exactly this one.
     detector : {'dart', 'fcl', 'bullet', 'ode'}
         Collision detector.
+    deactivation : bool
+        Keep dartpy's body deactivation (its default, True) or switch it off.
 
     The planar joints hang from the world origin, so a body's coordinates are
     its centre ``(x, z)`` and CCW angle in the analytic plane.  Skeletons are
@@ -72,12 +74,16 @@ class DartWorld:
     unchanged bit for bit, ``tests/engines/test_structure_3d.py``).
     """
 
-    def __init__(self, structure, dt: float, friction: float, detector: str):
+    def __init__(self, structure, dt: float, friction: float, detector: str,
+                 deactivation: bool = True):
         self.structure = structure
         self.world = w = dart.simulation.World()
-        # dartpy 6.20 puts bodies to sleep by default (slower than 0.01 m/s and 0.05
-        # rad/s for 0.5 s: every velocity set to 0); left as the trilith's calibration
-        # and thresholds were measured with it (its effect: docs/geometry.md, DART).
+        if not deactivation:
+            # dartpy 6.20 puts bodies to sleep by default (slower than 0.01 m/s and
+            # 0.05 rad/s for 0.5 s: every velocity set to 0); docs/dart.md.
+            options = w.getDeactivationOptions()
+            options.mEnabled = False
+            w.setDeactivationOptions(options)
         w.setTimeStep(dt)
         w.setGravity([0.0, 0.0, -structure.g])
         w.getConstraintSolver().setCollisionDetector(_detector(detector))

@@ -176,7 +176,7 @@ def test_a_small_tilt_turns_the_whole_structure_rigidly():
 # DART (dartpy 6.20) puts bodies to sleep (World.getDeactivationOptions: enabled,
 # below 0.01 m/s and 0.05 rad/s for 0.5 s): 0.5 s after this pulse every velocity
 # is set to 0 and the bob stops mid-swing (measured: frozen from t = 1.2856 s, the
-# same in the trilith fig5 under this pulse; the engine does not switch it off).
+# same in the trilith fig5 under this pulse; the engine keeps dartpy's default).
 # With deactivation off DART's bob follows the reference to 1.4e-4 of the swing.
 _SLEEPS = pytest.mark.xfail(strict=True, reason="DART's body deactivation freezes the bob "
                             "0.5 s after the pulse")
@@ -194,6 +194,16 @@ _BOB_MARKS = {"dart": _SLEEPS, "drake": _COMPLIANT}
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=_BOB_MARKS[e]) if e in _BOB_MARKS
                                     else e for e in geometry.STRUCTURE_ENGINES])
 def test_below_uplift_the_drums_bob_is_a_pendulum_on_a_rigid_base(engine):
+    _bob_on_a_rigid_base(engine)
+
+
+def test_dart_awake_bob_is_a_pendulum_on_a_rigid_base():
+    # The same check with DART's body deactivation off (Settings.deactivation): the
+    # freeze above is deactivation alone, not DART's contact or joints.
+    _bob_on_a_rigid_base("dart", deactivation=False)
+
+
+def _bob_on_a_rigid_base(engine, **settings):
     # Where a limit is exact: the frame does not uplift (1 m/s^2 against g b/H = 1.96),
     # so the bob swings on a rigidly moving hinge, psi'' = -(g sin psi + a(t) cos psi)/l,
     # whatever the columns are made of.  Integrated here independently of the model.
@@ -204,7 +214,7 @@ def test_below_uplift_the_drums_bob_is_a_pendulum_on_a_rigid_base(engine):
     scene = Drums(b=0.6, heights=(1.5, 1.5), mu=1.0, gamma=0.3, name="drums_bob")
     pulse = Pulse(1.0, 8.0)
     backend = get_backend(engine)
-    tr = backend.simulate(scene, pulse, backend.Settings(t_max=2.0))
+    tr = backend.simulate(scene, pulse, backend.Settings(t_max=2.0, **settings))
     assert tr.verdict.status == "survived" and tr.max_abs_theta < 1e-6
     l, g = scene.base.pendulum_length, scene.g
     ref = solve_ivp(lambda t, y: (y[1], -(g * np.sin(y[0]) + pulse.acceleration(t)
