@@ -3,12 +3,12 @@
 A campaign file may list scenes the model does not cover (:mod:`analytic.kinds`:
 drums, unequal columns, a block on a block).  There is no analytic reference
 there, so each (scene, case, pulse, Omega) point is answered as ``trilith
-spectrum --consensus`` answers it (:mod:`compare.cli.spectrum_kinds`):
+spectrum --consensus`` answers it (:mod:`compare.measure.kind_scan`):
 
 1. **The guess** (:class:`ScanJob`): the study's first engine's verdicts at
    amplitudes growing from the structure's static uplift bound, the geometric
    mean of the last survival and the first failure
-   (:func:`compare.cli.spectrum_kinds.scan_guess`); it replaces the model's number
+   (:func:`compare.measure.kind_scan.scan_guess`); it replaces the model's number
    as the searches' start.
 2. **Each engine's own first failure**, converged in the step
    (:class:`compare.campaign.atlas_consensus.ConsensusJob`, the atlas's job).
@@ -51,7 +51,7 @@ class ScanJob:
 
     def description(self) -> dict:
         """Everything the scan's result depends on (its store key)."""
-        from trilith_xval.compare.cli.spectrum_kinds import SCAN_FACTOR, SCAN_STEPS
+        from trilith_xval.compare.measure.kind_scan import SCAN_FACTOR, SCAN_STEPS
         from trilith_xval.compare.run.keys import backend_version, scene_dict, settings_dict
         spec = self.spec()
         return {"engine": self.engine, "version": backend_version(self.engine),
@@ -63,7 +63,7 @@ class ScanJob:
 def run_scan(job: ScanJob) -> dict:
     """``{'a_guess': [m/s^2] or None, 'runs': n}`` through the store; an exception
     becomes ``error``."""
-    from trilith_xval.compare.cli.spectrum_kinds import scan_guess
+    from trilith_xval.compare.measure.kind_scan import scan_guess
 
     def compute():
         guess, n = scan_guess(job.spec(), job.omega, job.pulse)

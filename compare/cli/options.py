@@ -151,8 +151,19 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes")
+# --consensus, trust, report), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "trust", "report")
+
+
+def check_structure_engines(names, kind: str, command: str) -> None:
+    """One line refusing an engine that builds the parametric trilith only
+    (:data:`engines.geometry.STRUCTURE_ENGINES`) for a scene of ``kind``."""
+    from trilith_xval.engines.geometry import STRUCTURE_ENGINES
+    for name in names:
+        if name not in STRUCTURE_ENGINES:
+            raise ValueError(f"trilith {command}: {name} runs the parametric trilith only, not "
+                             f"the {kind} kind (engines that run it: "
+                             f"{', '.join(STRUCTURE_ENGINES)})")
 
 
 def check_kind(scene, command: str | None) -> None:
@@ -163,8 +174,8 @@ def check_kind(scene, command: str | None) -> None:
     if kind == "trilith" or command is None or command in KIND_COMMANDS:
         return
     raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
-                     f"analytic model does not cover; 'trilith simulate' and 'trilith spectrum "
-                     f"--consensus E1,E2' run it (docs/geometry.md)")
+                     f"analytic model does not cover; 'trilith simulate', 'trilith spectrum "
+                     f"--consensus E1,E2' and 'trilith trust' run it (docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:

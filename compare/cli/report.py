@@ -10,6 +10,13 @@ threshold points and shows the rest from the stored validation, labelled
 Exit code 0 when the report was written, whatever the verdicts say (they are
 the report's content), unless ``--strict``: then 1 when a verdict fails (for
 CI jobs); 1 when a re-verified stored value disagrees; 2 on bad input.
+
+On a scene of another kind (drums, unequal, block_on_block) there is no model and
+no validation campaign: the report is the kind's trust page, engine against
+engine, the same as ``trilith trust --scene KIND`` writes (``DIR/index.html``,
+``DIR/trust.json``, ``DIR/trust.csv``), one stderr line saying so; ``--quick``,
+``--full``, ``--dt``, ``--settings`` and ``--record`` do not apply there, and
+``--strict`` exits 1 when an engine is not trusted.
 """
 from __future__ import annotations
 
@@ -34,8 +41,9 @@ from trilith_xval.compare.cli.options import add_store_args, use_store
 
 
 def add_parser(subparsers) -> None:
-    p = subparsers.add_parser("report", help="run the validation campaign, write an HTML/JSON report",
-                              description=__doc__)
+    p = subparsers.add_parser("report", description=__doc__,
+                              help="run the validation campaign, write an HTML/JSON report "
+                                   "(on another kind: its trust page, engine against engine)")
     scene_group(p).add_argument("--scene", default="fig5", help="scene name or TOML path")
     add_engine_list_arg(p, engine_names())
     how = p.add_mutually_exclusive_group()
@@ -120,6 +128,31 @@ def _render_stored(args: argparse.Namespace) -> int:
 _RUN_OPTIONS = ("quick", "full", "dt", "settings", "record")
 
 
+def _kind_report(args: argparse.Namespace, scene) -> int:
+    """The report of a scene of another kind: its trust page (module docstring)."""
+    from trilith_xval.compare.cli import options as _options
+    from trilith_xval.compare.cli.trust_kinds import (check_kind_trust, print_verdicts,
+                                                      write_kind_trust)
+    given = [f"--{n}" for n in _RUN_OPTIONS if getattr(args, n, None) not in (None, False)]
+    if given:
+        raise ValueError(f"trilith report on the {scene.kind} kind: {', '.join(given)} do not "
+                         "apply (no model, no validation campaign: its trust page is written)")
+    engines = parse_engines(args.engine)
+    check_kind_trust(scene, engines, None, "report")
+    out = check_output_path(args.out, "--out", directory=True, replace=True)
+    use_store(args)
+    if _options.VERBOSITY >= 0:
+        print(f"report: {scene.name} is of the {scene.kind} kind, which the model does not "
+              f"cover: writing its trust page (engine against engine, as 'trilith trust "
+              f"--scene {args.scene}') into {out}", file=sys.stderr)
+    _options.step_notes(engines, [scene])
+    doc = write_kind_trust(scene, engines, out, _options.VERBOSITY < 0)
+    print_verdicts(doc)
+    print(f"report written to {Path(out) / 'index.html'} (trust.json, trust.csv)")
+    failed = [e for e, v in doc["engines"].items() if v["threshold_verdict"]["trusted"] is False]
+    return 1 if args.strict and failed else 0
+
+
 def run(args: argparse.Namespace) -> int:
     from trilith_xval.compare.cli.excitation_args import record_suite
 
@@ -132,7 +165,10 @@ def run(args: argparse.Namespace) -> int:
     # The door: every option checked, the output directory made writable, before
     # the campaign (which takes minutes) is even imported.
     # The file's errors name the file; another kind than the trilith has no model.
-    check_kind(load_scene(args.scene), "report")
+    scene = load_scene(args.scene)
+    if getattr(scene, "kind", "trilith") != "trilith":
+        return _kind_report(args, scene)
+    check_kind(scene, "report")
     engines = parse_engines(args.engine)
     workers = resolve_workers(args.workers)
     if args.dt is not None and not (math.isfinite(args.dt)

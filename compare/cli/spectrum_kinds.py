@@ -1,66 +1,22 @@
 """``trilith spectrum --consensus`` on a scene the model does not cover
-(:mod:`analytic.kinds`: drums, unequal columns, a block on a block).
-
-There is no model spectrum to bisect around, so each frequency is answered by the
-engines alone (:mod:`compare.measure.consensus`): each engine's own first-failure
-amplitude (an overturn or a collapse, :mod:`engines.structure_monitor`),
-converged in the step, and their consensus.  The consensus search starts from a
-guess; without a model the guess is a scan: the first engine's verdicts at
-amplitudes growing by :data:`SCAN_FACTOR` from the structure's static uplift
-bound ``g w_min / (2 H)`` (:func:`uplift_bound`), the geometric mean of
-the last survival and the first failure.
+(:mod:`analytic.kinds`: drums, unequal columns, a block on a block): each
+frequency answered by the engines alone, started from a scan
+(:mod:`compare.measure.kind_scan`).
 """
 from __future__ import annotations
 
-import math
-
 from trilith_xval.compare.cli.options import envelope, info, print_json
 
-__all__ = ["kind_spectrum", "scan_guess", "SCAN_FACTOR", "SCAN_STEPS"]
-
-# Amplitude ratio of two scan probes: the threshold search then widens its bracket
-# up to +-115 % around the guess (compare.measure.thresholds.Search.max_expand), so a
-# scan bracket of 1.5 is well inside what it can reach.
-SCAN_FACTOR = 1.5
-# Probes of the scan: 1.5^14 ~ 290 times the uplift bound, past any one-sine
-# threshold of a standing structure (Fig. 5's highest is ~40 times g/lam).
-SCAN_STEPS = 14
-
-
-def uplift_bound(scene) -> float:
-    """``g w_min / (2 H)`` [m/s^2], ``w_min`` the narrowest body's width and ``H`` the
-    structure's height: below the static uplift of any rigid part of it (about any
-    corner its lever to its centre of mass is at least ``w_min / 2`` for centred
-    bodies, the centre at most ``H`` above the pivot), so the scan starts below
-    the first failure."""
-    rects = scene.layout()
-    top = max(r.top for r in rects)
-    return 0.5 * scene.g * min(r.b for r in rects) / top
-
-
-def scan_guess(spec, omega: float, kind) -> tuple[float | None, int]:
-    """``(guess [m/s^2] or None, runs)``: the geometric mean of the last surviving and
-    the first failing amplitude of the scan (module docstring) on ``spec``'s engine."""
-    from trilith_xval.compare.measure.engine_spectrum import point_spec
-    from trilith_xval.compare.measure.thresholds import overturns
-    a, survived = uplift_bound(spec.scene), None
-    for k in range(SCAN_STEPS):
-        run = point_spec(spec, spec.scene, omega, a, kind)
-        p = overturns(run.backend, run.scene, omega, a, run.settings, kind)
-        if p.status in ("overturned", "collapsed"):
-            low = survived if survived is not None else a / SCAN_FACTOR
-            return math.sqrt(low * a), k + 1
-        survived = a
-        a *= SCAN_FACTOR
-    return None, SCAN_STEPS
+__all__ = ["kind_spectrum"]
 
 
 def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
     """The command for a scene of another kind (module docstring)."""
     from trilith_xval.compare.cli.pulse_shape import shape_from_args
     from trilith_xval.compare.cli.spectrum_engines import check_engine_budget, engine_runs
-    from trilith_xval.compare.cli.options import parse_engine_list, use_store
-    from trilith_xval.compare.measure.consensus import consensus_at
+    from trilith_xval.compare.cli.options import (check_structure_engines, parse_engine_list,
+                                                  use_store)
+    from trilith_xval.compare.measure.kind_scan import kind_point
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
 
     kind = scene.kind
@@ -84,11 +40,7 @@ def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
     if len(names) < 2:
         raise ValueError(f"--consensus compares engines with each other: give two or more, "
                          f"got {', '.join(names) or 'none'}")
-    for name in names:
-        if name not in STRUCTURE_ENGINES:
-            raise ValueError(f"trilith spectrum: {name} runs the parametric trilith only, not "
-                             f"the {kind} kind (engines that run it: "
-                             f"{', '.join(STRUCTURE_ENGINES)})")
+    check_structure_engines(names, kind, "spectrum")
     omegas = parse_omega_range(args.omega, "--omega")
     shape = shape_from_args(args)
     loaded = settings_from_args(args, names)
@@ -98,19 +50,10 @@ def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
                 for n, r in runs.items()}
     check_engine_budget(args, runs, omegas, shape)
     use_store(args)
-    first = next(iter(runs.values()))
     points, n_scan = [], 0
     for omega in omegas:
-        guess, n = scan_guess(first, float(omega), shape)
+        point, n = kind_point(runs, scene, float(omega), shape)
         n_scan += n
-        if guess is None:
-            points.append({"omega": float(omega), "status": "none", "median": None,
-                           "a_guess": None, "engines": {}, "outliers": [], "no_answer": [
-                               {"engine": e, "cause": "no failure",
-                                "detail": "no failure up to the scan's end"} for e in names]})
-            continue
-        point = consensus_at(runs, scene, float(omega), guess, shape)
-        point["a_guess"] = point.pop("a_model")  # a scan's guess, not a model's number
         points.append(point)
     if args.json:
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": shape,

