@@ -118,8 +118,9 @@ def kind_trust_html(doc: dict) -> str:
     from trilith_xval.compare.report.html import _CSS
     esc = html.escape
     sc, d = doc["scene"], doc["design"]
-    head = ["pulse"] + CONSENSUS_HEAD[1:2] + ["scan's guess [m/s²]"] + CONSENSUS_HEAD[3:]
-    cons = [consensus_row("one sine", p["omega"], p["a_guess"], p) for p in doc["points"]]
+    # One-sine pulses only: the atlas's case column is dropped; the guess is the scan's.
+    head = CONSENSUS_HEAD[1:2] + ["scan's guess [m/s²]"] + CONSENSUS_HEAD[3:]
+    cons = [consensus_row("", p["omega"], p["a_guess"], p)[1:] for p in doc["points"]]
     hist = (table(*_history_rows(doc)) if doc["histories"] else
             "<p>No frequency with a consensus threshold: no time histories.</p>")
     body = [f"<h1>Which engine to trust on <code>{esc(str(sc.get('name')))}</code> "
