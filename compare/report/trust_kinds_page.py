@@ -32,6 +32,15 @@ def _histories(entry: dict) -> dict:
     return _cell(word, v["agrees"], v["why"])
 
 
+def _records(entry: dict) -> dict:
+    v = entry.get("record_verdict")
+    if v is None:
+        return _cell("no record given (--record)")
+    word = {True: "trusted (engine against engine)", False: "not trusted",
+            None: "not judged (no consensus)"}[v["trusted"]]
+    return _cell(word, v["trusted"], v["why"])
+
+
 def _settings(entry: dict) -> dict:
     return _cell(f"thresholds at dt = {fmt_sci(entry['threshold_dt'])} s, converged in the "
                  f"step from there; time histories at {fmt_sci(entry['reference_dt'])} s",
@@ -60,8 +69,8 @@ def kind_trust_rows(doc: dict) -> tuple[list[str], list[list]]:
                                                                  no["model_theta"])),
             ("time histories, engine against engine (survive or fail at 0.9x, 1.1x the "
              "consensus)", _histories),
-            ("ground motions", lambda e: _cell("not measured: --record is refused on "
-                                               "another kind")),
+            ("ground motions (first failing PGA, within 2 % of the engines' median)",
+             _records),
             ("settings", _settings), ("cost", _cost)]
     return header, [[name] + [fn(doc["engines"][e]) for e in engines] for name, fn in spec]
 
@@ -121,6 +130,14 @@ def kind_trust_html(doc: dict) -> str:
     # One-sine pulses only: the atlas's case column is dropped; the guess is the scan's.
     head = CONSENSUS_HEAD[1:2] + ["scan's guess [m/s²]"] + CONSENSUS_HEAD[3:]
     cons = [consensus_row("", p["omega"], p["a_guess"], p)[1:] for p in doc["points"]]
+    recs = "".join([
+        "<h2>Ground motions: engine against engine</h2><p>Each engine's own first failing "
+        "PGA of each record (the record scaled; every run over the record and "
+        f"{esc(str(doc.get('record_tail', '')))} s after it), converged in the step, "
+        "and their median.</p>",
+        consensus_table(["record", "scan's guess [m/s²]"] + CONSENSUS_HEAD[3:],
+                        [[r["record"]] + consensus_row("", 0.0, r["a_guess"], r)[2:]
+                         for r in doc["records"]])] if doc["records"] else [])
     hist = (table(*_history_rows(doc)) if doc["histories"] else
             "<p>No frequency with a consensus threshold: no time histories.</p>")
     body = [f"<h1>Which engine to trust on <code>{esc(str(sc.get('name')))}</code> "
@@ -139,7 +156,7 @@ def kind_trust_html(doc: dict) -> str:
             + esc(doc["no_model"]["model_theta"]) + ".</p>",
             "<h2>Trust table</h2>", table(*kind_trust_rows(doc)),
             "<h2>Consensus: engine against engine</h2>", consensus_table(head, cons),
-            "<h2>Time histories: engine against engine</h2>", hist,
+            "<h2>Time histories: engine against engine</h2>", hist, recs,
             "<h2>Each engine's own first failure</h2>", table(*kind_point_rows(doc)),
             f"<p class='small'>{esc(doc['project'])}; CPU {doc['cost']['cpu_s']:.1f} s in "
             f"this process, wall {doc['cost']['wall_s']:.1f} s, load average "

@@ -41,6 +41,7 @@ def test_trust_on_drums_is_engine_against_engine(tmp_path, capsys, cheap):
     assert {"index.html", "trust.csv", "trust.json"} <= {p.name for p in out.iterdir()}
     doc = json.loads((out / "trust.json").read_text())
     assert doc["kind"] == "drums" and doc["model"] is None and doc["records"] is None
+    assert all(e["record_verdict"] is None for e in doc["engines"].values())
     assert set(doc["no_model"]) == {"restitution", "model_theta"}
     (point,) = doc["points"]
     fails = {e: o["a_fails"] for e, o in point["own"].items() if o["converged"]}
@@ -74,7 +75,7 @@ def test_trust_on_drums_is_engine_against_engine(tmp_path, capsys, cheap):
 
 @pytest.mark.parametrize("argv, word", [
     (["--engine", "drake,pymunk"], "drake runs the parametric trilith only, not the drums kind"),
-    (["--engine", "pymunk,mujoco", "--record", "sample"], "trust --record: not available"),
+    (["--engine", "pymunk,mujoco", "--record", "/nonexistent.csv"], "--record"),
     (["--engine", "nosuch"], "--engine"),
     (["--engine", "pymunk", "--set", "lam=3"], "--set lam: not a value of the drums kind"),
 ])
@@ -130,6 +131,32 @@ def test_the_design_follows_the_slowest_stack():
     omegas = trust_kinds.design_omegas(load_scene("drums"))
     assert len(omegas) == 6 and omegas == sorted(omegas)
     assert math.isclose(omegas[-1] / omegas[0], 6.0, rel_tol=1e-3)
+
+
+def test_a_record_on_a_kind_is_engine_against_engine(tmp_path, capsys, monkeypatch):
+    # The record's own window (its 10 s and the tail) runs; 1e-3 s keeps it to seconds.
+    monkeypatch.setattr(trust_kinds, "trust_kind",
+                        functools.partial(trust_kinds.trust_kind, over_p=(4.0,),
+                                          options={"dt": 1e-3}))
+    out = tmp_path / "t"
+    code = main(["trust", "--scene", "block_on_block", "--engine", "pymunk,mujoco",
+                 "--record", "scenes/records/sample.csv", "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    doc = json.loads((out / "trust.json").read_text())
+    (rec,) = doc["records"]
+    assert rec["record"] == "sample.csv" and rec["im"] == "pga"
+    fails = {e: o["a_fails"] for e, o in rec["own"].items() if o["converged"]}
+    for e, entry in doc["engines"].items():
+        trusted = entry["record_verdict"]["trusted"]
+        if len(fails) == 2:
+            assert min(fails.values()) <= rec["median"] <= max(fails.values())
+            assert trusted is (abs(rec["engines"][e]["deviation"]) <= OUTLIER_TOL)
+        else:
+            assert trusted is (None if e in fails else False)
+    assert "Ground motions: engine against engine" in (out / "index.html").read_text()
+    assert "trust: 3/3 ground motions, engine against engine 1/1" in captured.err
+    assert "MuJoCo: ground motions " in captured.out
 
 
 def test_report_on_a_kind_writes_its_trust_page(tmp_path, capsys, cheap):
