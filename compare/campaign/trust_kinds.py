@@ -151,14 +151,26 @@ def trust_kind(scene, engines, *, records=(), over_p=OVER_P, options: dict | Non
         No progress lines on stderr.
     """
     from trilith_xval.analytic.excitation import Still
+    from trilith_xval.analytic.ida import IDASettings
     from trilith_xval.compare.campaign.trust_check import _Progress, _cpu
     from trilith_xval.compare.measure.consensus import OUTLIER_TOL, STEP_AGREE
-    from trilith_xval.analytic.ida import IDASettings
     from trilith_xval.compare.measure.kind_scan import kind_point, kind_record
     from trilith_xval.compare.run.keys import project_version
     from trilith_xval.compare.run.spec import RunSpec
     from trilith_xval.engines import configure, get_backend
     from trilith_xval.engines.calibration import threshold_choice
+    from trilith_xval.engines.geometry import STRUCTURE_ENGINES
+    if getattr(scene, "kind", "trilith") == "trilith":
+        raise ValueError("trust_kind: scene is a trilith, which the model covers; use "
+                         "compare.campaign.trust_check.trust_scene")
+    odd = [e for e in engines if e not in STRUCTURE_ENGINES]
+    if not engines or odd:
+        raise ValueError(f"trust_kind: engines must be one or more of "
+                         f"{', '.join(STRUCTURE_ENGINES)}, got {list(engines)!r}")
+    if not over_p or not all(isinstance(f, (int, float)) and math.isfinite(f) and f > 0
+                             for f in over_p):
+        raise ValueError(f"trust_kind: over_p must be positive finite multiples of p, "
+                         f"got {over_p!r}")
     t0, c0, load0 = time.perf_counter(), _cpu(), os.getloadavg()[0]
     layer = dict(overrides=options, overrides_from="trust_kind(options=...)")
     runs = {e: RunSpec.resolve(e, scene, Still(), calibrated=True, **layer) for e in engines}

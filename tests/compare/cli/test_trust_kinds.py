@@ -92,6 +92,16 @@ def test_bad_input_is_refused_before_any_work(tmp_path, capsys, no_work, monkeyp
     assert not out.exists()
 
 
+def test_the_api_refuses_bad_input_before_any_work(no_work):
+    drums = load_scene("drums")
+    for kwargs, word in [({"scene": load_scene("fig5")}, "scene is a trilith"),
+                         ({"engines": ("nosuch",)}, "engines must be one or more of"),
+                         ({"over_p": (4.0, -1.0)}, "over_p must be positive")]:
+        args = {"scene": drums, "engines": ("pymunk",), **kwargs}
+        with pytest.raises(ValueError, match=word):
+            trust_kinds.trust_kind(args.pop("scene"), args.pop("engines"), **args)
+
+
 def _point(omega, devs, missing=(), outliers=()):
     return {"omega": omega, "status": "consensus", "median": 10.0,
             "engines": {e: {"deviation": d} for e, d in devs.items()},
