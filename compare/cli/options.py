@@ -151,8 +151,8 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes")
+# --consensus, fragility), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "fragility")
 
 
 def check_kind(scene, command: str | None) -> None:

@@ -7,52 +7,29 @@ amplitude (an overturn or a collapse, :mod:`engines.structure_monitor`),
 converged in the step, and their consensus.  The consensus search starts from a
 guess; without a model the guess is a scan: the first engine's verdicts at
 amplitudes growing by :data:`SCAN_FACTOR` from the structure's static uplift
-bound ``g w_min / (2 H)`` (:func:`uplift_bound`), the geometric mean of
-the last survival and the first failure.
+bound ``g w_min / (2 H)`` (:func:`~compare.measure.consensus.uplift_bound`), the
+geometric mean of the last survival and the first failure
+(:func:`compare.measure.consensus.scan`, shared with ``trilith fragility``).
 """
 from __future__ import annotations
 
-import math
-
 from trilith_xval.compare.cli.options import envelope, info, print_json
+from trilith_xval.compare.measure.consensus import SCAN_FACTOR, SCAN_STEPS, scan, uplift_bound
 
-__all__ = ["kind_spectrum", "scan_guess", "SCAN_FACTOR", "SCAN_STEPS"]
-
-# Amplitude ratio of two scan probes: the threshold search then widens its bracket
-# up to +-115 % around the guess (compare.measure.thresholds.Search.max_expand), so a
-# scan bracket of 1.5 is well inside what it can reach.
-SCAN_FACTOR = 1.5
-# Probes of the scan: 1.5^14 ~ 290 times the uplift bound, past any one-sine
-# threshold of a standing structure (Fig. 5's highest is ~40 times g/lam).
-SCAN_STEPS = 14
-
-
-def uplift_bound(scene) -> float:
-    """``g w_min / (2 H)`` [m/s^2], ``w_min`` the narrowest body's width and ``H`` the
-    structure's height: below the static uplift of any rigid part of it (about any
-    corner its lever to its centre of mass is at least ``w_min / 2`` for centred
-    bodies, the centre at most ``H`` above the pivot), so the scan starts below
-    the first failure."""
-    rects = scene.layout()
-    top = max(r.top for r in rects)
-    return 0.5 * scene.g * min(r.b for r in rects) / top
+__all__ = ["kind_spectrum", "scan_guess", "uplift_bound", "SCAN_FACTOR", "SCAN_STEPS"]
 
 
 def scan_guess(spec, omega: float, kind) -> tuple[float | None, int]:
-    """``(guess [m/s^2] or None, runs)``: the geometric mean of the last surviving and
-    the first failing amplitude of the scan (module docstring) on ``spec``'s engine."""
+    """``(guess [m/s^2] or None, runs)``: the scan (:func:`compare.measure.consensus.scan`)
+    of ``spec``'s engine from the uplift bound at ``omega`` (module docstring)."""
     from trilith_xval.compare.measure.engine_spectrum import point_spec
     from trilith_xval.compare.measure.thresholds import overturns
-    a, survived = uplift_bound(spec.scene), None
-    for k in range(SCAN_STEPS):
+
+    def fails(a: float) -> bool:
         run = point_spec(spec, spec.scene, omega, a, kind)
         p = overturns(run.backend, run.scene, omega, a, run.settings, kind)
-        if p.status in ("overturned", "collapsed"):
-            low = survived if survived is not None else a / SCAN_FACTOR
-            return math.sqrt(low * a), k + 1
-        survived = a
-        a *= SCAN_FACTOR
-    return None, SCAN_STEPS
+        return p.status in ("overturned", "collapsed")
+    return scan(fails, uplift_bound(spec.scene))
 
 
 def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:

@@ -40,8 +40,9 @@ import statistics
 
 from trilith_xval.compare.measure.thresholds import SEARCH, engine_threshold
 
-__all__ = ["STEP_AGREE", "OUTLIER_TOL", "MAX_HALVINGS", "FAILURE_SEARCH", "own_threshold",
-           "consensus", "outlier_cause", "consensus_at", "where_model_cannot_judge"]
+__all__ = ["STEP_AGREE", "OUTLIER_TOL", "MAX_HALVINGS", "FAILURE_SEARCH", "SCAN_FACTOR",
+           "SCAN_STEPS", "own_threshold", "consensus", "outlier_cause", "consensus_at",
+           "where_model_cannot_judge", "uplift_bound", "scan"]
 
 # Two steps agree when their failing amplitudes differ by at most 1 %: half the
 # 2 % tolerance the engines are held to against the model, so a converged answer
@@ -56,6 +57,45 @@ MAX_HALVINGS = 2
 # The one search, counting a collapse as a failure and going on through it.
 FAILURE_SEARCH = dataclasses.replace(SEARCH, failure=("overturned", "collapsed"),
                                      stop_on_collapse=False)
+# Amplitude ratio of two scan probes (:func:`scan`): the threshold search then widens
+# its bracket up to +-115 % around the guess (compare.measure.thresholds.Search.max_expand),
+# so a scan bracket of 1.5 is well inside what it can reach.
+SCAN_FACTOR = 1.5
+# Probes of the scan: 1.5^14 ~ 290 times the uplift bound, past any one-sine
+# threshold of a standing structure (Fig. 5's highest is ~40 times g/lam).
+SCAN_STEPS = 14
+
+
+def uplift_bound(scene) -> float:
+    """``g w_min / (2 H)`` [m/s^2], ``w_min`` the narrowest body's width and ``H`` the
+    structure's height: below the static uplift of any rigid part of it (about any
+    corner its lever to its centre of mass is at least ``w_min / 2`` for centred
+    bodies, the centre at most ``H`` above the pivot), so a scan from it starts
+    below the first failure."""
+    rects = scene.layout()
+    top = max(r.top for r in rects)
+    return 0.5 * scene.g * min(r.b for r in rects) / top
+
+
+def scan(fails, start: float, top: float = math.inf) -> tuple[float | None, int]:
+    """Where a search without a model starts: ``(guess or None, runs)``.
+
+    ``fails(value) -> bool`` is probed at ``start`` times :data:`SCAN_FACTOR` to the
+    ``k``, ``k < SCAN_STEPS``, the last probe clipped to ``top`` (a search's upper
+    end: beyond it the answer is censored); the guess is the geometric mean of the
+    last survival and the first failure (``start / SCAN_FACTOR`` standing for the
+    survival when ``start`` already fails); None when nothing failed."""
+    a, survived = start, None
+    for k in range(SCAN_STEPS):
+        a = min(a, top)
+        if fails(a):
+            low = survived if survived is not None else a / SCAN_FACTOR
+            return math.sqrt(low * a), k + 1
+        if a >= top:
+            return None, k + 1
+        survived = a
+        a *= SCAN_FACTOR
+    return None, SCAN_STEPS
 
 
 def _failing_status(point) -> str | None:
@@ -74,7 +114,7 @@ def _row(point, dt: float) -> dict:
 
 
 def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
-                  rel_tol: float = SEARCH.rel_tol) -> dict:
+                  rel_tol: float = SEARCH.rel_tol, motion=None) -> dict:
     """One engine's own first-failure amplitude at ``omega`` [rad/s], converged in
     the step (module docstring, steps 1-2).
 
@@ -93,6 +133,11 @@ def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
         The pulse.
     rel_tol : float
         Final bracket width relative to ``a_guess`` (default 0.5 %).
+    motion : callable, optional
+        ``motion(value) -> excitation``: search the scale of a ground motion
+        instead of the pulse's amplitude
+        (:func:`compare.measure.thresholds.engine_threshold`); ``omega`` is then a
+        label (NaN allowed), ``a_guess`` and the results are intensities.
 
     Returns
     -------
@@ -110,7 +155,7 @@ def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
     for i, dt in enumerate(ladder):
         run = spec.with_options("the consensus's step", dt=dt)
         p = engine_threshold(spec.backend, spec.scene, omega, centre, run.settings, kind=kind,
-                             search=search)
+                             search=search, motion=motion)
         rows.append(_row(p, dt))
         points.append(p)
         if p.bracketed:
