@@ -151,8 +151,9 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus, fragility), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes", "fragility")
+# --consensus, fragility), the engine against its own reference step (calibrate),
+# the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "fragility", "calibrate")
 
 
 def check_kind(scene, command: str | None) -> None:
@@ -369,8 +370,11 @@ def run_spec(engine: str, scene, excitation, loaded=None, *, calibrated: bool = 
              overrides: dict | None = None):
     """``engine``'s run, resolved once (:class:`compare.run.spec.RunSpec`): its
     defaults, its calibration where ``calibrated`` (threshold searches), the
-    ``--settings`` table (``loaded``), then ``overrides`` (the command line)."""
+    ``--settings`` table (``loaded``; refused when the file's ``[domain]`` is of
+    another kind than ``scene``), then ``overrides`` (the command line)."""
     from trilith_xval.compare.run.spec import RunSpec
+    if loaded is not None and loaded.options(engine):
+        loaded.check_scene(scene)
     return RunSpec.resolve(engine, scene, excitation, calibrated=calibrated,
                            file_options=file_options(loaded, engine),
                            file_name="" if loaded is None else repr(str(loaded.path)),

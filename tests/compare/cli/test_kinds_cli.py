@@ -39,7 +39,6 @@ def test_simulate_with_the_model_says_there_is_none(capsys, no_work):
 NEED_MODEL = [
     ("map", []), ("trust", []), ("record", ["-A", "5", "-w", "8", "--out", "x.gif"]),
     ("restitution", []),
-    ("calibrate", ["--engine", "pymunk"]),
 ]
 
 
