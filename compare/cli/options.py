@@ -164,8 +164,9 @@ def check_kind(scene, command: str | None) -> None:
     if kind == "trilith" or command is None or command in KIND_COMMANDS:
         return
     raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
-                     f"analytic model does not cover; 'trilith simulate' and 'trilith spectrum "
-                     f"--consensus E1,E2' run it (docs/geometry.md)")
+                     f"analytic model does not cover; 'trilith simulate', 'spectrum --consensus "
+                     f"E1,E2', 'fragility --engine E1,E2' and 'calibrate' (its own reference "
+                     f"step) run it (docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
