@@ -151,9 +151,9 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus, fragility), the engine against its own reference step (calibrate),
-# the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes", "fragility", "calibrate")
+# --consensus, fragility, restitution), the engine against its own reference step
+# (calibrate), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "fragility", "calibrate", "restitution")
 
 
 def check_kind(scene, command: str | None) -> None:
@@ -165,8 +165,8 @@ def check_kind(scene, command: str | None) -> None:
         return
     raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
                      f"analytic model does not cover; 'trilith simulate', 'spectrum --consensus "
-                     f"E1,E2', 'fragility --engine E1,E2' and 'calibrate' (its own reference "
-                     f"step) run it (docs/geometry.md)")
+                     f"E1,E2', 'fragility --engine E1,E2', 'restitution --engine E1,E2' and "
+                     f"'calibrate' (its own reference step) run it (docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
