@@ -72,18 +72,31 @@ def scene_coordinates(scene) -> dict:
 @dataclass(frozen=True)
 class Domain:
     """``ranges``: coordinate -> (lo, hi), inclusive; a coordinate absent from
-    ``ranges`` was not varied, so no scene is inside for it."""
+    ``ranges`` was not varied, so no scene is inside for it.  ``kind``: the kind of
+    scene calibrated on (``[domain] kind``, default the parametric trilith); a
+    scene of another kind is outside, and a domain of another kind than the
+    trilith holds over that kind's scenes (they have none of the trilith's
+    coordinates; :mod:`analytic.kinds`)."""
 
     ranges: tuple = ()  # ((name, (lo, hi)), ...)
     no_pendulum: bool = False  # the pendulum-free curve (gamma = 0) was calibrated too
+    kind: str = "trilith"
 
     @classmethod
     def from_table(cls, table: dict, where: str) -> "Domain":
+        from trilith_xval.analytic.kinds import KINDS
         out = []
         table = dict(table)
         no_pendulum = table.pop("no_pendulum", False)
         if not isinstance(no_pendulum, bool):
             raise ValueError(f"{where}: [domain] no_pendulum must be true or false")
+        kind = table.pop("kind", "trilith")
+        if kind != "trilith" and kind not in KINDS:
+            raise ValueError(f"{where}: [domain] kind must be one of "
+                             f"{', '.join(['trilith', *KINDS])}, got {kind!r}")
+        if kind != "trilith" and (table or no_pendulum):
+            raise ValueError(f"{where}: [domain] of the {kind} kind takes no trilith "
+                             f"coordinate, got {', '.join(table) or 'no_pendulum'}")
         for name, value in table.items():
             if name not in COORDINATES:
                 raise ValueError(f"{where}: [domain] {name} is not a coordinate; allowed: "
@@ -94,13 +107,22 @@ class Domain:
                 raise ValueError(f"{where}: [domain] {name} must be [lo, hi] with finite "
                                  f"lo <= hi, got {value!r}")
             out.append((name, (float(value[0]), float(value[1]))))
-        return cls(tuple(out), no_pendulum)
+        return cls(tuple(out), no_pendulum, kind)
 
     def as_dict(self) -> dict:
+        if self.kind != "trilith":
+            return {"kind": self.kind}
         return {**{k: list(v) for k, v in self.ranges}, "no_pendulum": self.no_pendulum}
 
     def outside(self, scene) -> str | None:
-        """Why ``scene`` is outside (the first coordinate that leaves it), or None."""
+        """Why ``scene`` is outside (another kind, or the first coordinate that
+        leaves it), or None."""
+        kind = getattr(scene, "kind", "trilith")  # a Scene has no kind: the trilith
+        if kind != self.kind:
+            return (f"{scene.name} is of the {kind} kind, the calibration's of the "
+                    f"{self.kind} kind")
+        if kind != "trilith":
+            return None
         coords = scene_coordinates(scene)
         ranges = dict(self.ranges)
         for name in COORDINATES:

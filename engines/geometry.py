@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 __all__ = ["RestPoses", "size", "column_lefts", "rest_poses", "base_corners", "box_inertia",
            "ground_box", "Box", "Bob", "Structure", "structure_of", "TRILITH_KINDS",
-           "STRUCTURE_ENGINES"]
+           "STRUCTURE_ENGINES", "RELEASE_KINDS", "MAX_KIND_TILT", "release_limit"]
 
 # The kinds the parametric Scene describes (the analytic model's mechanism).
 TRILITH_KINDS = ("trilith", "block")
@@ -260,16 +260,17 @@ def structure_of(scene, theta0: float = 0.0, psi0: float = 0.0) -> Structure:
     A parametric :class:`~analytic.parameters.Scene` gives the trilith (``mu >
     0``) or the two free blocks (``mu = 0``) tilted by ``theta0`` [rad] with the
     bob at ``psi0`` [rad] (:func:`rest_poses`); a scene of :mod:`analytic.kinds`
-    gives its boxes upright (initial tilts are the trilith's restitution
-    experiments: ``theta0`` and ``psi0`` must be 0 for the other kinds).
+    gives its boxes upright, tilted by at most :data:`MAX_KIND_TILT` (a plumb
+    error), or, for the kinds of :data:`RELEASE_KINDS`, released from a tilt below
+    :func:`release_limit` with ``psi0 = 0`` (free rocking).
     """
     if getattr(scene, "kind", "trilith") in TRILITH_KINDS:
         return _trilith_structure(scene, theta0, psi0)
-    if abs(theta0) > MAX_KIND_TILT or psi0 != 0.0:
+    release = scene.kind in RELEASE_KINDS and psi0 == 0.0 and abs(theta0) < release_limit(scene)
+    if (abs(theta0) > MAX_KIND_TILT or psi0 != 0.0) and not release:
         raise ValueError(f"theta0 must be in [-{MAX_KIND_TILT:g}, {MAX_KIND_TILT:g}] rad and "
                          f"psi0 0 for the {scene.kind} kind (a plumb error of the whole "
-                         f"structure; release tests are the trilith's), got {theta0!r}, "
-                         f"{psi0!r}")
+                         f"structure){_release_text(scene)}, got {theta0!r}, {psi0!r}")
     return _kind_structure(scene, theta0)
 
 
@@ -278,6 +279,58 @@ def structure_of(scene, theta0: float = 0.0, psi0: float = 0.0) -> Structure:
 # (4 um at 1e-6 rad over 4 m, the threshold search's tilt); a millirad is a plumb
 # error, more would drop the far footing measurably.
 MAX_KIND_TILT = 1e-3
+# Kinds released from a real tilt (free rocking): a block on a block turns as one
+# rigid body about its footprint's corner; each column of drums as one rigid stack
+# about its own base corner, the lintel carried on the top drums' highest corners
+# (the trilith's parallelogram, :func:`rest_poses`).  Whether they go on rocking as
+# one is measured, not assumed.
+RELEASE_KINDS = ("drums", "block_on_block")
+
+
+def release_limit(scene) -> float:
+    """The largest release tilt [rad] of a kind of :data:`RELEASE_KINDS`: the angle at
+    which the rigidly turned part's centre of mass (the whole block on a block, one
+    column of drums) passes over its pivot corner, the smaller of both sides."""
+    rects = scene.layout()
+    part = [r for r in rects if r.name.startswith("column_left_")] if scene.kind == "drums" \
+        else list(rects)
+    mass = sum(r.mass for r in part)
+    x_cm = sum(r.mass * r.x for r in part) / mass
+    y_cm = sum(r.mass * r.y for r in part) / mass
+    left = min(r.x - 0.5 * r.b for r in part if abs(r.y - 0.5 * r.h) < 1e-12)
+    right = max(r.x + 0.5 * r.b for r in part if abs(r.y - 0.5 * r.h) < 1e-12)
+    return min(math.atan2(x_cm - left, y_cm), math.atan2(right - x_cm, y_cm))
+
+
+def _release_text(scene) -> str:
+    """The release a kind allows, for the refusal's message."""
+    if scene.kind not in RELEASE_KINDS:
+        return f"; the {scene.kind} kind has no free-rocking release"
+    return (f", or a free-rocking release below {release_limit(scene):.4g} rad with psi0 0 "
+            f"(its release limit)")
+
+
+def _parallelogram(rects, theta0: float) -> dict:
+    """``{name: (move, angle)}`` of a column of drums released from ``theta0``: each
+    column's drums turned rigidly about its bottom drum's pivot corner, the lintel
+    translated with the top drum's corner diagonally opposite the pivot."""
+    c, s = math.cos(theta0), math.sin(theta0)
+
+    def rotation(px: float):
+        return lambda x, y: (px + c * (x - px) - s * y, s * (x - px) + c * y)
+    moves = {}
+    for side in ("left", "right"):
+        column = [r for r in rects if r.name.startswith(f"column_{side}_")]
+        bottom, top = column[0], column[-1]
+        turn = rotation(bottom.x - 0.5 * bottom.b if theta0 >= 0.0 else bottom.x + 0.5 * bottom.b)
+        moves.update({r.name: (turn, theta0) for r in column})
+        corner = (top.x + 0.5 * top.b if theta0 >= 0.0 else top.x - 0.5 * top.b, top.y + 0.5 * top.h)
+        moved = turn(*corner)
+        shift = (moved[0] - corner[0], moved[1] - corner[1])
+    for r in rects:
+        if r.name not in moves:  # the lintel: carried, not turned
+            moves[r.name] = ((lambda x, y: (x + shift[0], y + shift[1])), 0.0)
+    return moves
 
 
 def _kind_structure(scene, theta0: float = 0.0) -> Structure:
@@ -294,14 +347,18 @@ def _kind_structure(scene, theta0: float = 0.0) -> Structure:
     def turn(x: float, y: float) -> tuple[float, float]:
         return pivot + c * (x - pivot) - s * y, s * (x - pivot) + c * y
 
+    moves = {r.name: (turn, theta0) for r in rects}
+    if scene.kind == "drums" and abs(theta0) > MAX_KIND_TILT:  # a release: the parallelogram
+        moves = _parallelogram(rects, theta0)
     bodies = tuple(Box(r.name, r.b, r.h, r.mass, box_inertia(r.mass, r.b, depth, r.h),
-                       (r.x, r.y), (*turn(r.x, r.y), theta0)) for r in rects)
+                       (r.x, r.y), (*moves[r.name][0](r.x, r.y), moves[r.name][1]))
+                   for r in rects)
     bob = None
     hinge = scene.hinge()
     if hinge is not None:
         parent, anchor, mass, length = hinge
         box = next(x for x in bodies if x.name == parent)
-        at = turn(box.upright[0] + anchor[0], box.upright[1] + anchor[1])
+        at = moves[parent][0](box.upright[0] + anchor[0], box.upright[1] + anchor[1])
         # The bob hangs plumb (psi0 = 0) from the turned hinge.
         bob = Bob(mass, parent, anchor, at, (at[0], at[1] - length), length, 0.0)
     top = max(x.upright[1] + 0.5 * x.h for x in bodies)

@@ -33,6 +33,11 @@ pays) and the whole evaluation's (``cpu_s``: this process and the
 workers it reaped, including the model's reference runs and the measurement).  The
 result is the Pareto front of engine cost against worst error and the cheapest
 candidate within the tolerance.
+
+On a scene of another kind (drums, unequal columns, a block on a block) there is
+no model: the thresholds metric measures each candidate against the engine's own
+thresholds at a reference step (self-convergence,
+:mod:`compare.campaign.calibrate_kinds`); the other metrics are refused.
 """
 from __future__ import annotations
 
@@ -43,6 +48,9 @@ import os
 from dataclasses import dataclass, field
 
 from trilith_xval.analytic._workers import cpu_seconds
+from trilith_xval.compare.campaign.calibrate_metrics import histories as _histories
+from trilith_xval.compare.campaign.calibrate_metrics import restitution as _restitution
+from trilith_xval.compare.campaign.calibrate_metrics import thresholds as _thresholds
 from trilith_xval.compare.run.spec import RunSpec
 
 __all__ = ["METRICS", "ValidationSet", "Evaluation", "Calibration", "calibrate",
@@ -136,6 +144,8 @@ class Calibration:
     evaluations: list = field(default_factory=list)
     load_average: tuple = ()
     base: dict = field(default_factory=dict)  # settings every candidate starts from
+    kind: str = "trilith"  # another kind: errors are against the engine's own reference
+    self_reference: dict = field(default_factory=dict)  # dt_ref, thresholds (other kinds)
 
     @property
     def front(self) -> list:
@@ -155,7 +165,9 @@ class Calibration:
                 "load_average": list(self.load_average),
                 "recommended": rec.to_dict() if rec else None,
                 "front": [e.to_dict() for e in self.front],
-                "evaluations": [e.to_dict() for e in self.evaluations]}
+                "evaluations": [e.to_dict() for e in self.evaluations],
+                **({} if self.kind == "trilith" else
+                   {"kind": self.kind, "model": None, "self_reference": self.self_reference})}
 
 
 def default_tolerance(metric: str) -> float:
@@ -196,7 +208,7 @@ def _candidates(space: dict) -> list[dict]:
     return [dict(zip(names, values)) for values in itertools.product(*(space[n] for n in names))]
 
 
-# ------------------------------------------------------------------ the three metrics
+# ------------------------------------------------------------------ the candidates
 def _candidate_run(engine: str, scene, base: dict, varied: dict) -> RunSpec:
     """One candidate's run of ``engine`` on ``scene`` (no base motion): the
     engine's defaults, ``base`` (e.g. a settings file's table), then the
@@ -207,67 +219,11 @@ def _candidate_run(engine: str, scene, base: dict, varied: dict) -> RunSpec:
                            overrides_from="the candidate settings")
 
 
-def _restitution(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
-    from trilith_xval.compare.measure.restitution import free_rocking
-    scene = run.scene
-    cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
-             for lam, mu in vs.releases]
-    if scene.has_pendulum:
-        cases.append((f"lam {scene.lam:g} mu {scene.mu:g} gamma {scene.gamma:g}", scene))
-    errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
-    for label, sc in cases:
-        r = free_rocking(run.at(scene=sc), n_impacts=vs.n_impacts, restitution_factor=rf)
-        errors.append((label, r.max_rel_error if r.complete else math.nan))
-        engine_cpu += r.diagnostics["cpu_time"]
-        simulated += r.diagnostics["steps"] * r.settings["dt"]
-        runs += 1
-    return errors, engine_cpu, simulated, runs
-
-
-def _thresholds(run: RunSpec, reference, workers):
-    from trilith_xval.compare.measure.engine_spectrum import engine_spectrum
-    es = engine_spectrum(run, reference, workers=workers)
-    errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
-    for curve, points in es.curves.items():
-        for p in points:
-            runs += p.n_runs
-            engine_cpu += p.point.cpu_s  # the candidate's own search, not the step rule's
-            if math.isfinite(p.point.sim_s):  # NaN: served by the store (bypassed here)
-                simulated += p.point.sim_s
-            # The model cannot judge the engine there (named only after the step
-            # rule found no finer step that agrees).
-            if p.cause == "model":
-                continue
-            errors.append((f"{curve} Omega {p.omega:g}", abs(p.rel_error)))
-    return errors, engine_cpu, simulated, runs
-
-
-def _histories(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
-    from trilith_xval import engines
-    from trilith_xval.compare.measure.trajectories import compare_trajectories
-    from trilith_xval.scenes import point_pulse
-    scene = run.scene
-    errors, engine_cpu, simulated, runs = [], 0.0, 0.0, 0
-    for sc in (scene, scene.without_pendulum()) if scene.has_pendulum else (scene,):
-        for point in vs.points:
-            pulse = point_pulse(point)
-            model = {} if rf == 1.0 else {"restitution_factor": rf}
-            ref = engines.simulate("analytic", sc, pulse, **model)
-            test = engines.simulate(run.backend, sc, pulse, run.at(sc, pulse).settings)
-            c = compare_trajectories(ref, test)
-            err = c.theta_rms_first if c.verdict_agrees else 1.0
-            label = f"{point} {'pendulum' if sc.has_pendulum else 'no pendulum'}"
-            errors.append((label, err))
-            engine_cpu += test.diagnostics["cpu_time"]
-            simulated += test.diagnostics["steps"] * test.settings["dt"]
-            runs += 1
-    return errors, engine_cpu, simulated, runs
-
-
 def calibrate(engine: str, metric: str = "thresholds", *, validation: ValidationSet | None = None,
               space: dict | None = None, tolerance: float | None = None, workers: int = 1,
               progress=None, scene=None, base: dict | None = None,
-              restitution_factor: float = 1.0) -> Calibration:
+              restitution_factor: float = 1.0, reference_dt: float | None = None
+              ) -> Calibration:
     """Evaluate every candidate of ``space`` on ``validation`` for ``metric``.
 
     Parameters
@@ -303,6 +259,9 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         is the exact impact.  The restitution metric's target is then ``r`` x
         Eq. 19/20, the thresholds' the scaled model's spectrum, the histories'
         the scaled model's run.
+    reference_dt : float, optional
+        On scenes of another kind only: the step [s] of the engine's own
+        reference thresholds (default the engine's reference step).
 
     Returns
     -------
@@ -328,6 +287,12 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         scenes = list(scene) if isinstance(scene, (list, tuple)) else [scene]
     if not scenes:
         raise ValueError("scene: give at least one validation scene")
+    from trilith_xval.compare.campaign.calibrate_kinds import scene_kind
+    kind = scene_kind(scenes)
+    if kind != "trilith" and (metric != "thresholds" or rf != 1.0):
+        raise ValueError(f"metric {metric!r}{'' if rf == 1.0 else ', restitution_factor'}: "
+                         f"there is no model of the {kind} kind (no Eq. 19/20, no model "
+                         "theta); only 'thresholds', against the engine's own reference step")
     base = dict(base or {})
     space = default_space(engine, base=base) if space is None else dict(space)
     candidates = _candidates(space)
@@ -336,11 +301,19 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     cal = Calibration(engine, engines.get_backend(engine).version(), metric, float(tolerance), vs,
                       load_average=os.getloadavg(), base=base)
     reference: dict = {}  # the model's spectra, once, only if a candidate needs them
+    if kind != "trilith":  # the engine's own thresholds at its reference step, first
+        from trilith_xval.compare.campaign.calibrate_kinds import kind_reference
+        cal.kind, cal.self_reference = kind, kind_reference(
+            [(sc, _candidate_run(engine, sc, base, {})) for sc in scenes], vs.omegas,
+            reference_dt, reference)
 
     def one_scene(sc, varied: dict):
         run = _candidate_run(engine, sc, base, varied)
         if metric == "restitution":
             return _restitution(run, vs, rf)
+        if kind != "trilith":
+            from trilith_xval.compare.campaign.calibrate_kinds import self_thresholds
+            return self_thresholds(run, reference[id(sc)])
         if metric == "thresholds":
             if id(sc) not in reference:
                 from trilith_xval.analytic.spectrum import overturning_spectrum
@@ -379,6 +352,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         description = _candidate_description(engine, metric, vs, scenes, {**base, **cand})
         if rf != 1.0:  # absent at 1: candidates stored before the factor keep their keys
             description["restitution_factor"] = rf
+        if kind != "trilith":  # the target is the engine's own, at this step
+            description["reference_dt"] = cal.self_reference["dt_ref"]
         ev = runs.lookup("calibration-candidate", description, code=runs.ALL_CODE)
         if ev is not None:
             ev = dataclasses.replace(ev, from_store=True)

@@ -46,10 +46,26 @@ class SettingsFile:
     path: str
     sha256: str
     tables: dict = field(default_factory=dict)
+    domain: object = None  # engines.calibration.Domain of its [domain] table, or None
 
     def options(self, engine: str) -> dict:
         """The fields ``engine``'s table sets (empty when the file has no table for it)."""
         return dict(self.tables.get(engine, {}))
+
+    def check_scene(self, scene) -> None:
+        """ValueError naming the file when its ``[domain]`` is of another kind than
+        ``scene`` (a step calibrated on a column of drums says nothing of a trilith,
+        nor the reverse); a file without a ``[domain]`` is not checked.  Only the
+        kind is enforced here: a trilith design's ranges are the shipped
+        calibrations' rule (:func:`engines.calibration.threshold_choice`)."""
+        if self.domain is None:
+            return
+        kind = getattr(scene, "kind", "trilith")
+        if kind != self.domain.kind:
+            raise ValueError(f"--settings: {self.path!r} was calibrated on the "
+                             f"{self.domain.kind} kind ([domain] of the file); scene "
+                             f"{scene.name!r} is of the {kind} kind: refused, the file says "
+                             f"nothing of it")
 
     def describe(self) -> dict:
         return {"file": self.path, "sha256": self.sha256,
@@ -70,8 +86,8 @@ def read_settings_file(path) -> SettingsFile:
     ValueError
         Unreadable, not TOML, too large, an unknown engine (naming the known
         ones), a field the engine does not have (naming its fields), a field set
-        per run (:data:`RUN_FIELDS`) or a value the engine refuses; the message
-        starts with the file's name.
+        per run (:data:`RUN_FIELDS`), a value the engine refuses or a malformed
+        ``[domain]``; the message starts with the file's name.
     """
     from trilith_xval.scenes.safe_read import read_bytes
     p = Path(path)
@@ -81,7 +97,14 @@ def read_settings_file(path) -> SettingsFile:
         doc = tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise ValueError(f"{where}: not TOML ({str(exc).splitlines()[0]})") from None
-    return SettingsFile(str(p), hashlib.sha256(data).hexdigest(), _checked_tables(doc, where))
+    domain = None
+    if "domain" in doc:
+        from trilith_xval.engines.calibration import Domain
+        if not isinstance(doc["domain"], dict):
+            raise ValueError(f"{where}: [domain] must be a table")
+        domain = Domain.from_table(doc["domain"], where)
+    return SettingsFile(str(p), hashlib.sha256(data).hexdigest(), _checked_tables(doc, where),
+                        domain)
 
 
 def _checked_tables(doc: dict, where: str) -> dict[str, dict]:

@@ -12,6 +12,8 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_scene_args, add
                                  add_store_args, add_workers_arg, check_output_path, envelope,
                                  file_options, info, resolve_workers,
                                  settings_from_args, settings_line, sig, use_store)
+from trilith_xval.compare.cli.calibrate_kinds import (check_kind_calibration, kind_tables,
+                                                     print_self_reference)
 from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.run.jsonable import plain
 
@@ -27,7 +29,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "(restitution: free rocking vs Eq. 19/20; thresholds: first-overturning "
                     "amplitudes vs the model; histories: theta(t) at the paper's points A-D), "
                     "measure each one's CPU time with the run store bypassed, and recommend "
-                    "the cheapest within the tolerance.")
+                    "the cheapest within the tolerance. On a scene of another kind (no model): "
+                    "thresholds only, each candidate against the engine's own thresholds at its "
+                    "reference step (the finest --dt, or the engine's reference step).")
     parser.add_argument("--engine", required=True, metavar="NAME",
                         help=f"the engine to calibrate: {', '.join(engine_names())}")
     add_scene_args(parser, several=True)
@@ -155,9 +159,16 @@ def run(args: argparse.Namespace) -> int:
     rf = restitution_factor(args)
     design = _design(args)
     scenes = design[0] if design else _common.scenes_from_args(args)
+    kind = check_kind_calibration(args, scenes, rf)
     loaded = settings_from_args(args, (engine,))
+    for sc in scenes if loaded is not None and loaded.options(engine) else ():
+        loaded.check_scene(sc)
     base = file_options(loaded, engine)
     space = _space(args, engine, base)
+    dt_ref = None
+    if kind != "trilith":  # the engine's own reference: the finest step asked, or its own
+        from trilith_xval.engines.calibration import reference_dt
+        dt_ref = min(space["dt"]) if args.dt is not None else reference_dt(engine)
     names = tuple(sc.name for sc in scenes)
     name = names[0] if len(names) == 1 else names
     vs = (ValidationSet(scene=name, omegas=_omegas(args.omega)) if args.omega is not None
@@ -172,6 +183,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         source = f"{engine}'s calibrated step (times the search factors)"
     _check_budget(engine, space, vs, base, source, scenes)
+    if dt_ref is not None:
+        _check_budget(engine, {"dt": [dt_ref]}, vs, base, "the reference step", scenes)
     workers = resolve_workers(args.workers)
     outputs = {"--json": args.json, "--csv": args.csv, "--settings-out": args.settings_out}
     for option, path in outputs.items():
@@ -193,10 +206,12 @@ def run(args: argparse.Namespace) -> int:
 
     cal = calibrate(engine, args.metric, validation=vs, space=space, tolerance=args.tolerance,
                     workers=workers, progress=progress, scene=scenes, base=base,
-                    restitution_factor=rf)
+                    restitution_factor=rf, reference_dt=dt_ref)
     if bar is not None:
         bar.close()
     _print(cal)
+    if kind != "trilith":
+        print_self_reference(cal)
     held = None
     if design and cal.recommended is not None:
         held = _held_out(engine, args, cal, design[1], vs, base, workers)
@@ -229,6 +244,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{'training' if design else 'validation'} set"))
             if design:
                 text += _domain_tables(args, cal, design, held)
+            if kind != "trilith":
+                text += kind_tables(cal, scenes)
             atomic.write_text(args.settings_out, text)
             info(f"wrote {args.settings_out}")
     return 0 if rec is not None else 1

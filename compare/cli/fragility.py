@@ -10,6 +10,9 @@ empirical curve and a lognormal fit with a bootstrap band
 With ``--stripes``, a multiple-stripe analysis beside it (:mod:`compare.measure.msa`,
 Baker 2015): every record run at each stripe, the overturns counted and a
 lognormal fitted to the counts by maximum likelihood.
+On a scene of another kind (drums, unequal columns, a block on a block) there is
+no model IDA: two or more engines each give their own first failing intensity and
+are checked against each other (:mod:`compare.cli.fragility_kinds`).
 Every run goes through the run store (a killed command resumes); records run in
 parallel (``--workers``) or on a Dask cluster (``--scheduler``).
 """
@@ -46,7 +49,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="also a multiple-stripe analysis at these intensities (in the "
                              "--im unit, PGA accepts g: 0.2g,0.4g,0.6g), fitted beside IDA")
     parser.add_argument("--engine", default="none", metavar="NAME[,NAME...]",
-                        help=f"engines beside the model: {', '.join(ENGINES)}, or none")
+                        help=f"engines beside the model: {', '.join(ENGINES)}, or none; on a "
+                             "scene of another kind two or more, against each other")
     add_settings_arg(parser)
     parser.add_argument("--out", default="fragility", metavar="DIR",
                         help="a new or empty folder, or one an earlier fragility run wrote "
@@ -97,7 +101,11 @@ def run(args: argparse.Namespace) -> int:
     from trilith_xval.scenes.ground_motion import load_suite
 
     scene = scene_from_args(args)
+    kind = getattr(scene, "kind", "trilith")
     engines_ = parse_engine_list(args.engine, none_ok=True)
+    if kind != "trilith":
+        from trilith_xval.compare.cli.fragility_kinds import check_kind_engines
+        check_kind_engines(scene, engines_, args)
     st = ida_settings(args)
     loaded = settings_from_args(args, engines_)
     runs = engine_runs(scene, engines_, loaded)
@@ -112,14 +120,30 @@ def run(args: argparse.Namespace) -> int:
                          "curve needs at least 2 (one record's IDA: trilith spectrum --record "
                          "FILE)")
     store = use_store(args)
-    backends = ("analytic",) + engines_
-    results = intensities(scene, suite, runs, st, workers, args.scheduler)
+    if kind == "trilith":
+        backends = ("analytic",) + engines_
+        results = intensities(scene, suite, runs, st, workers, args.scheduler)
+    else:  # no model: each engine's own first failure (compare.cli.fragility_kinds)
+        from trilith_xval.compare.measure.record_jobs import KindJob
+        backends = engines_
+        results = _run_all([KindJob(run, r, st) for run in runs for r in suite], workers,
+                           args.scheduler)
     doc = _summarise(scene, suite, backends, st, results)
+    if kind != "trilith":
+        from trilith_xval.compare.cli.fragility_kinds import record_consensus
+        doc.update(kind=kind, model=None, engine_against_engine=True,
+                   consensus=record_consensus(doc, st.im_hi))
     if stripes:
         _add_msa(doc, scene, suite, runs, st, stripes, workers, args.scheduler)
     doc["settings_file"] = None if loaded is None else loaded.describe()
     _write(out, doc, st)
+    if kind != "trilith":
+        from trilith_xval.compare.cli.fragility_kinds import (print_kind_fragility,
+                                                              print_kind_header)
+        print_kind_header(doc)
     print_fragility(doc, st)
+    if kind != "trilith":
+        print_kind_fragility(doc, st)
     if store is not None:
         from trilith_xval.compare.run.runs import stats_line
         info(stats_line())
@@ -180,7 +204,7 @@ def _summarise(scene, suite, backends, st: IDASettings, results) -> dict:
     # A curve needs two motions: with fewer there is no fit, only the records.
     fits = {b: fragility(v, censored_at=st.im_hi) if len(v) >= 2 else None
             for b, v in usable.items()}
-    ref = fits["analytic"]
+    ref = fits.get("analytic")  # None on a scene of another kind: no model curve
     return {"command": "fragility", "scene": scene.to_dict(), "ida": st.describe(),
             "records": [{"label": r.label, "pga": r.pga, "pgv": r.pgv,
                          "duration": r.end_time, "n_samples": len(r.times)} for r in suite],

@@ -37,11 +37,14 @@ def print_fragility(doc: dict, st: IDASettings) -> None:
     and what the fit leaves out (islands, isolated overturns, records without a
     robust bracket, long runs) and each engine's agreement with the model."""
     unit = IM_UNITS[st.im]
+    # Another kind: a failure is an overturn or a collapse (engines.structure_monitor).
+    what = "failure" if doc.get("engine_against_engine") else "overturn"
     for b, body in doc["backends"].items():
         fit = body["fit"] or {"median": None, "n": 0, "n_censored": 0}
         med = fit["median"]
-        shown = "no fit (fewer than 2 overturns)" if med is None else _fit_text(fit, st)
-        print(f"{b}: IDA, {fit['n']} records, {fit['n_censored']} never overturned up to "
+        shown = f"no fit (fewer than 2 {what}s)" if med is None else _fit_text(fit, st)
+        print(f"{b}: IDA, {fit['n']} records, {fit['n_censored']} never "
+              f"{'failed' if what == 'failure' else 'overturned'} up to "
               f"{st.im_hi:g} {unit}; {shown}")
         msa = body.get("msa")
         if msa:

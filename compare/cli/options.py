@@ -151,8 +151,10 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus, trust, report), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes", "trust", "report")
+# --consensus, trust, report, fragility, restitution), the engine against its own
+# reference step (calibrate), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "trust", "report", "fragility", "calibrate",
+                 "restitution")
 
 
 def check_structure_engines(names, kind: str, command: str) -> None:
@@ -174,8 +176,9 @@ def check_kind(scene, command: str | None) -> None:
     if kind == "trilith" or command is None or command in KIND_COMMANDS:
         return
     raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
-                     f"analytic model does not cover; 'trilith simulate', 'trilith spectrum "
-                     f"--consensus E1,E2' and 'trilith trust' run it (docs/geometry.md)")
+                     f"analytic model does not cover; 'trilith simulate', 'spectrum --consensus "
+                     f"E1,E2', 'trust', 'fragility --engine E1,E2', 'restitution --engine E1,E2' "
+                     f"and 'calibrate' (its own reference step) run it (docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:
@@ -380,8 +383,11 @@ def run_spec(engine: str, scene, excitation, loaded=None, *, calibrated: bool = 
              overrides: dict | None = None):
     """``engine``'s run, resolved once (:class:`compare.run.spec.RunSpec`): its
     defaults, its calibration where ``calibrated`` (threshold searches), the
-    ``--settings`` table (``loaded``), then ``overrides`` (the command line)."""
+    ``--settings`` table (``loaded``; refused when the file's ``[domain]`` is of
+    another kind than ``scene``), then ``overrides`` (the command line)."""
     from trilith_xval.compare.run.spec import RunSpec
+    if loaded is not None and loaded.options(engine):
+        loaded.check_scene(scene)
     return RunSpec.resolve(engine, scene, excitation, calibrated=calibrated,
                            file_options=file_options(loaded, engine),
                            file_name="" if loaded is None else repr(str(loaded.path)),

@@ -26,7 +26,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_scene_args(parser)
     parser.add_argument("--engine", default="pymunk", metavar="NAME",
                         help="backend with free-rocking settings (theta0): "
-                             + ", ".join(("analytic",) + engine_names()))
+                             + ", ".join(("analytic",) + engine_names())
+                             + "; on drums or a block on a block two or more, E1,E2 "
+                               "(no model: engine against engine)")
     add_settings_arg(parser)
     parser.add_argument("--theta0", type=float, default=None, metavar="RAD",
                         help="initial tilt [rad], 0 < |theta0| < alpha; sign = side "
@@ -47,6 +49,9 @@ def run(args: argparse.Namespace) -> int:
                                                           free_rocking)
 
     scene = scene_from_args(args)
+    if getattr(scene, "kind", "trilith") != "trilith":  # no model: engines against each other
+        from trilith_xval.compare.cli.restitution_kinds import kind_restitution
+        return kind_restitution(args, scene)
     theta0 = args.theta0 if args.theta0 is not None else DEFAULT_THETA0_FRACTION * scene.alpha
     n = args.n_impacts if args.n_impacts is not None else DEFAULT_N_IMPACTS
     if not 1 <= n <= MAX_N_IMPACTS:

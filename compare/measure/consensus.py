@@ -95,8 +95,10 @@ def own_threshold(spec, omega: float, a_guess: float, kind="sine", *,
     rel_tol : float
         Final bracket width relative to ``a_guess`` (default 0.5 %).
     motion : callable, optional
-        ``value -> ground motion`` searched instead of the pulse (a record scaled
-        to an intensity, ``omega`` then NaN); default None, the pulse.
+        ``motion(value) -> excitation``: search the scale of a ground motion
+        instead of the pulse's amplitude
+        (:func:`compare.measure.thresholds.engine_threshold`); ``omega`` is then a
+        label (NaN allowed), ``a_guess`` and the results are intensities.
 
     Returns
     -------

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["uplift_bound", "scan_guess", "kind_point", "kind_record", "SCAN_FACTOR",
+__all__ = ["uplift_bound", "scan", "scan_guess", "kind_point", "kind_record", "SCAN_FACTOR",
            "SCAN_STEPS", "FAILED"]
 
 # Amplitude ratio of two scan probes: the threshold search then widens its bracket
@@ -40,15 +40,22 @@ def uplift_bound(scene) -> float:
     return 0.5 * scene.g * min(r.b for r in rects) / top
 
 
-def _scan(scene, fails) -> tuple[float | None, int]:
-    """``(guess or None, runs)``: ``fails(a)`` at amplitudes growing by
-    :data:`SCAN_FACTOR` from :func:`uplift_bound`; the geometric mean of the last
-    survival and the first failure."""
-    a, survived = uplift_bound(scene), None
+def scan(fails, start: float, top: float = math.inf) -> tuple[float | None, int]:
+    """Where a search without a model starts: ``(guess or None, runs)``.
+
+    ``fails(value) -> bool`` is probed at ``start`` times :data:`SCAN_FACTOR` to the
+    ``k``, ``k < SCAN_STEPS``, the last probe clipped to ``top`` (a search's upper
+    end: beyond it the answer is censored); the guess is the geometric mean of the
+    last survival and the first failure (``start / SCAN_FACTOR`` standing for the
+    survival when ``start`` already fails); None when nothing failed."""
+    a, survived = start, None
     for k in range(SCAN_STEPS):
+        a = min(a, top)
         if fails(a):
             low = survived if survived is not None else a / SCAN_FACTOR
             return math.sqrt(low * a), k + 1
+        if a >= top:
+            return None, k + 1
         survived = a
         a *= SCAN_FACTOR
     return None, SCAN_STEPS
@@ -64,7 +71,7 @@ def scan_guess(spec, omega: float, kind) -> tuple[float | None, int]:
         run = point_spec(spec, spec.scene, omega, a, kind)
         return overturns(run.backend, run.scene, omega, a, run.settings,
                          kind).status in FAILED
-    return _scan(spec.scene, fails)
+    return scan(fails, uplift_bound(spec.scene))
 
 
 def _none(scene, engines, **where) -> dict:
@@ -113,7 +120,7 @@ def kind_record(runs: dict, scene, motion, st) -> tuple[dict, int]:
         run = record_run(first, motion, st, a)
         return overturns_under(run.backend, run.scene, scaled(a), run.settings,
                                a).status in FAILED
-    guess, n = _scan(scene, fails)
+    guess, n = scan(fails, uplift_bound(scene))
     where = {"record": motion.label, "im": st.im}
     if guess is None:
         return _none(scene, runs, **where), n

@@ -6,6 +6,8 @@ frozen value holding its run (:class:`compare.run.spec.RunSpec`).
   (:func:`analytic.ida.first_overturn_intensity`);
 * :class:`RobustJob`: an engine's robust bracket around the model's intensity
   (:func:`compare.measure.record_threshold.engine_intensity`);
+* :class:`KindJob`: an engine's own first failing intensity on a scene of another
+  kind, without a model (:func:`compare.measure.record_kinds.own_intensity`);
 * :class:`StripeJob`: the verdict at each stripe of a multiple-stripe analysis
   (:mod:`compare.measure.msa`).
 
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 
 from trilith_xval.compare.run.spec import RunSpec
 
-__all__ = ["IDAJob", "RobustJob", "StripeJob", "run_job", "model_run"]
+__all__ = ["IDAJob", "RobustJob", "KindJob", "StripeJob", "run_job", "model_run"]
 
 MODEL = "analytic"  # the model's backend name in these jobs (run compiled)
 
@@ -104,6 +106,27 @@ class RobustJob:
         return runs.memo("robust-ida", what,
                          lambda: engine_intensity(run, record, st, im_model),
                          label=f"robust ida {run.backend} {record.label}", code=runs.ALL_CODE)
+
+
+@dataclass(frozen=True)
+class KindJob:
+    """An engine's own first failing intensity of ``record`` on a scene of another
+    kind: a scan, then the robust bracket converged in the step."""
+
+    run: RunSpec
+    record: object
+    st: object  # analytic.ida.IDASettings
+
+    def __call__(self) -> dict:
+        from trilith_xval.compare.measure.record_kinds import own_intensity
+        from trilith_xval.compare.run import runs
+        from trilith_xval.compare.run.keys import scene_dict, settings_dict
+        run, record, st = self.run, self.record, self.st
+        what = {"backend": run.backend, "scene": scene_dict(run.scene),
+                "record": _record_digest(record), "ida": st.describe(),
+                "settings": settings_dict(run.settings)}
+        return runs.memo("kind-ida", what, lambda: own_intensity(run, record, st),
+                         label=f"own ida {run.backend} {record.label}", code=runs.ALL_CODE)
 
 
 @dataclass(frozen=True)

@@ -71,7 +71,9 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
         sec.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         sec.xaxis.set_minor_formatter(NullFormatter())
         sec.set_xlabel("PGA [g]")
-    ax.set_ylabel("P(overturn | IM)")
+    # A scene of another kind: the engines' failures (overturn or collapse), no model.
+    kinds = doc.get("engine_against_engine", False)
+    ax.set_ylabel("P(failure | IM)" if kinds else "P(overturn | IM)")
     ax.set_ylim(0.0, 1.0)
     if ax.get_legend_handles_labels()[1]:  # no fit (fewer than 2 overturns): no line
         ax.legend(fontsize=8, loc="upper left")
@@ -79,7 +81,9 @@ def plot_fragility(path, doc: dict, st: IDASettings) -> None:
     msa = any(body.get("msa") for body in doc["backends"].values())
     ax.set_title(f"{doc['scene'].get('name', '')}{pendulum}: {len(doc['records'])} records\n"
                  "steps: empirical; lines: IDA lognormal fit, 90 % band"
-                 + ("; circles, dashes: MSA stripes and fit" if msa else ""), fontsize=8)
+                 + ("; circles, dashes: MSA stripes and fit" if msa else "")
+                 + (f"\n{doc['kind']}: no model; engine against engine" if kinds else ""),
+                 fontsize=8)
     fig.tight_layout()
     savefig(fig, path, dpi=120)
     plt.close(fig)

@@ -169,8 +169,32 @@ def test_a_small_tilt_turns_the_whole_structure_rigidly():
             d0 = math.dist(a[i].start[:2], a[j].start[:2])
             # Rounding of a rotation of metre-sized coordinates: ~1e-15 m.
             assert math.dist(b[i].start[:2], b[j].start[:2]) == pytest.approx(d0, abs=1e-12)
+    # Beyond a plumb error: a release below the kind's limit only, none for unequal columns.
     with pytest.raises(ValueError, match="theta0 must be in"):
-        geometry.structure_of(scene, 0.1)
+        geometry.structure_of(scene, 1.01 * geometry.release_limit(scene))
+    with pytest.raises(ValueError, match="the unequal kind has no free-rocking release"):
+        geometry.structure_of(load_scene("unequal"), 0.1)
+
+
+def test_a_release_tilts_each_column_of_drums_as_a_rigid_stack_under_the_lintel():
+    scene = load_scene("drums")
+    theta0 = 0.5 * geometry.release_limit(scene)
+    flat, tilted = geometry.structure_of(scene), geometry.structure_of(scene, theta0)
+    upright = {x.name: x for x in flat.bodies}
+    bodies = {x.name: x for x in tilted.bodies}
+    for side in ("left", "right"):
+        column = [n for n in bodies if n.startswith(f"column_{side}_")]
+        for i, n in enumerate(column):
+            assert bodies[n].start[2] == theta0
+            for m in column[:i]:  # rigid: distances between centres kept
+                assert math.dist(bodies[n].start[:2], bodies[m].start[:2]) == pytest.approx(
+                    math.dist(upright[n].start[:2], upright[m].start[:2]), abs=1e-12)
+    # The lintel rests level on the top drums' highest corners (zero gap).
+    top, lintel = bodies["column_left_2"], bodies["lintel"]
+    x, y, a = top.start
+    corner_y = y + math.sin(a) * 0.5 * top.b + math.cos(a) * 0.5 * top.h
+    assert lintel.start[2] == 0.0
+    assert lintel.start[1] - 0.5 * lintel.h == pytest.approx(corner_y, abs=1e-12)
 
 
 # DART (dartpy 6.20) puts bodies to sleep (World.getDeactivationOptions: enabled,

@@ -38,8 +38,6 @@ def test_simulate_with_the_model_says_there_is_none(capsys, no_work):
 # Commands that need the model, with what each needs besides --scene.
 NEED_MODEL = [
     ("map", []), ("record", ["-A", "5", "-w", "8", "--out", "x.gif"]),
-    ("restitution", []), ("fragility", ["--records", "synthetic"]),
-    ("calibrate", ["--engine", "pymunk"]),
 ]
 
 
