@@ -16,7 +16,7 @@ import math
 
 from trilith_xval.compare.cli.options import envelope, info, print_json
 
-__all__ = ["kind_spectrum", "scan_guess", "SCAN_FACTOR", "SCAN_STEPS"]
+__all__ = ["kind_spectrum", "kind_points", "scan_guess", "SCAN_FACTOR", "SCAN_STEPS"]
 
 # Amplitude ratio of two scan probes: the threshold search then widens its bracket
 # up to +-115 % around the guess (compare.measure.thresholds.Search.max_expand), so a
@@ -55,12 +55,35 @@ def scan_guess(spec, omega: float, kind) -> tuple[float | None, int]:
     return None, SCAN_STEPS
 
 
+def kind_points(runs: dict, scene, omegas, shape) -> tuple[list[dict], int]:
+    """``(points, scan runs)``: at each of ``omegas`` [rad/s] the engines' consensus
+    (:func:`compare.measure.consensus.consensus_at`, ``runs``: engine -> its
+    threshold-search RunSpec) started from the scan of the first engine
+    (:func:`scan_guess`); a frequency where the scan finds no failure has status
+    ``'none'`` and every engine under ``no_answer``."""
+    from trilith_xval.compare.measure.consensus import consensus_at
+    first = next(iter(runs.values()))
+    points, n_scan = [], 0
+    for omega in omegas:
+        guess, n = scan_guess(first, float(omega), shape)
+        n_scan += n
+        if guess is None:
+            points.append({"omega": float(omega), "status": "none", "median": None,
+                           "a_guess": None, "engines": {}, "outliers": [], "no_answer": [
+                               {"engine": e, "cause": "no failure",
+                                "detail": "no failure up to the scan's end"} for e in runs]})
+            continue
+        point = consensus_at(runs, scene, float(omega), guess, shape)
+        point["a_guess"] = point.pop("a_model")  # a scan's guess, not a model's number
+        points.append(point)
+    return points, n_scan
+
+
 def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
     """The command for a scene of another kind (module docstring)."""
     from trilith_xval.compare.cli.pulse_shape import shape_from_args
     from trilith_xval.compare.cli.spectrum_engines import check_engine_budget, engine_runs
     from trilith_xval.compare.cli.options import parse_engine_list, use_store
-    from trilith_xval.compare.measure.consensus import consensus_at
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
 
     kind = scene.kind
@@ -98,20 +121,7 @@ def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
                 for n, r in runs.items()}
     check_engine_budget(args, runs, omegas, shape)
     use_store(args)
-    first = next(iter(runs.values()))
-    points, n_scan = [], 0
-    for omega in omegas:
-        guess, n = scan_guess(first, float(omega), shape)
-        n_scan += n
-        if guess is None:
-            points.append({"omega": float(omega), "status": "none", "median": None,
-                           "a_guess": None, "engines": {}, "outliers": [], "no_answer": [
-                               {"engine": e, "cause": "no failure",
-                                "detail": "no failure up to the scan's end"} for e in names]})
-            continue
-        point = consensus_at(runs, scene, float(omega), guess, shape)
-        point["a_guess"] = point.pop("a_model")  # a scan's guess, not a model's number
-        points.append(point)
+    points, n_scan = kind_points(runs, scene, omegas, shape)
     if args.json:
         inputs = {"scene": scene.to_dict(), "omega": args.omega, "pulse": shape,
                   "criterion": args.criterion, "t_max": args.t_max, "consensus": list(names)}
