@@ -152,7 +152,7 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
 # --consensus), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes", "map")
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "map", "record", "view")
 
 
 def check_kind(scene, command: str | None) -> None:

@@ -37,7 +37,7 @@ def test_simulate_with_the_model_says_there_is_none(capsys, no_work):
 
 # Commands that need the model, with what each needs besides --scene.
 NEED_MODEL = [
-    ("trust", []), ("record", ["-A", "5", "-w", "8", "--out", "x.gif"]),
+    ("trust", []),
     ("restitution", []), ("fragility", ["--records", "synthetic"]),
     ("calibrate", ["--engine", "pymunk"]),
 ]
