@@ -15,12 +15,13 @@ against engine, never agreement with the model.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from trilith_xval.compare.cli.options import print_json
 
-__all__ = ["kind_map", "KindMap", "STATUSES", "FAILURES", "BASIS"]
+__all__ = ["kind_map", "kind_record_map", "report", "MapAxes", "KindMap", "STATUSES", "FAILURES", "BASIS"]
 
 # The statuses of a run of another kind, in the order a map's legend lists them.
 STATUSES = ("survived", "overturned", "collapsed", "unstable", "undecided")
@@ -87,10 +88,6 @@ def _check(args, scene, names) -> None:
     """Refuse, before any work, what the engines' map of a kind cannot give."""
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
     kind = scene.kind
-    if args.record is not None:
-        raise ValueError(f"trilith map --record: not on the {kind} kind yet (scene "
-                         f"{scene.name!r}); 'trilith map --scene {scene.name} --engine E1,E2' "
-                         f"maps pulses")
     if not names:
         raise ValueError(f"trilith map: there is no analytic map of the {kind} kind (scene "
                          f"{scene.name!r}: the model does not cover it); give --engine E1,E2 "
@@ -102,6 +99,9 @@ def _check(args, scene, names) -> None:
     if len(names) < 2:
         raise ValueError(f"--engine: the map of the {kind} kind compares engines with each "
                          f"other: give two or more, got {', '.join(names)}")
+    if args.record is not None and args.consensus:
+        raise ValueError(f"--consensus with --record does not apply to the {kind} kind: the "
+                         "consensus searches a pulse's amplitude")
     if args.convergence:
         raise ValueError(f"--convergence does not apply to the {kind} kind: --consensus "
                          "converges each engine's own threshold in the step")
@@ -118,7 +118,6 @@ def kind_map(args, scene, omegas, amps, workers: int, shape: str) -> int:
     from trilith_xval.compare.cli.map import _EngineRun
     from trilith_xval.compare.cli.map_text import subsample
     from trilith_xval.compare.cli.map import ENGINE_POINTS
-    from trilith_xval.compare.cli.spectrum_kinds import SCAN_STEPS
 
     model = [n.strip() for n in (args.engine or "").split(",") if n.strip().startswith("analytic")]
     if model:  # before the list's own check, which knows engines only
@@ -126,6 +125,9 @@ def kind_map(args, scene, omegas, amps, workers: int, shape: str) -> int:
                          f"give engines from {', '.join(_structure_engines())}")
     names = _options.parse_engine_list(args.engine) if args.engine is not None else ()
     _check(args, scene, names)
+    if args.record is not None:  # the record's intensity x time scale, engines alone
+        from trilith_xval.compare.cli.record_map import record_map
+        return record_map(args, scene, workers, names)
     w = (_options.parse_omega_range(args.engine_omega, "--engine-omega") if args.engine_omega
          else subsample(omegas, ENGINE_POINTS))
     a = (_options.parse_range(args.engine_amplitude, "--engine-amplitude", "m/s^2")
@@ -161,48 +163,106 @@ def kind_map(args, scene, omegas, amps, workers: int, shape: str) -> int:
         searches = {n: _options.run_spec(n, scene, Still(), loaded, calibrated=True,
                                          overrides=window) for n in names}
         points, _ = kind_points(searches, scene, w, shape)
-    _write(args, scene, kmap, points, shape)
+    axes = MapAxes("omega", "amplitude", "Omega [rad/s]", r"$\Omega$ [rad/s]", "m/s^2",
+                   r"$A_s$ [m/s$^2$]", f"{w.size} frequencies x {a.size} amplitudes, {shape} pulse",
+                   f"{shape} pulse")
+    extra = {"pulse": shape, "t_max": args.t_max}
+    return report(args, scene, kmap, axes, extra, points)
+
+
+def kind_record_map(args, scene, record, values, scales, workers: int, names) -> int:
+    """``map --record`` on a kind: each engine's verdict at every (time scale k,
+    intensity) cell (:class:`compare.cli.record_map._RecordRun`: the record scaled
+    and played ``k`` times slower, in the fixed window), as :func:`kind_map` for
+    pulses; ``values``, ``scales``: the engine grid, checked."""
+    from trilith_xval.analytic.overturn_map import verdict_map
+    from trilith_xval.compare.cli.options import use_store
+    from trilith_xval.compare.cli.record_map import _RecordRun
+    use_store(args)
+    status, cpu = {}, {}
+    for n in names:
+        m = verdict_map(_RecordRun(n, scene, record, args.im, args.tail), scene, scales, values,
+                        backend=n, pulse=record.label, workers=workers)
+        index = np.array([STATUSES.index(lab.split(" (")[0]) for lab in m.labels])
+        status[n], cpu[n] = index[m.cells], m.cpu_s
+    unit = {"pga": "m/s^2", "pgv": "m/s", "scale": ""}[args.im]
+    name = args.im.upper() if args.im != "scale" else "scale factor"
+    tex = {"pga": " [m/s$^2$]", "pgv": " [m/s]", "scale": ""}[args.im]
+    axes = MapAxes("time_scale", args.im, "time scale k", "time scale k (every period x k)",
+                   unit, name + tex, f"{scales.size} time scales x {values.size} {args.im} "
+                   f"values of record {record.label}, window end + {args.tail:g} s",
+                   f"record {record.label}")
+    extra = {"record": record.describe(), "im": args.im, "tail": args.tail}
+    return report(args, scene, KindMap(scales, values, status, cpu), axes, extra)
+
+
+@dataclass(frozen=True)
+class MapAxes:
+    """How a kind's map names its axes: ``x``, ``y`` the JSON/CSV names of the
+    columns' and rows' values (``omega``, ``amplitude``; a record's ``time_scale``,
+    ``intensity``), ``x_text`` the text table's heading, ``x_label`` and ``y_label``
+    the PNG's, ``y_unit`` the rows' unit, ``what`` the grid in words, ``subject``
+    the excitation in the PNG's titles."""
+
+    x: str
+    y: str
+    x_text: str
+    x_label: str
+    y_unit: str
+    y_label: str
+    what: str
+    subject: str
+
+
+def report(args, scene, kmap: KindMap, axes: MapAxes, extra: dict, points=None) -> int:
+    """Write ``--csv``/``--plot`` whole and print the JSON (``extra``: the inputs
+    beside the scene) or the text of the engines' map ``kmap``."""
+    names = list(kmap.status)
+    _write(args, scene, kmap, points, axes)
     if args.json:
         doc = {"kind": scene.kind, "model": None, "basis": BASIS, "scene": scene.to_dict(),
-               "pulse": shape, "t_max": args.t_max, **kmap.to_dict()}
+               **extra, "axes": {"omega": axes.x, "amplitude": axes.y}, **kmap.to_dict()}
         if points is not None:
             doc["consensus"] = points
         from trilith_xval.compare.run.jsonable import plain
         print_json(plain(doc))
         return 0
     print(f"scene {scene.name} ({scene.kind}): no analytic map; the engines' verdicts on "
-          f"{w.size} frequencies x {a.size} amplitudes, {shape} pulse; {BASIS}")
+          f"{axes.what}; {BASIS}")
     for n in names:
         counts = ", ".join(f"{s} {k}" for s, k in kmap.counts(n).items() if k)
-        print(f"{n}: {counts} ({cpu[n]:.1f} CPU s)")
+        print(f"{n}: {counts} ({kmap.cpu_s[n]:.1f} CPU s)")
     print(f"engines disagree on {kmap.disagreements} of {kmap.agree.size} cells")
-    head = "".join(f" {n + ' [m/s^2]':>18}" for n in names)
-    print(f"first failure on the grid\n{'Omega [rad/s]':>13}{head}")
-    for j, omega in enumerate(w):
+    unit = f" [{axes.y_unit}]" if axes.y_unit else ""
+    head = "".join(f" {n + unit:>18}" for n in names)
+    print(f"first failure on the grid\n{axes.x_text:>13}{head}")
+    for j, x in enumerate(kmap.omega):
         row = "".join(f" {kmap.first[n][j]:18.4g}" if math.isfinite(kmap.first[n][j])
                       else f" {'none':>18}" for n in names)
-        print(f"{omega:13.4g}{row}")
+        print(f"{x:13.4g}{row}")
     if points is not None:
+        from trilith_xval.compare.cli.spectrum_kinds import SCAN_STEPS
         print("each engine's own first failure, converged in the step, and their consensus:")
         for p in points:
             own = ", ".join(f"{e} {r['a_fails']:.4g}" for e, r in p["engines"].items())
             median = "-" if p["median"] is None else f"{p['median']:.4g}"
-            print(f"  Omega {p['omega']:g}: {own or 'no failure in ' + str(SCAN_STEPS) + ' scan probes'}"
+            print(f"  Omega {p['omega']:g}: {own or f'no failure in {SCAN_STEPS} scan probes'}"
                   f"; median {median} m/s^2, {p['status']}")
     return 0
 
 
-def _write(args, scene, kmap: KindMap, points, shape: str) -> None:
+def _write(args, scene, kmap: KindMap, points, axes: MapAxes) -> None:
     """The CSV (one row per engine and cell, then each engine's converged first
     failure with ``--consensus``) and the PNG, each written whole."""
     if args.csv:
         from trilith_xval.compare.run.atomic import write_text
-        rows = ["engine,omega,amplitude,verdict,engines_agree,basis"]
+        rows = [f"engine,{axes.x},{axes.y},verdict,engines_agree,basis"]
         rows += [f"{r},\"{BASIS}\"" for r in kmap.csv_rows()]
         for p in points or ():
-            rows += [f"{e},{p['omega']:.12g},{r['a_fails']:.12g},first failure (converged in the step; "
-                     f"engines: {p['status']}),,\"{BASIS}\"" for e, r in p["engines"].items()]
+            rows += [f"{e},{p['omega']:.12g},{r['a_fails']:.12g},first failure (converged "
+                     f"in the step; engines: {p['status']}),,\"{BASIS}\""
+                     for e, r in p["engines"].items()]
         write_text(args.csv, "\n".join(rows) + "\n")
     if args.plot:
         from trilith_xval.compare.report.kind_map_plot import plot_kind_map
-        plot_kind_map(kmap, args.plot, scene, shape, points)
+        plot_kind_map(kmap, args.plot, scene, axes, points)

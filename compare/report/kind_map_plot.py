@@ -12,9 +12,10 @@ STATUS_COLOURS = {"survived": "white", "overturned": "0.45", "collapsed": "tab:p
                   "unstable": "tab:red", "undecided": "tab:orange"}
 
 
-def plot_kind_map(kmap, path, scene, pulse: str, points=None) -> None:
+def plot_kind_map(kmap, path, scene, labels, points=None) -> None:
     """Write the figure of ``kmap`` (:class:`compare.cli.map_kinds.KindMap`) to
-    ``path``; ``points``: the ``--consensus`` points (each engine's converged first
+    ``path``; ``labels``: its axes' names (:class:`~compare.cli.map_kinds.MapAxes`);
+    ``points``: the ``--consensus`` points (each engine's converged first
     failure, drawn as a triangle in its colour at each frequency)."""
     import matplotlib
     matplotlib.use("Agg")
@@ -69,9 +70,9 @@ def plot_kind_map(kmap, path, scene, pulse: str, points=None) -> None:
                                             ls=h.get_linestyle(), label=lab)
                                      for lab, h in seen.items()],
                   fontsize=7, loc="upper left")
-        ax.set_xlabel(r"$\Omega$ [rad/s]")
-        ax.set_ylabel(r"$A_s$ [m/s$^2$]")
-        ax.set_title(f"{name}: {pulse} pulse, scene {scene.name} ({scene.kind})", fontsize=9)
+        ax.set_xlabel(labels.x_label)
+        ax.set_ylabel(labels.y_label)
+        ax.set_title(f"{name}: {labels.subject}, scene {scene.name} ({scene.kind})", fontsize=9)
     fig.suptitle(f"No model of the {scene.kind} kind: {BASIS}", fontsize=9)
     fig.tight_layout()
     from trilith_xval.compare.run.atomic import savefig

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -64,7 +65,10 @@ def test_disagreements_are_counted_and_hatched(tmp_path):
     from trilith_xval.compare.report.kind_map_plot import plot_kind_map
     from trilith_xval.scenes import load_scene
     path = tmp_path / "m.png"
-    plot_kind_map(kmap, path, load_scene("drums"), "sine")
+    from trilith_xval.compare.cli.map_kinds import MapAxes
+    axes = MapAxes("omega", "amplitude", "Omega", "Omega [rad/s]", "m/s^2", "A [m/s^2]",
+                   "2 x 3", "sine pulse")
+    plot_kind_map(kmap, path, load_scene("drums"), axes)
     assert path.stat().st_size > 0
 
 
@@ -74,7 +78,9 @@ BAD = [
     (["--engine", "analytic,pymunk"], "--engine analytic: the model does not cover"),
     (["--engine", "pymunk,mujoco", "--restitution-factor", "0.9"], "no model of the drums"),
     (["--engine", "pymunk,mujoco", "--convergence"], "--convergence does not apply"),
-    (["--engine", "pymunk,mujoco", "--record", "x.csv"], "trilith map --record: not on"),
+    (["--engine", "pymunk,mujoco", "--record", "x.csv", "--consensus"],
+     "--consensus with --record does not apply"),
+    (["--engine", "pymunk,mujoco", "--record", "missing.csv"], "missing.csv"),
     (["--engine", "pymunk,mujoco", *GRID, "--max-engine-runs", "10"], "--max-engine-runs 10"),
     (["--engine", "pymunk,mujoco", "--engine-omega", "0:2:1"], "--engine-omega"),
 ]
@@ -89,3 +95,18 @@ def test_bad_input_is_refused_in_one_line_before_work(extra, message, capsys, no
     assert main(["map", "--scene", "drums", *extra]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and message in err, err
+
+
+def test_record_map_on_a_kind_is_the_engines_own(tmp_path, capsys):
+    path = str(Path(__file__).parents[3] / "scenes" / "records" / "sample.AT2")
+    assert main(["map", "--scene", "block_on_block", "--engine", "pymunk,mujoco", "--record",
+                 path, "--intensity", "2:8:6", "--time-scale", "1:1.5:0.5", "--tail", "1",
+                 "--cache", str(tmp_path / "store"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["model"] is None and doc["basis"] == BASIS
+    assert doc["axes"] == {"omega": "time_scale", "amplitude": "pga"}
+    assert doc["omega"] == [1.0, 1.5] and doc["amplitude"] == [2.0, 8.0]
+    # 2 m/s^2 of PGA is below every static uplift: the upper block's g b/h = 3.27 m/s^2,
+    # the lower block's (carrying it) higher.
+    for e in ("pymunk", "mujoco"):
+        assert doc["engines"][e]["cells"][0] == ["survived", "survived"]
