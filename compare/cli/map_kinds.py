@@ -79,6 +79,14 @@ class KindMap:
                            f"{bool(self.agree[i, j])}")
 
 
+def _statuses(m) -> np.ndarray:
+    """The cells of ``m`` (:class:`analytic.overturn_map.OverturnMap`) as indices into
+    :data:`STATUSES`: the status alone, since a kind's mode counts sign changes of
+    the mean rotation of the bodies on the ground, not the model's impacts."""
+    index = np.array([STATUSES.index(lab.split(" (")[0]) for lab in m.labels])
+    return index[m.cells]
+
+
 def _structure_engines() -> tuple[str, ...]:
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
     return STRUCTURE_ENGINES
@@ -107,17 +115,17 @@ def _check(args, scene, names) -> None:
                          "converges each engine's own threshold in the step")
 
 
-def kind_map(args, scene, omegas, amps, workers: int, shape: str) -> int:
+def kind_map(args, scene, omegas, amps, workers: int, shape) -> int:
     """The command for a scene of another kind (module docstring).  ``omegas``,
     ``amps``: the checked ``--omega``/``--amplitude`` grids the engine grid is
-    taken from when ``--engine-omega``/``--engine-amplitude`` are not given."""
+    taken from when ``--engine-omega``/``--engine-amplitude`` are not given;
+    ``shape``: the pulse (:func:`compare.cli.pulse_shape.shape_from_args`)."""
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.analytic.overturn_map import verdict_map
     from trilith_xval.analytic.pulses import pulse_of
     from trilith_xval.compare.cli import options as _options
-    from trilith_xval.compare.cli.map import _EngineRun
+    from trilith_xval.compare.cli.map import ENGINE_POINTS, _EngineRun
     from trilith_xval.compare.cli.map_text import subsample
-    from trilith_xval.compare.cli.map import ENGINE_POINTS
 
     model = [n.strip() for n in (args.engine or "").split(",") if n.strip().startswith("analytic")]
     if model:  # before the list's own check, which knows engines only
@@ -148,14 +156,12 @@ def kind_map(args, scene, omegas, amps, workers: int, shape: str) -> int:
         for omega in w:
             cells[n].at(excitation=pulse_of(shape, float(max(a)), float(omega)))
     _options.step_notes(names, [scene])
+    _options.use_store(args)  # every run stored: a killed map resumes
     status, cpu = {}, {}
     for n in names:
         m = verdict_map(_EngineRun(cells[n], shape), scene, w, a, backend=n, pulse=shape,
                         workers=workers)
-        # The status alone: a kind's "mode" counts sign changes of the mean rotation
-        # of the bodies on the ground, not the model's impacts.
-        index = np.array([STATUSES.index(lab.split(" (")[0]) for lab in m.labels])
-        status[n], cpu[n] = index[m.cells], m.cpu_s
+        status[n], cpu[n] = _statuses(m), m.cpu_s
     kmap = KindMap(w, a, status, cpu)
     points = None
     if args.consensus:
@@ -183,8 +189,7 @@ def kind_record_map(args, scene, record, values, scales, workers: int, names) ->
     for n in names:
         m = verdict_map(_RecordRun(n, scene, record, args.im, args.tail), scene, scales, values,
                         backend=n, pulse=record.label, workers=workers)
-        index = np.array([STATUSES.index(lab.split(" (")[0]) for lab in m.labels])
-        status[n], cpu[n] = index[m.cells], m.cpu_s
+        status[n], cpu[n] = _statuses(m), m.cpu_s
     unit = {"pga": "m/s^2", "pgv": "m/s", "scale": ""}[args.im]
     name = args.im.upper() if args.im != "scale" else "scale factor"
     tex = {"pga": " [m/s$^2$]", "pgv": " [m/s]", "scale": ""}[args.im]

@@ -47,6 +47,7 @@ def test_map_on_drums_writes_each_engines_verdicts_whole(tmp_path, capsys):
         == {(e, w, a, cells[e][i, j]) for e in cells for j, w in enumerate(doc["omega"])
             for i, a in enumerate(doc["amplitude"])}
     assert out_png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert any((tmp_path / "store").iterdir())  # the cells went through the run store
 
 
 def test_disagreements_are_counted_and_hatched(tmp_path):
