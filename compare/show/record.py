@@ -8,6 +8,9 @@ panels side by side compare at a glance.  (PyBullet's own software renderer had
 its own world-fixed camera and scale and lost the lintel as the base drifted; it
 is no longer used for recordings.)
 
+A scene of another kind (:mod:`analytic.kinds`) has no theta/psi picture: every
+body is drawn from each engine's own poses (:mod:`compare.show.kind_record`).
+
 When every run has ended before ``--duration`` (all overturned), the recording
 stops :data:`HOLD_AFTER_END` seconds after the last one, so the verdicts can be
 read but no panel sits frozen for long.

@@ -79,7 +79,8 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
          duration: float | None = None, scene_arg: str | None = None,
          runs: tuple = ()) -> dict:
     """Show a run in a window: PyBullet's GUI if available, else a matplotlib
-    animation drawn from the backend's Trajectory (several panels for ``'all'``).
+    animation drawn from the backend's Trajectory (several panels for ``'all'``); a
+    scene of another kind from each engine's poses (:mod:`compare.show.kind_record`).
 
     Returns the trajectories shown (backend -> Trajectory); empty when PyBullet's
     own GUI was used.  Raises ``ValueError`` when there is no display, with the
