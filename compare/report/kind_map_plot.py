@@ -12,6 +12,18 @@ STATUS_COLOURS = {"survived": "white", "overturned": "0.45", "collapsed": "tab:p
                   "unstable": "tab:red", "undecided": "tab:orange"}
 
 
+def _edges(values):
+    """Cell edges of a grid that may be uneven (a subsampled engine grid): the
+    midpoints, the ends as far out as their neighbours, as pcolormesh's
+    ``shading='nearest'`` draws them."""
+    import numpy as np
+    v = np.asarray(values, float)
+    if v.size == 1:
+        return np.array([v[0] - 0.5, v[0] + 0.5])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate(([2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]))
+
+
 def plot_kind_map(kmap, path, scene, labels, points=None) -> None:
     """Write the figure of ``kmap`` (:class:`compare.cli.map_kinds.KindMap`) to
     ``path``; ``labels``: its axes' names (:class:`~compare.cli.map_kinds.MapAxes`);
@@ -36,16 +48,15 @@ def plot_kind_map(kmap, path, scene, labels, points=None) -> None:
     for ax in axes.ravel()[len(names):]:
         ax.set_visible(False)
     cmap = ListedColormap([STATUS_COLOURS[s] for s in STATUSES])
-    dw = np.diff(kmap.omega).min() if kmap.omega.size > 1 else 1.0
-    da = np.diff(kmap.amplitude).min() if kmap.amplitude.size > 1 else 1.0
+    xe, ye = _edges(kmap.omega), _edges(kmap.amplitude)
     lines = [(n, color(n) or f"C{k}") for k, n in enumerate(names)]
     for ax, name in zip(axes.ravel(), names):
         grid = kmap.status[name]
         ax.pcolormesh(kmap.omega, kmap.amplitude, grid, cmap=cmap, vmin=-0.5,
                       vmax=len(STATUSES) - 0.5, shading="nearest", edgecolors="0.8", lw=0.3)
         for i, j in zip(*np.nonzero(~kmap.agree)):
-            ax.add_patch(plt.Rectangle((kmap.omega[j] - dw / 2, kmap.amplitude[i] - da / 2),
-                                       dw, da, fill=False, hatch="xxx", edgecolor="tab:red",
+            ax.add_patch(plt.Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i],
+                                       fill=False, hatch="xxx", edgecolor="tab:red",
                                        lw=0.0, zorder=2))
         for k, (other, c) in enumerate(lines):  # dashes differ: equal curves stay visible
             ax.step(kmap.omega, kmap.first[other], where="mid", color=c, lw=2.4 - 0.5 * k,
