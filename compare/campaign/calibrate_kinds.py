@@ -6,7 +6,7 @@ is the engine's own: at each pulse frequency its first *failing* amplitude (an
 overturn or a collapse, :mod:`engines.structure_monitor`) at the reference step
 ``dt_ref`` (the finest step asked, or the engine's reference step), found as
 ``trilith spectrum --consensus`` finds it without a model: a scan from the
-structure's static uplift bound (:func:`compare.cli.spectrum_kinds.scan_guess`),
+structure's static uplift bound (:func:`compare.measure.kind_scan.scan_guess`),
 then the one robust bracket (:func:`compare.measure.thresholds.engine_threshold`
 with :data:`compare.measure.consensus.FAILURE_SEARCH`).  A candidate's error at a
 frequency is ``|A_candidate - A_ref| / A_ref``, its bracket centred on ``A_ref``.

@@ -145,6 +145,12 @@ def run(args: argparse.Namespace) -> int:
     shape = shape_from_args(args)
     engines, eng_grid = (), None
     rf = restitution_factor(args)
+    if getattr(scene, "kind", "trilith") != "trilith":  # no model: the engines' own map
+        if rf != 1.0:
+            raise ValueError(f"--restitution-factor scales the model's impacts; there is no "
+                             f"model of the {scene.kind} kind")
+        from trilith_xval.compare.cli.map_kinds import kind_map
+        return kind_map(args, scene, omegas, amps, workers, shape)
     if args.record is not None:
         if rf != 1.0:  # the record map runs the exact impact
             raise ValueError("--restitution-factor is not supported with --record yet")

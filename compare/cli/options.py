@@ -151,10 +151,10 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 # The commands that run a scene of another kind (analytic.kinds), which the model
 # does not cover: the engines alone (simulate), their consensus (spectrum
-# --consensus, trust, report, fragility, restitution), the engine against its own
-# reference step (calibrate), the listing (scenes).
-KIND_COMMANDS = ("simulate", "spectrum", "scenes", "trust", "report", "fragility", "calibrate",
-                 "restitution")
+# --consensus, trust, report, map, fragility, restitution), the engine against its own
+# reference step (calibrate), the drawings (record, view), the listing (scenes).
+KIND_COMMANDS = ("simulate", "spectrum", "scenes", "trust", "report", "map", "record", "view",
+                 "fragility", "calibrate", "restitution")
 
 
 def check_structure_engines(names, kind: str, command: str) -> None:
@@ -176,9 +176,8 @@ def check_kind(scene, command: str | None) -> None:
     if kind == "trilith" or command is None or command in KIND_COMMANDS:
         return
     raise ValueError(f"trilith {command}: scene {scene.name!r} is of the {kind} kind, which the "
-                     f"analytic model does not cover; 'trilith simulate', 'spectrum --consensus "
-                     f"E1,E2', 'trust', 'fragility --engine E1,E2', 'restitution --engine E1,E2' "
-                     f"and 'calibrate' (its own reference step) run it (docs/geometry.md)")
+                     f"analytic model does not cover; {', '.join(KIND_COMMANDS)} run it "
+                     f"(docs/geometry.md)")
 
 
 def add_pulse_kind_arg(parser: argparse.ArgumentParser) -> None:

@@ -44,6 +44,8 @@ def watch_inputs(args: argparse.Namespace) -> tuple:
     scene = scene_from_args(args)
     excitation = excitation_from_args(args, default=(DEFAULT_AMPLITUDE, DEFAULT_OMEGA))
     names = resolve_engines(args.engine)
+    if getattr(scene, "kind", "trilith") != "trilith":
+        names = kind_engines(scene, args.engine, names)
     loaded = settings_from_args(args, tuple(n for n in names if n in engine_names()))
     runs = tuple(run_spec(n, scene, excitation, loaded) for n in names)
     settings = RecordSettings(fps=args.fps, duration=args.duration,
@@ -54,6 +56,25 @@ def watch_inputs(args: argparse.Namespace) -> tuple:
         check_run_budget(run.backend, run.settings, excitation, option="--duration",
                          length=duration)
     return scene, excitation, settings
+
+
+def kind_engines(scene, given: str, names: tuple[str, ...]) -> tuple[str, ...]:
+    """The engines of a recording of another kind: ``all`` is every engine that
+    builds it (:data:`engines.geometry.STRUCTURE_ENGINES`); the model is refused,
+    as an engine that runs the trilith only."""
+    from trilith_xval.engines.geometry import STRUCTURE_ENGINES
+    if given.strip() == "all":
+        return STRUCTURE_ENGINES
+    for name in names:
+        if name.startswith("analytic"):
+            raise ValueError(f"--engine {name}: there is no model of the {scene.kind} kind; "
+                             f"give engines from {', '.join(STRUCTURE_ENGINES)} (default "
+                             f"analytic)")
+        if name not in STRUCTURE_ENGINES:
+            raise ValueError(f"--engine {name}: runs the parametric trilith only, not the "
+                             f"{scene.kind} kind (engines that run it: "
+                             f"{', '.join(STRUCTURE_ENGINES)})")
+    return names
 
 
 def add_parser(subparsers) -> None:
@@ -73,10 +94,15 @@ def run(args: argparse.Namespace) -> int:
     scene, excitation, settings = watch_inputs(args)
     check_output_path(args.out, "--out", suffixes=FORMATS)
     check_output(args.out)  # the encoder (ffmpeg for .mp4)
-    result = record(scene, excitation, args.engine, args.out, settings)
+    engines = (args.engine if getattr(scene, "kind", "trilith") == "trilith"
+               else ",".join(r.backend for r in settings.runs))  # "all" resolved for the kind
+    result = record(scene, excitation, engines, args.out, settings)
+    kind = getattr(scene, "kind", "trilith") != "trilith"
     verdicts = ", ".join(f"{name}: {traj.verdict.status}"
                          + (f", overturn_time = {traj.overturn_time:.3f} s"
                             if traj.overturned else "")
+                         + (f", at {traj.verdict.time:.3f} s" if kind and not traj.overturned
+                            and traj.verdict.time is not None else "")
                          for name, traj in result.trajectories.items())
     print(f"wrote {result.path}: {result.n_frames} frames at {result.fps:g} fps "
           f"({result.duration:.3f} s); {verdicts}")

@@ -125,6 +125,9 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
         check_output_path(args.csv, "--csv")
     if args.plot:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
+    if getattr(scene, "kind", "trilith") != "trilith":  # no model: the engines alone
+        from trilith_xval.compare.cli.map_kinds import kind_record_map
+        return kind_record_map(args, scene, record, eng_values, eng_scales, workers, engines_)
     use_store(args)
     maps = []
     for name, (v, k) in [("analytic", (values, scales))] + [(e, (eng_values, eng_scales))

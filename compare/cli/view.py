@@ -21,6 +21,8 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     scene, excitation, settings = watch_inputs(args)
-    view(scene, excitation, args.engine, fps=args.fps, duration=args.duration,
+    engines = (args.engine if getattr(scene, "kind", "trilith") == "trilith"
+               else ",".join(r.backend for r in settings.runs))  # "all" resolved for the kind
+    view(scene, excitation, engines, fps=args.fps, duration=args.duration,
          scene_arg=args.scene, runs=settings.runs)
     return 0

@@ -8,6 +8,9 @@ panels side by side compare at a glance.  (PyBullet's own software renderer had
 its own world-fixed camera and scale and lost the lintel as the base drifted; it
 is no longer used for recordings.)
 
+A scene of another kind (:mod:`analytic.kinds`) has no theta/psi picture: every
+body is drawn from each engine's own poses (:mod:`compare.show.kind_record`).
+
 When every run has ended before ``--duration`` (all overturned), the recording
 stops :data:`HOLD_AFTER_END` seconds after the last one, so the verdicts can be
 read but no panel sits frozen for long.
@@ -358,18 +361,28 @@ def record(scene: Scene, excitation, engine: str, out: str | Path,
     names = tuple(trajectories) if trajectories else resolve_engines(engine)
     duration = settings.duration if settings.duration is not None else default_duration(excitation)
     frame_times(duration, settings.fps)  # validates the frame count before any run
+    kind = getattr(scene, "kind", "trilith") != "trilith"
     if trajectories is None:
         for name in names:  # fail on a missing backend before any long run
             load_backend(name)
-        trajectories = {name: run_backend(recording_run(name, scene, excitation, duration,
-                                                        settings.run_of(name)))
-                        for name in names}
+        runs = {name: recording_run(name, scene, excitation, duration, settings.run_of(name))
+                for name in names}
+        if kind:  # every body drawn from the engine's own poses
+            from trilith_xval.compare.show.kind_record import run_with_poses
+            posed = {name: run_with_poses(run) for name, run in runs.items()}
+            trajectories = {name: r.trajectory for name, r in posed.items()}
+        else:
+            trajectories = {name: run_backend(run) for name, run in runs.items()}
     duration = shown_duration(trajectories, duration)
     times = frame_times(duration, settings.fps)
     dpi = 100
     figure = Figure(figsize=(len(names) * settings.panel_width / dpi,
                              settings.panel_height / dpi), dpi=dpi)
-    panels = Panels(scene, excitation, times, trajectories, figure)
+    if kind:
+        from trilith_xval.compare.show.kind_record import KindPanels
+        panels = KindPanels(times, posed, excitation, figure)
+    else:
+        panels = Panels(scene, excitation, times, trajectories, figure)
     frames = render_frames(panels, figure)
     if path.suffix.lower() == ".gif":
         write_gif(frames, path, settings.fps)

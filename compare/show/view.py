@@ -79,7 +79,8 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
          duration: float | None = None, scene_arg: str | None = None,
          runs: tuple = ()) -> dict:
     """Show a run in a window: PyBullet's GUI if available, else a matplotlib
-    animation drawn from the backend's Trajectory (several panels for ``'all'``).
+    animation drawn from the backend's Trajectory (several panels for ``'all'``); a
+    scene of another kind from each engine's poses (:mod:`compare.show.kind_record`).
 
     Returns the trajectories shown (backend -> Trajectory); empty when PyBullet's
     own GUI was used.  Raises ``ValueError`` when there is no display, with the
@@ -112,10 +113,17 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     span = settings.duration if settings.duration is not None else default_duration(excitation)
     spans = {name: recording_run(name, scene, excitation, span, settings.run_of(name))
              for name in names}
-    if len(names) == 1 and _own_gui(spans[names[0]], span):
+    kind = getattr(scene, "kind", "trilith") != "trilith"
+    # An engine's own GUI draws the trilith only: a kind is drawn from its poses.
+    if not kind and len(names) == 1 and _own_gui(spans[names[0]], span):
         return {}
     frame_times(span, settings.fps)  # validates the frame count before any run
-    trajectories = {name: run_backend(run) for name, run in spans.items()}
+    if kind:
+        from trilith_xval.compare.show.kind_record import KindPanels, run_with_poses
+        posed = {name: run_with_poses(run) for name, run in spans.items()}
+        trajectories = {name: r.trajectory for name, r in posed.items()}
+    else:
+        trajectories = {name: run_backend(run) for name, run in spans.items()}
     times = frame_times(shown_duration(trajectories, span), settings.fps)
 
     import matplotlib.pyplot as plt
@@ -124,7 +132,8 @@ def view(scene: Scene, excitation, engine: str = "analytic", fps: float = 30.0,
     # At most 12 in (1200 px at 100 dpi) wide: three panels fit a 1280 px screen.
     width = min(4.8, 12.0 / len(names))
     figure = plt.figure(figsize=(width * len(names), 0.75 * width))
-    panels = Panels(scene, excitation, times, trajectories, figure)
+    panels = (KindPanels(times, posed, excitation, figure) if kind
+              else Panels(scene, excitation, times, trajectories, figure))
     # Keep a reference: an unreferenced FuncAnimation is garbage-collected and stops.
     # blit: only the moving artists are redrawn (Panels.update returns them), which
     # keeps the window near real time with several panels.
