@@ -5,20 +5,22 @@ CPU s, simulated s, runs)`` on one scene against the model.
 ``restitution``: free rocking, the first impacts' velocity ratios against Eq. 19/20;
 ``thresholds``: the first-overturning amplitudes against the model's spectrum;
 ``histories``: theta(t) before the first impact at the paper's points A-D.
+Each takes the candidate's run and ``vs``, the validation set
+(:class:`compare.campaign.calibrate.ValidationSet`; not imported here, as
+calibrate imports this module).
 """
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:  # annotations only: calibrate imports this module
-    from trilith_xval.compare.campaign.calibrate import ValidationSet
+if TYPE_CHECKING:  # annotations only
     from trilith_xval.compare.run.spec import RunSpec
 
 __all__ = ["restitution", "thresholds", "histories"]
 
 
-def restitution(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
+def restitution(run: RunSpec, vs, rf: float = 1.0):
     from trilith_xval.compare.measure.restitution import free_rocking
     scene = run.scene
     cases = [(f"lam {lam:g} mu {mu:g}", scene.without_pendulum().replace(lam=lam, mu=mu))
@@ -53,7 +55,7 @@ def thresholds(run: RunSpec, reference, workers):
     return errors, engine_cpu, simulated, runs
 
 
-def histories(run: RunSpec, vs: ValidationSet, rf: float = 1.0):
+def histories(run: RunSpec, vs, rf: float = 1.0):
     from trilith_xval import engines
     from trilith_xval.compare.measure.trajectories import compare_trajectories
     from trilith_xval.scenes import point_pulse

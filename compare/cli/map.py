@@ -12,6 +12,7 @@ from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, add_pulse_kind_arg,
                                  add_store_args, add_workers_arg, check_output_path, parse_engine_list,
                                  parse_omega_range, parse_range, print_json, resolve_workers,
                                  scene_from_args)
+from trilith_xval.compare.cli.map_cells import ENGINE_POINTS, EngineRun
 from trilith_xval.compare.cli.map_text import print_map_summary, subsample
 from trilith_xval.compare.report.map_plot import plot_maps
 from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
@@ -20,7 +21,6 @@ from trilith_xval.compare.run.jsonable import plain
 
 DEFAULT_OMEGA = "3:30:0.5"
 DEFAULT_AMPLITUDE = "0.5:100:0.5"
-ENGINE_POINTS = 8  # default engine grid: at most 8 x 8 of the analytic grid's values
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -82,22 +82,6 @@ def _engine_grid(args, omegas, amps, n_engines: int):
                          f"engine), more than --max-engine-runs {args.max_engine_runs}: coarsen "
                          f"--engine-omega/--engine-amplitude or raise --max-engine-runs")
     return w, a
-
-
-class _EngineRun:
-    """``(A, Omega) -> Verdict`` of one engine: its run ``spec`` (a
-    :class:`compare.run.spec.RunSpec`) at each cell's pulse, verdict only, the
-    friction rule evaluated for that pulse, through the run store."""
-
-    def __init__(self, spec, pulse):
-        self.spec = spec.with_options("the map's cells", verdict_only=True)
-        self.pulse = pulse
-
-    def __call__(self, amplitude: float, omega: float):
-        from trilith_xval.analytic.pulses import pulse_of
-        from trilith_xval.compare.run import runs
-        spec = self.spec.at(excitation=pulse_of(self.pulse, amplitude, omega))
-        return runs.simulate(spec.backend, spec.scene, spec.excitation, spec.settings).verdict
 
 
 CSV_COLUMNS = ("backend", "omega", "amplitude", "verdict", "model_valid_at_first_overturning",
@@ -192,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
                 cells[n].at(excitation=pulse_of(shape, float(max(eng_grid[1])), float(w)))
     maps = [analytic_map(scene, omegas, amps, settings, workers=workers)]
     for name in engines:
-        maps.append(verdict_map(_EngineRun(cells[name], settings.pulse), scene, *eng_grid,
+        maps.append(verdict_map(EngineRun(cells[name], settings.pulse), scene, *eng_grid,
                                 backend=name, pulse=settings.pulse, workers=workers))
     thresholds = {}
     if engines:

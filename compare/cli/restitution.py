@@ -12,8 +12,7 @@ from trilith_xval.compare.cli.options import (add_scene_args, add_settings_arg, 
 from trilith_xval.compare.cli.model_options import add_restitution_arg, restitution_factor
 from trilith_xval.compare.run.jsonable import plain
 
-# Half the static overturning angle: large, clean impacts far from toppling.
-DEFAULT_THETA0_FRACTION = 0.5
+from trilith_xval.compare.measure.restitution import DEFAULT_THETA0_FRACTION
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:

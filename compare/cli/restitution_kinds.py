@@ -15,8 +15,8 @@ def _checked(args, scene):
     """``(engines, theta0, n)`` or one line refusing, before any work, what has no
     meaning without a model or cannot be released."""
     from trilith_xval.compare.cli.options import parse_engine_list
-    from trilith_xval.compare.cli.restitution import DEFAULT_THETA0_FRACTION
-    from trilith_xval.compare.measure.restitution import DEFAULT_N_IMPACTS, MAX_N_IMPACTS
+    from trilith_xval.compare.measure.restitution import (DEFAULT_N_IMPACTS,
+                                                          DEFAULT_THETA0_FRACTION, MAX_N_IMPACTS)
     from trilith_xval.engines.geometry import RELEASE_KINDS, STRUCTURE_ENGINES, release_limit
     kind = scene.kind
     if kind not in RELEASE_KINDS:

@@ -24,12 +24,15 @@ from trilith_xval.analytic.excitation import Still
 from trilith_xval.analytic.trajectory import Trajectory
 
 __all__ = ["ImpactRestitution", "RestitutionResult", "measure_restitution", "free_rocking",
-           "restitution_from_trajectory", "analytic_impact_times", "DEFAULT_N_IMPACTS",
+           "restitution_from_trajectory", "analytic_impact_times", "DEFAULT_N_IMPACTS", "DEFAULT_THETA0_FRACTION",
            "MAX_N_IMPACTS"]
 
 # Four impacts: two of each side, while the amplitude is still large enough that
 # every engine resolves the impact cleanly (the amplitude drops ~e^2 per impact).
 DEFAULT_N_IMPACTS = 4
+# The release tilt, as a fraction of the static overturning angle: large, clean
+# impacts far from toppling.
+DEFAULT_THETA0_FRACTION = 0.5
 MAX_N_IMPACTS = 50
 
 

@@ -4,9 +4,13 @@ first failure on the grid drawn on every panel, the cells where the engines
 disagree hatched; engine against engine, never agreement with the model."""
 from __future__ import annotations
 
-__all__ = ["plot_kind_map", "STATUS_COLOURS"]
+__all__ = ["plot_kind_map", "STATUS_COLOURS", "STATUSES", "FAILURES", "BASIS"]
 
-# Statuses of a kind's run (compare.cli.map_kinds.STATUSES): failures dark, as the
+# The statuses of a run of another kind, in the order a map's legend lists them.
+STATUSES = ("survived", "overturned", "collapsed", "unstable", "undecided")
+FAILURES = ("overturned", "collapsed")
+BASIS = "engine against engine, never agreement with the model"
+# Statuses of a kind's run (STATUSES): failures dark, as the
 # trilith map's overturns, a collapse in the trilith map's colour for it.
 STATUS_COLOURS = {"survived": "white", "overturned": "0.45", "collapsed": "tab:purple",
                   "unstable": "tab:red", "undecided": "tab:orange"}
@@ -37,7 +41,6 @@ def plot_kind_map(kmap, path, scene, labels, points=None) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    from trilith_xval.compare.cli.map_kinds import BASIS, STATUSES
     from trilith_xval.compare.report.plots import color
 
     names = list(kmap.status)
