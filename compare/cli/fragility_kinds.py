@@ -21,6 +21,7 @@ def check_kind_engines(scene, engines_: tuple[str, ...], args) -> None:
     a scene of another kind: fewer than two engines (one engine has nobody to be
     checked against), an engine that does not build the body list, ``--stripes``
     (the multiple-stripe analysis is the model's comparison)."""
+    from trilith_xval.compare.cli.options import check_structure_engines
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
     kind = scene.kind
     if len(engines_) < 2:
@@ -28,10 +29,7 @@ def check_kind_engines(scene, engines_: tuple[str, ...], args) -> None:
                          f"{scene.name!r}); --engine needs two or more engines to check "
                          f"against each other ({', '.join(STRUCTURE_ENGINES)}), got "
                          f"{','.join(engines_) or 'none'}")
-    for e in engines_:
-        if e not in STRUCTURE_ENGINES:
-            raise ValueError(f"--engine: {e} runs the parametric trilith only, not the {kind} "
-                             f"kind; allowed: {', '.join(STRUCTURE_ENGINES)}")
+    check_structure_engines(engines_, kind, "fragility")
     if args.stripes is not None:
         raise ValueError(f"--stripes: the multiple-stripe analysis is not run on the {kind} "
                          "kind (no model to compare it with); leave it out")

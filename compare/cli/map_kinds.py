@@ -91,16 +91,14 @@ def _structure_engines() -> tuple[str, ...]:
 
 def _check(args, scene, names) -> None:
     """Refuse, before any work, what the engines' map of a kind cannot give."""
+    from trilith_xval.compare.cli.options import check_structure_engines
     from trilith_xval.engines.geometry import STRUCTURE_ENGINES
     kind = scene.kind
     if not names:
         raise ValueError(f"trilith map: there is no analytic map of the {kind} kind (scene "
                          f"{scene.name!r}: the model does not cover it); give --engine E1,E2 "
                          f"(the engines against each other: {', '.join(STRUCTURE_ENGINES)})")
-    for name in names:
-        if name not in STRUCTURE_ENGINES:
-            raise ValueError(f"--engine {name}: runs the parametric trilith only, not the "
-                             f"{kind} kind (engines that run it: {', '.join(STRUCTURE_ENGINES)})")
+    check_structure_engines(names, kind, "map")
     if len(names) < 2:
         raise ValueError(f"--engine: the map of the {kind} kind compares engines with each "
                          f"other: give two or more, got {', '.join(names)}")

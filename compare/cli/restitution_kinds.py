@@ -14,7 +14,7 @@ __all__ = ["kind_restitution"]
 def _checked(args, scene):
     """``(engines, theta0, n)`` or one line refusing, before any work, what has no
     meaning without a model or cannot be released."""
-    from trilith_xval.compare.cli.options import parse_engine_list
+    from trilith_xval.compare.cli.options import check_structure_engines, parse_engine_list
     from trilith_xval.compare.measure.restitution import (DEFAULT_N_IMPACTS,
                                                           DEFAULT_THETA0_FRACTION, MAX_N_IMPACTS)
     from trilith_xval.engines.geometry import RELEASE_KINDS, STRUCTURE_ENGINES, release_limit
@@ -27,10 +27,7 @@ def _checked(args, scene):
         raise ValueError(f"--engine: there is no Eq. 19/20 for the {kind} kind; give two or "
                          f"more engines to check against each other "
                          f"({', '.join(STRUCTURE_ENGINES)}), got {','.join(names)}")
-    for e in names:
-        if e not in STRUCTURE_ENGINES:
-            raise ValueError(f"--engine: {e} runs the parametric trilith only, not the {kind} "
-                             f"kind; allowed: {', '.join(STRUCTURE_ENGINES)}")
+    check_structure_engines(names, kind, "restitution")
     if args.psi0 != 0.0:
         raise ValueError(f"--psi0: the {kind} kind is released with its bob at rest (0)")
     if getattr(args, "restitution_factor", None) not in (None, 1.0):
