@@ -260,12 +260,13 @@ def write_campaign(doc: dict, out: Path) -> None:
             "table{border-collapse:collapse;font-size:12px}td,th{border:1px solid #ccc;"
             "padding:2px 6px;text-align:right}</style></head><body>"
             f"<h1>Campaign {html.escape(study['name'])}</h1>"
-            f"<p>{len(study['scenes']) + len(study.get('kind_scenes') or ())} scenes, engines {', '.join(study['engines'])}, "
-            f"steps {study['steps']}, Omega {study['omegas']} rad/s; engine overturning "
-            "threshold against the analytic one (rel_error = A_engine/A_analytic - 1).</p>"
-            "<h2>Summary</h2>" + table(doc["summary"], list(doc["summary"][0]) if
-                                       doc["summary"] else [])
-            + "<h2>Every job</h2>" + table(doc["rows"], cols)
+            f"<p>{len(study['scenes']) + len(study.get('kind_scenes') or ())} scenes, engines "
+            f"{', '.join(study['engines'])}, "
+            f"steps {study['steps']}, Omega {study['omegas']} rad/s"
+            + ("; engine overturning threshold against the analytic one (rel_error = "
+               "A_engine/A_analytic - 1)" if doc["rows"] else "") + ".</p>"
+            + ("<h2>Summary</h2>" + table(doc["summary"], list(doc["summary"][0]))
+               + "<h2>Every job</h2>" + table(doc["rows"], cols) if doc["rows"] else "")
             + _consensus_section(doc.get("consensus") or [], study["engines"], table)
             + f"<h2>Versions</h2>{table([doc['versions']], list(doc['versions']))}"
             "</body></html>\n")
@@ -284,7 +285,7 @@ def _consensus_section(rows: list[dict], engines: list[str], table) -> str:
         for e in engines:
             got = (r.get("engines") or {}).get(e)
             row[f"{e} [m/s^2]"] = got["a_fails"] if got else None
-            row[f"{e} dev."] = got["deviation"] if got else None
+            row[f"{e} vs median"] = f"{100 * got['deviation']:+.2f} %" if got else None
         row["outliers"] = "; ".join(f"{o['engine']} ({o['cause']})" for o in r["outliers"])
         row["no answer"] = "; ".join(f"{m['engine']} ({m['cause']})" for m in r["no_answer"])
         flat.append(row)
