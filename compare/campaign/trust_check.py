@@ -39,7 +39,7 @@ import time
 
 import numpy as np
 
-__all__ = ["trust_scene", "GRID_OVER_P", "N_THRESHOLDS", "HISTORY_FACTORS"]
+__all__ = ["trust_scene", "StageProgress", "GRID_OVER_P", "N_THRESHOLDS", "HISTORY_FACTORS"]
 
 # Omega / p of the model's grid: Fig. 5's 3-30 rad/s is 1.4-14 p.
 GRID_OVER_P = tuple(float(x) for x in np.linspace(1.5, 13.5, 25))
@@ -48,7 +48,7 @@ N_CONSENSUS = 3  # per curve, where the model is invalid: the engines against ea
 HISTORY_FACTORS = (0.9, 1.1)  # x the model's threshold: one survives, one overturns
 
 
-class _Progress:
+class StageProgress:
     """One stderr line per stage: ``trust: stage k/N name ... done/total, elapsed``."""
 
     def __init__(self, n_stages: int, quiet: bool):
@@ -225,7 +225,7 @@ def trust_scene(scene, engines, *, records=(), workers: int = 1, quiet: bool = F
     from trilith_xval.compare.run.keys import project_version
     tol = Tolerances()
     t0, c0, load0 = time.perf_counter(), _cpu(), os.getloadavg()[0]
-    progress = _Progress(1 + 3 * len(engines) + (len(engines) if records else 0)
+    progress = StageProgress(1 + 3 * len(engines) + (len(engines) if records else 0)
                          + (len(engines) >= 2), quiet)
     progress.next("model: spectrum and validity")
     band = _band(scene, workers)

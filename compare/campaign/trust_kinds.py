@@ -152,7 +152,8 @@ def trust_kind(scene, engines, *, records=(), over_p=OVER_P, options: dict | Non
     """
     from trilith_xval.analytic.excitation import Still
     from trilith_xval.analytic.ida import IDASettings
-    from trilith_xval.compare.campaign.trust_check import _Progress, _cpu
+    from trilith_xval.analytic._workers import cpu_seconds
+    from trilith_xval.compare.campaign.trust_check import StageProgress
     from trilith_xval.compare.measure.consensus import OUTLIER_TOL, STEP_AGREE
     from trilith_xval.compare.measure.kind_scan import kind_point, kind_record
     from trilith_xval.compare.run.keys import project_version
@@ -171,13 +172,13 @@ def trust_kind(scene, engines, *, records=(), over_p=OVER_P, options: dict | Non
                              for f in over_p):
         raise ValueError(f"trust_kind: over_p must be positive finite multiples of p, "
                          f"got {over_p!r}")
-    t0, c0, load0 = time.perf_counter(), _cpu(), os.getloadavg()[0]
+    t0, c0, load0 = time.perf_counter(), cpu_seconds(), os.getloadavg()[0]
     layer = dict(overrides=options, overrides_from="trust_kind(options=...)")
     runs = {e: RunSpec.resolve(e, scene, Still(), calibrated=True, **layer) for e in engines}
     defaults = {e: RunSpec.resolve(e, scene, **layer) for e in engines}
     p, R, body = structure_p(scene)
     omegas = design_omegas(scene, over_p)
-    progress = _Progress(2 + bool(records), quiet)
+    progress = StageProgress(2 + bool(records), quiet)
     progress.next("thresholds, engine against engine", len(omegas))
     points, n_scan = [], 0
     for i, w in enumerate(omegas):
@@ -216,7 +217,7 @@ def trust_kind(scene, engines, *, records=(), over_p=OVER_P, options: dict | Non
             "history_verdict": _history_verdict(histories, e),
             "record_verdict": None if found is None else verdict(found, e),
             "cost": _cost(points, e)}
-    doc["cost"] = {"wall_s": time.perf_counter() - t0, "cpu_s": _cpu() - c0,
+    doc["cost"] = {"wall_s": time.perf_counter() - t0, "cpu_s": cpu_seconds() - c0,
                    "load_average": [load0, os.getloadavg()[0]]}
     return doc
 

@@ -31,7 +31,7 @@ def test_consensus_where_the_lintel_would_be_thrown_off(capsys):
     band = {"curves": {"no_pendulum": [
         _row(24.0, 63.137, False, "lintel normal force -0.25 of its weight")]}}
     runs = {e: RunSpec.resolve(e, scene, calibrated=True) for e in ("pymunk", "mujoco")}
-    (c,) = trust_check._consensus(runs, scene, band, trust_check._Progress(1, True))
+    (c,) = trust_check._consensus(runs, scene, band, trust_check.StageProgress(1, True))
     assert c["case"] == "no_pendulum" and c["status"] == "consensus"
     assert all(abs(v["deviation"]) <= 0.02 for v in c["engines"].values())
     from trilith_xval.compare.report.trust_page import _consensus_section
