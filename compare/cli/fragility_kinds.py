@@ -76,22 +76,11 @@ def print_kind_fragility(doc: dict, st) -> None:
     """The per-record consensus table and the closing line of a kind's result."""
     from trilith_xval.analytic.ida import IM_UNITS
     from trilith_xval.compare.cli.options import info
+    from trilith_xval.compare.cli.spectrum_kinds import print_consensus_table
     unit = IM_UNITS[st.im] or "-"
     names = list(doc["backends"])
-    head = "".join(f" {e + ' [' + unit + ']':>16}" for e in names)
-    print(f"{'record':>16}{head} {'median':>9} {'status':>10}  failure")
-    for p in doc["consensus"]:
-        cells = "".join(f" {p['engines'][e]['a_fails']:16.4g}" if e in p["engines"]
-                        else f" {'-':>16}" for e in names)
-        median = f"{p['median']:9.4g}" if p["median"] is not None else f"{'-':>9}"
-        print(f"{p['record'][:16]:>16}{cells} {median} {p['status']:>10}  "
-              f"{p.get('failure') or '-'}")
-        for miss in p["no_answer"]:
-            info(f"  {p['record']}: {miss['engine']} has no answer ({miss['cause']}: "
-                 f"{miss['detail']})")
-        for o in p["outliers"]:
-            info(f"  {p['record']}: {o['engine']} is an outlier ({100 * o['deviation']:+.2g} "
-                 f"%, cause {o['cause']})")
+    print_consensus_table(doc["consensus"], names, ("record", 16), unit,
+                          lambda p: f"{p['record'][:16]:>16}", lambda p: p["record"], col=16)
     steps = sorted({r["dt"] for body in doc["backends"].values() for r in body["records"]
                     if r.get("dt") is not None})
     info(f"steps of the answers: {', '.join(f'{d:.3g} s' for d in steps) or '-'} (each "

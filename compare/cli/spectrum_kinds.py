@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from trilith_xval.compare.cli.options import envelope, info, print_json
 
-__all__ = ["kind_spectrum"]
+__all__ = ["kind_spectrum", "print_consensus_table"]
 
 
 def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
@@ -64,21 +64,29 @@ def kind_spectrum(args, scene, parse_omega_range, settings_from_args) -> int:
     print(f"scene {scene.name} ({kind}): no model; each engine's own first failure "
           f"(overturn or collapse), converged in the step, and their consensus; {shape} pulse, "
           f"criterion {args.criterion}")
-    head = "".join(f" {e + ' [m/s^2]':>18}" for e in names)
-    print(f"{'Omega [rad/s]':>13}{head} {'median':>9} {'status':>10}  failure")
-    for p in points:
-        cells = []
-        for e in names:
-            row = p["engines"].get(e)
-            cells.append(f" {row['a_fails']:18.4g}" if row else f" {'-':>18}")
-        median = f"{p['median']:9.4g}" if p["median"] is not None else f"{'-':>9}"
-        print(f"{p['omega']:13.4g}{''.join(cells)} {median} {p['status']:>10}  "
-              f"{p.get('failure') or '-'}")
-        for miss in p["no_answer"]:
-            info(f"  Omega {p['omega']:g}: {miss['engine']} has no answer ({miss['cause']}: "
-                 f"{miss['detail']})")
-        for out in p["outliers"]:
-            info(f"  Omega {p['omega']:g}: {out['engine']} is an outlier "
-                 f"({100 * out['deviation']:+.2g} %, cause {out['cause']})")
+    print_consensus_table(points, names, ("Omega [rad/s]", 13), "m/s^2",
+                          lambda p: f"{p['omega']:13.4g}", lambda p: f"Omega {p['omega']:g}")
     info("engine against engine, never agreement with a model (docs/geometry.md)")
     return 0
+
+
+def print_consensus_table(points, names, head: tuple[str, int], unit: str, label, where,
+                          col: int = 18) -> None:
+    """One row per consensus point (:func:`compare.measure.consensus.consensus`): its
+    ``label(point)`` under ``head`` (title, width), each engine's own first failure
+    [``unit``] in a column ``col`` wide, the median, the status and the failure; then
+    on stderr each engine without an answer and each outlier, prefixed ``where(point)``."""
+    title, width = head
+    print(f"{title:>{width}}" + "".join(f" {e + ' [' + unit + ']':>{col}}" for e in names)
+          + f" {'median':>9} {'status':>10}  failure")
+    for p in points:
+        cells = "".join(f" {p['engines'][e]['a_fails']:{col}.4g}" if e in p["engines"]
+                        else f" {'-':>{col}}" for e in names)
+        median = f"{p['median']:9.4g}" if p["median"] is not None else f"{'-':>9}"
+        print(f"{label(p)}{cells} {median} {p['status']:>10}  {p.get('failure') or '-'}")
+        for miss in p["no_answer"]:
+            info(f"  {where(p)}: {miss['engine']} has no answer ({miss['cause']}: "
+                 f"{miss['detail']})")
+        for out in p["outliers"]:
+            info(f"  {where(p)}: {out['engine']} is an outlier "
+                 f"({100 * out['deviation']:+.2g} %, cause {out['cause']})")
