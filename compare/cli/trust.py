@@ -34,8 +34,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--engine", default=None, metavar="NAME[,NAME...]|all",
                         help="engines to judge (default: the engines marked affordable, about "
                              "a CPU second per threshold point; 'all' adds the others); on "
-                             "another kind, engine against engine: two or more to judge them, "
-                             "one alone is not judged")
+                             "another kind, engine against engine: two or more (one alone is "
+                             "refused)")
     parser.add_argument("--record", default=None, metavar="FILE|DIR",
                         help="also each ground motion's first overturning intensity (PGA), "
                              "model against engine: a CSV/AT2 file, a folder of them, or a "

@@ -11,8 +11,14 @@ __all__ = ["check_kind_trust", "write_kind_trust", "print_verdicts"]
 
 
 def check_kind_trust(scene, engines, command: str) -> None:
-    """The door for a kind (before any work): engines that build the body list."""
+    """The door for a kind (before any work): two or more engines that build the
+    body list (one engine alone has nothing to be judged against; as map,
+    fragility and restitution, it is refused rather than measured for minutes)."""
     check_structure_engines(engines, scene.kind, command)
+    if len(engines) < 2:
+        raise ValueError(f"trilith {command}: there is no model of the {scene.kind} kind; "
+                         f"--engine needs two or more engines to judge against each other, "
+                         f"got {','.join(engines) or 'none'}")
 
 
 def write_kind_trust(scene, engines, out, quiet: bool, records=()) -> dict:

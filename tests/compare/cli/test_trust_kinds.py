@@ -186,3 +186,13 @@ def test_report_on_a_kind_writes_its_trust_page(tmp_path, capsys, cheap):
     assert main(["report", "--scene", "block_on_block", "--quick", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "--quick do not apply" in err
+
+
+def test_one_engine_alone_is_refused_before_any_work(capsys, tmp_path):
+    from trilith_xval.compare.cli.main import main
+    for command in ("trust", "report"):
+        assert main([command, "--scene", "block_on_block", "--engine", "pymunk",
+                     "--out", str(tmp_path / command)]) == 2
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and "two or more engines" in err
+        assert not (tmp_path / command).exists()
