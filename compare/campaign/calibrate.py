@@ -24,9 +24,10 @@ per engine and per *metric*, on a stated validation set:
 
 Every candidate (the product of the values in the search space) is evaluated on
 the whole set with the store bypassed, so that every cost is what the runs cost on
-the machine that ran them.  Each finished candidate is then kept in the run store
-(when one is active): a killed calibration resumes at the next candidate, and a
-served candidate (``from_store``) keeps the costs measured when it ran.  Two
+the machine that ran them.  Each finished scene of a candidate, and then the
+finished candidate, is kept in the run store (when one is active): a killed
+calibration resumes at the next scene, and a served candidate (``from_store``) keeps
+the costs measured when its scenes ran.  Two
 costs are kept: the engine's own (``engine_cpu_s``, the CPU seconds each engine
 run measured inside its stepping loop, summed: what a user of these settings
 pays) and the whole evaluation's (``cpu_s``: this process and the
@@ -117,7 +118,8 @@ class Evaluation:
     cpu_s: float  # the whole evaluation, reference runs and measurement included
     simulated_s: float  # simulated seconds of every engine run of the evaluation
     runs: int
-    from_store: bool = False  # served by the run store: its costs are those measured then
+    # Served by the run store, whole or scene by scene: its costs are those measured then.
+    from_store: bool = False
 
     @property
     def real_time_factor(self) -> float:
@@ -269,6 +271,7 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     """
     from trilith_xval import engines
     from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.keys import scene_dict
     from trilith_xval.scenes import load_scene
     if metric not in METRICS:
         raise ValueError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
@@ -330,20 +333,39 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
             return _thresholds(run, reference[id(sc)], workers)
         return _histories(run, vs, rf)
 
-    def evaluate(cand: dict) -> Evaluation:
-        with runs.using(None):  # measured costs: no run inside served from a store
-            cpu0 = cpu_seconds()
-            errors, engine_cpu, simulated, n = [], 0.0, 0.0, 0
-            for sc in scenes:
+    def scene_part(sc, cand: dict, description: dict):
+        # One scene of one candidate, kept in the run store as soon as it is done
+        # (keyed by that scene alone): a calibration killed mid-candidate (one
+        # candidate over a design's scenes can take CPU hours) resumes at the next.  Measured with the store
+        # bypassed, so its costs are what its runs cost when they ran.
+        key = {**description, "scenes": [scene_dict(sc)], "part": "scene",
+               "validation": {**description["validation"], "scene": sc.name}}
+        stored = runs.lookup("calibration-scene", key, code=runs.ALL_CODE)
+        if stored is not None:
+            return stored, True
+
+        def measure():
+            with runs.using(None):
+                cpu0 = cpu_seconds()
                 e, c, t, k = one_scene(sc, cand)
-                errors += [(f"{sc.name}: {label}" if len(scenes) > 1 else label, err)
-                           for label, err in e]
-                engine_cpu, simulated, n = engine_cpu + c, simulated + t, n + k
-            values = [e for _, e in errors]
-            worst = max(values) if values and all(math.isfinite(v) for v in values) \
-                else math.inf
-            return Evaluation(dict(cand), worst, tuple(errors), engine_cpu,
-                              cpu_seconds() - cpu0, simulated, n)
+                return (tuple(tuple(x) for x in e), c, t, k, cpu_seconds() - cpu0)
+        return runs.memo("calibration-scene", key, measure,
+                         label=f"calibrate {engine} {metric} {sc.name}",
+                         code=runs.ALL_CODE), False
+
+    def evaluate(cand: dict, description: dict) -> Evaluation:
+        errors, engine_cpu, simulated, n, cpu, served = [], 0.0, 0.0, 0, 0.0, False
+        for sc in scenes:
+            (e, c, t, k, s), hit = scene_part(sc, cand, description)
+            errors += [(f"{sc.name}: {label}" if len(scenes) > 1 else label, err)
+                       for label, err in e]
+            engine_cpu, simulated, n, cpu = engine_cpu + c, simulated + t, n + k, cpu + s
+            served = served or hit
+        values = [e for _, e in errors]
+        worst = max(values) if values and all(math.isfinite(v) for v in values) \
+            else math.inf
+        return Evaluation(dict(cand), worst, tuple(errors), engine_cpu, cpu, simulated, n,
+                          from_store=served)
 
     for i, cand in enumerate(candidates):
         # Each finished candidate is kept whole in the run store, so a killed
@@ -358,7 +380,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
         if ev is not None:
             ev = dataclasses.replace(ev, from_store=True)
         else:
-            ev = runs.memo("calibration-candidate", description, lambda: evaluate(cand),
+            ev = runs.memo("calibration-candidate", description,
+                           lambda: evaluate(cand, description),
                            label=f"calibrate {engine} {metric}", code=runs.ALL_CODE)
         cal.evaluations.append(ev)
         if progress is not None:

@@ -117,6 +117,49 @@ def test_a_calibration_resumes_from_the_store_with_its_measured_costs(tmp_path, 
     assert again.recommended.options == first.recommended.options
 
 
+def test_a_calibration_killed_mid_candidate_resumes_at_the_next_scene(tmp_path, monkeypatch):
+    # One candidate over a design's scenes can take CPU hours (Drake at 1e-4 s):
+    # each scene is kept as soon as it is done, so a kill loses one scene at most.
+    from trilith_xval.compare.campaign import calibrate as module
+    from trilith_xval.compare.run import runs
+    from trilith_xval.compare.run.store import RunStore
+    from trilith_xval.scenes import load_scene
+
+    scenes = [load_scene("fig5"), load_scene("fig11_mu1")]
+    vs = ValidationSet(omegas=(12.0,))
+    measure, seen = module._thresholds, []
+
+    def killed_at_the_second(run, reference, workers):
+        if run.scene.name == "fig11_mu1":
+            raise KeyboardInterrupt  # as Ctrl-C (or kill -9) mid-candidate
+        out = measure(run, reference, workers)
+        seen.append(out)
+        return out
+
+    def counted(run, reference, workers):
+        seen.append(run.scene.name)
+        return measure(run, reference, workers)
+
+    previous = runs.activate(RunStore(tmp_path / "store"))
+    try:
+        monkeypatch.setattr(module, "_thresholds", killed_at_the_second)
+        with pytest.raises(KeyboardInterrupt):
+            calibrate("pymunk", "thresholds", validation=vs, space={"dt": [2e-3]}, scene=scenes)
+        (first_scene,) = seen
+        seen.clear()
+        monkeypatch.setattr(module, "_thresholds", counted)
+        cal = calibrate("pymunk", "thresholds", validation=vs, space={"dt": [2e-3]},
+                        scene=scenes)
+    finally:
+        runs.activate(previous)
+    assert seen == ["fig11_mu1"]  # the finished scene is not measured again
+    (ev,) = cal.evaluations
+    assert ev.from_store  # its costs are partly those measured before the kill
+    assert [(f"fig5: {label}", err) for label, err in first_scene[0]] == \
+        [e for e in ev.errors if e[0].startswith("fig5: ")]
+    assert {e[0].split(":")[0] for e in ev.errors} == {"fig5", "fig11_mu1"}
+
+
 def test_a_validation_set_of_several_scenes_takes_the_worst_over_all(tmp_path, capsys):
     import json
     out = tmp_path / "cal.json"
