@@ -356,8 +356,9 @@ def _print(cal) -> None:
               f"{e.runs:5d}  {mark}")
     served = sum(e.from_store for e in cal.evaluations)
     if served:
-        print(f"{served} of {len(cal.evaluations)} candidates served by the run store, with "
-              "the costs measured when they ran (--no-cache measures every one now)")
+        print(f"{served} of {len(cal.evaluations)} candidates served by the run store (whole, "
+              "or the scenes finished before a kill), with the costs measured when they ran "
+              "(--no-cache measures every one now)")
     if rec is None:
         print(f"no candidate meets {cal.tolerance:g}: widen the search (--dt, --vary) "
               f"or the tolerance")
