@@ -24,7 +24,8 @@ domain (and the values the calibration kept fixed are the scene's too);
 otherwise the engine's reference settings (its ``Settings`` defaults), with one
 line saying why.  A file whose table sets nothing (PyBullet, Drake: no coarser
 step kept a Fig. 5 threshold within 1 %, and no step, the reference included, met
-2 % on the sampled design) is a calibration that chose the reference.  A missing or malformed file is an error, never a silent fallback.
+2 % on the sampled design) is a calibration that chose the reference.  A missing
+or malformed file is an error, never a silent fallback.
 """
 from __future__ import annotations
 

@@ -336,8 +336,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
     def scene_part(sc, cand: dict, description: dict):
         # One scene of one candidate, kept in the run store as soon as it is done
         # (keyed by that scene alone): a calibration killed mid-candidate (one
-        # candidate over a design's scenes can take CPU hours) resumes at the next.  Measured with the store
-        # bypassed, so its costs are what its runs cost when they ran.
+        # candidate over a design's scenes can take CPU hours) resumes at the next.
+        # Measured with the store bypassed: its costs are what its runs cost then.
         key = {**description, "scenes": [scene_dict(sc)], "part": "scene",
                "validation": {**description["validation"], "scene": sc.name}}
         stored = runs.lookup("calibration-scene", key, code=runs.ALL_CODE)
@@ -368,9 +368,8 @@ def calibrate(engine: str, metric: str = "thresholds", *, validation: Validation
                           from_store=served)
 
     for i, cand in enumerate(candidates):
-        # Each finished candidate is kept whole in the run store, so a killed
-        # calibration resumes at the next one; a served candidate keeps the costs
-        # measured when it ran.
+        # A finished candidate is kept whole in the run store (its scenes, as they
+        # finish, by scene_part); a served one keeps the costs measured when it ran.
         description = _candidate_description(engine, metric, vs, scenes, {**base, **cand})
         if rf != 1.0:  # absent at 1: candidates stored before the factor keep their keys
             description["restitution_factor"] = rf

@@ -13,7 +13,8 @@ import math
 import statistics
 
 __all__ = ["trust_table", "threshold_agreement", "engine_cost", "key_settings", "conclusion",
-           "label", "fmt_sci", "fmt_seconds", "fmt_pct", "AGREEMENT_RULE", "EXCUSED"]
+           "label", "fmt_sci", "fmt_seconds", "fmt_pct", "cost_text", "AGREEMENT_RULE",
+           "EXCUSED"]
 
 
 # Settings that are bookkeeping, not the engine's numerical choices.
@@ -179,6 +180,22 @@ def fmt_seconds(x: float | None) -> str:
     if x < 120.0:
         return f"{x:.2g} s" if x < 10 else f"{x:.0f} s"
     return f"{x / 60.0:.2g} min"
+
+
+def cost_text(cost: dict, *, unmeasured: str, per_point: str = "") -> str:
+    """An engine's cost as the trust pages state it: median CPU per threshold point
+    (``per_point`` says what it includes), CPU s per simulated s, and the CPU of the
+    failing points' reruns when there were any; ``unmeasured`` when no threshold
+    point was measured."""
+    if cost.get("threshold_point_cpu_s") is None:
+        return unmeasured
+    parts = [f"{fmt_seconds(cost['threshold_point_cpu_s'])} CPU per threshold point{per_point}"]
+    if cost.get("cpu_per_sim_s") is not None:
+        parts.append(f"{cost['cpu_per_sim_s']:.3g} CPU s per simulated s")
+    if cost.get("rerun_cpu_s"):
+        parts.append("failing points remeasured (finer steps, causes): "
+                     f"{fmt_seconds(cost['rerun_cpu_s'])} CPU")
+    return "; ".join(parts)
 
 
 def conclusion(engine: str, row: dict) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import html
 
 from trilith_xval.compare.report.cells import _cell, csv_text, table
-from trilith_xval.compare.report.trust import fmt_sci, fmt_seconds
+from trilith_xval.compare.report.trust import cost_text, fmt_sci
 
 __all__ = ["banner", "kind_trust_rows", "kind_point_rows", "kind_trust_csv", "kind_trust_html"]
 
@@ -48,13 +48,8 @@ def _settings(entry: dict) -> dict:
 
 
 def _cost(entry: dict) -> dict:
-    c = entry["cost"]
-    if c["threshold_point_cpu_s"] is None:
-        return _cell("no point measured")
-    rtf = c["cpu_per_sim_s"]
-    return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per threshold point (its "
-                 "step ladder included)"
-                 + (f"; {rtf:.3g} CPU s per simulated s" if rtf is not None else ""))
+    return _cell(cost_text(entry["cost"], unmeasured="no point measured",
+                           per_point=" (its step ladder included)"))
 
 
 def kind_trust_rows(doc: dict) -> tuple[list[str], list[list]]:

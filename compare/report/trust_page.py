@@ -7,7 +7,7 @@ import html
 import math
 
 from trilith_xval.compare.report.cells import _cell, cause_phrase, csv_text, table
-from trilith_xval.compare.report.trust import fmt_pct, fmt_sci, fmt_seconds
+from trilith_xval.compare.report.trust import cost_text, fmt_pct, fmt_sci
 
 __all__ = ["trust_rows", "trust_html", "trust_csv", "point_rows", "spectrum_figures"]
 
@@ -67,14 +67,8 @@ def _settings(entry: dict) -> dict:
 
 
 def _cost(entry: dict) -> dict:
-    c = entry["cost"]
-    if c["threshold_point_cpu_s"] is None:
-        return _cell("served by the run store (--no-cache measures it)")
-    rtf = c["cpu_per_sim_s"]
-    return _cell(f"{fmt_seconds(c['threshold_point_cpu_s'])} CPU per threshold point; "
-                 + (f"{rtf:.3g} CPU s per simulated s" if rtf is not None else "")
-                 + (f"; failing points remeasured (finer steps, causes): "
-                    f"{fmt_seconds(c['rerun_cpu_s'])} CPU" if c["rerun_cpu_s"] else ""))
+    return _cell(cost_text(entry["cost"],
+                           unmeasured="served by the run store (--no-cache measures it)"))
 
 
 def trust_rows(doc: dict) -> tuple[list[str], list[list]]:
